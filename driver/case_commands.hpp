@@ -1,0 +1,22 @@
+#pragma once
+#include <string>
+#include <vector>
+
+namespace boycott::driver {
+
+struct CaseRunOptions {
+  std::string case_file;
+  std::string out_dir;
+  std::vector<std::string> overrides;
+  std::vector<std::string> petsc_options;
+  bool quiet = false;
+};
+
+/// `boycott case run`: exit code as in design brief section 7.
+int case_run(const CaseRunOptions& opt, int argc, char** argv);
+/// `boycott case check`: validates and prints the pre-flight report.
+int case_check(const std::string& file, const std::vector<std::string>& sets);
+/// `boycott case keys`: every key with its default.
+int case_keys();
+
+}  // namespace boycott::driver

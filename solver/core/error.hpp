@@ -1,0 +1,36 @@
+#pragma once
+// Error kinds map to the process exit codes of design brief section 7, so a driver can tell
+// bad input (never retried) from a run that went unstable (retry may help after a change).
+#include <stdexcept>
+#include <string>
+
+namespace boycott {
+
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitFailure = 1,      ///< unexpected internal failure
+  kExitInputError = 2,   ///< the case or study file is wrong; nothing ran
+  kExitPhysicsError = 3, ///< the run became unphysical (NaN, alpha_f outside (0,1], ...)
+  kExitCheckpointError = 4,  ///< a checkpoint exists but cannot be used (corrupt, other parameters)
+  kExitInterrupted = 75, ///< stopped by SIGINT/SIGTERM after writing a checkpoint (EX_TEMPFAIL)
+};
+
+/// Bad input: names the field, the value and the limit.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A run that left the physically admissible state; raised before anything is checkpointed.
+class PhysicsError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A checkpoint that cannot be resumed from.
+class CheckpointError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace boycott

@@ -1,0 +1,47 @@
+#include <fstream>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "scenes/run_common.hpp"
+#include "scenes/scene.hpp"
+#include "scenes/scenes_list.hpp"
+
+namespace boycott::scenes {
+
+SceneFn find_scene(const std::string& name) {
+  static const std::map<std::string, SceneFn> table = {
+      {"dem_only", &run_dem_only},
+      {"channel_flow", &run_channel_flow},
+  };
+  auto it = table.find(name);
+  if (it == table.end()) throw InputError(fmt::format("scene '{}' is not implemented yet", name));
+  return it->second;
+}
+
+int run_case(CaseParams params, RunContext& ctx) {
+  validate(params);
+  const SceneFn fn = find_scene(params.scene);
+  std::filesystem::create_directories(ctx.out_dir);
+  const auto params_path = ctx.out_dir / "params.json";
+  const auto canonical = to_json(params);
+  if (std::filesystem::exists(params_path)) {
+    // A run folder belongs to one case: resuming another case's folder would mix results.
+    std::ifstream in(params_path);
+    nlohmann::json stored;
+    try {
+      stored = nlohmann::json::parse(in);
+    } catch (const std::exception&) {
+      throw CheckpointError(fmt::format("{} is unreadable; refusing to overwrite it", params_path.string()));
+    }
+    if (stored != canonical)
+      throw CheckpointError(fmt::format("{} holds case {} but this is case {}; use another --out folder",
+                                        ctx.out_dir.string(), case_id(case_from_json(stored)), case_id(params)));
+  } else {
+    write_file_atomic(params_path, canonical.dump(2) + "\n");
+  }
+  return fn(params, ctx);
+}
+
+}  // namespace boycott::scenes

@@ -1,0 +1,74 @@
+#include "scenes/run_common.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "core/version.hpp"
+
+namespace boycott::scenes {
+
+void write_file_atomic(const std::filesystem::path& path, const std::string& text) {
+  const auto tmp = path.string() + ".tmp";
+  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) throw std::runtime_error(fmt::format("cannot write {}", tmp));
+  std::size_t off = 0;
+  while (off < text.size()) {
+    auto n = ::write(fd, text.data() + off, text.size() - off);
+    if (n <= 0) {
+      ::close(fd);
+      throw std::runtime_error(fmt::format("write to {} failed", tmp));
+    }
+    off += static_cast<std::size_t>(n);
+  }
+  ::fsync(fd);
+  ::close(fd);
+  std::filesystem::rename(tmp, path);
+}
+
+namespace {
+nlohmann::json num_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+}  // namespace
+
+nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const ModelTimers& timers) {
+  nlohmann::json j;
+  j["scene"] = p.scene;
+  j["case_id"] = case_id(p);
+  j["status"] = s.status;
+  j["simulated_time_s"] = s.simulated_time_s;
+  j["wall_time_s"] = s.wall_time_s;
+  j["particle_steps"] = s.particle_steps;
+  j["mean_settling_velocity_m_s"] = num_or_null(s.mean_settling_velocity_m_s);
+  j["settling_velocity_stderr_m_s"] = num_or_null(s.settling_velocity_stderr_m_s);
+  j["models"] = timers.to_json();
+  j["program_version"] = fmt::format("{}+{}", kVersion, kGitRevision);
+  return j;
+}
+
+CsvWriter::CsvWriter(const std::filesystem::path& path, std::vector<std::string> columns, bool append)
+    : ncol_(columns.size()) {
+  const bool exists = std::filesystem::exists(path) && std::filesystem::file_size(path) > 0;
+  f_ = std::fopen(path.c_str(), append && exists ? "a" : "w");
+  if (!f_) throw std::runtime_error(fmt::format("cannot write {}", path.string()));
+  if (!(append && exists)) {
+    for (std::size_t i = 0; i < columns.size(); ++i) std::fprintf(f_, i ? ",%s" : "%s", columns[i].c_str());
+    std::fputc('\n', f_);
+  }
+}
+
+CsvWriter::~CsvWriter() {
+  if (f_) std::fclose(f_);
+}
+
+void CsvWriter::row(const std::vector<double>& values) {
+  for (std::size_t i = 0; i < values.size() && i < ncol_; ++i) std::fprintf(f_, i ? ",%.10g" : "%.10g", values[i]);
+  std::fputc('\n', f_);
+}
+
+void CsvWriter::flush() { std::fflush(f_); }
+
+}  // namespace boycott::scenes

@@ -1,0 +1,58 @@
+#pragma once
+// What every scene writes the same way: summary.json with the common keys of design brief
+// section 7, timeseries.csv, atomic file replacement.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/case_params.hpp"
+#include "core/timers.hpp"
+
+namespace boycott::scenes {
+
+/// Writes `text` to `path` through a temporary file, fsync and rename, so a reader (or a kill)
+/// never sees half a file.
+void write_file_atomic(const std::filesystem::path& path, const std::string& text);
+
+/// Common summary keys. Scene-specific keys are added to the returned object by the scene.
+struct SummaryBase {
+  std::string status = "completed";  ///< "completed" | "interrupted" | "failed"
+  double simulated_time_s = 0.0;
+  double wall_time_s = 0.0;
+  double particle_steps = 0.0;  ///< particles x DEM steps
+  double mean_settling_velocity_m_s = kUnset;
+  double settling_velocity_stderr_m_s = kUnset;
+};
+nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const ModelTimers& timers);
+
+/// Appends rows to a CSV file with a fixed header; creates it (with the header) when absent.
+class CsvWriter {
+ public:
+  CsvWriter(const std::filesystem::path& path, std::vector<std::string> columns, bool append);
+  ~CsvWriter();
+  void row(const std::vector<double>& values);
+  void flush();
+  CsvWriter(const CsvWriter&) = delete;
+  CsvWriter& operator=(const CsvWriter&) = delete;
+
+ private:
+  std::FILE* f_ = nullptr;
+  std::size_t ncol_;
+};
+
+/// Wall clock since construction, seconds.
+class WallClock {
+ public:
+  double seconds() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace boycott::scenes

@@ -1,0 +1,36 @@
+#pragma once
+// A scene is a function from a validated case to a finished run folder (summary.json,
+// timeseries.csv, ...). Scenes switch on only the physics they need and record it in
+// ModelTimers, which every summary lists.
+#include <atomic>
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "core/case_params.hpp"
+
+namespace boycott::scenes {
+
+struct RunContext {
+  std::filesystem::path out_dir;
+  /// Set asynchronously by SIGINT/SIGTERM: the scene finishes its step, checkpoints, returns 75.
+  const std::atomic<bool>* stop_requested = nullptr;
+  bool quiet = false;
+  /// Progress callback (simulated time s), for the driver's display; may be empty.
+  std::function<void(double)> progress;
+  bool should_stop() const { return stop_requested && stop_requested->load(std::memory_order_relaxed); }
+};
+
+/// Runs (or resumes) a case. Returns the process exit code (error.hpp); writes summary.json.
+using SceneFn = int (*)(const CaseParams&, RunContext&);
+
+/// The scene table: name -> function. Throws InputError for a scene not built yet.
+SceneFn find_scene(const std::string& name);
+
+/// Validates, writes params.json beside the outputs (refusing a folder that holds another case)
+/// and runs the scene.
+int run_case(CaseParams params, RunContext& ctx);
+
+}  // namespace boycott::scenes
