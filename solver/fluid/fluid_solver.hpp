@@ -1,0 +1,215 @@
+#pragma once
+// Volume-averaged incompressible Navier-Stokes on a staggered (MAC) grid laid out by PETSc DMDA,
+// equation set II (Zhou et al. 2010; Zeng et al. 2021, Eqs. 1-2), per unit fluid mass:
+//
+//   d(a)/dt + div(a u) = 0                                                        (1)
+//   d(a u)/dt + div(a u u) = -a grad(p)/rho + a div(nu_eff (grad u + grad u^T)) + a g
+//                            - a G e_z / rho + S/rho + K (u_p - u)/rho            (2)
+//
+// a = alpha_f (given, time-varying), S an explicit momentum source (N/m^3), K an implicit drag
+// coefficient (kg/(m^3 s)) with the deposited particle velocity u_p, G the uniform mean
+// pressure gradient in z (Pa/m) set by the flux controller, nu_eff = nu + nu_t (Vreman).
+//
+// Layout ("DMDA with explicit staggering"): one cell-centred DMDA (dof 1); the value stored at
+// cell (i,j,k) of the u, v, w vectors lives on that cell's LOWER x, y, z face. With y walls the
+// y-face j = 0 is the wall y = 0 (v = 0 kept there) and the top wall face j = ny is implicit.
+// Discretisation: finite volume, BDF2 (variable step) in time, QUICK convection by deferred
+// correction on implicit upwind, central diffusion and pressure gradient, SIMPLE with
+// under-relaxation; linear systems by PETSc KSP with prefixes "momentum_" and "pressure_"
+// (defaults: BiCGStab + block Jacobi/ILU; CG + hypre BoomerAMG, constant null space removed).
+#include <mpi.h>
+#include <petscdmda.h>
+#include <petscksp.h>
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/grid_spec.hpp"
+
+namespace boycott {
+struct CaseParams;
+}
+
+namespace boycott::fluid {
+
+struct FluidSettings {
+  GridSpec grid;
+  double density_kg_m3 = 1000.0;
+  double viscosity_pa_s = 1.0e-3;  ///< dynamic
+  bool vreman = false;             ///< Vreman subgrid viscosity on/off
+  double vreman_constant = 0.07;
+  bool top_slip = false;  ///< y = W is a slip (mirror) wall instead of no-slip
+  std::array<double, 3> body_acceleration_m_s2 = {0.0, 0.0, 0.0};
+  /// Flux controller target for the volume mean of alpha_f w (m/s); NaN = controller off.
+  double target_mean_flux_z_m_s = std::numeric_limits<double>::quiet_NaN();
+  int simple_max_iterations = 30;
+  double simple_tolerance = 1.0e-6;
+  double velocity_relaxation = 0.8;
+  double pressure_relaxation = 0.5;  ///< used by plain SIMPLE; SIMPLEC corrects p fully
+  /// SIMPLEC correction coefficient a/(rho (a_P - sum a_nb)) instead of SIMPLE's a/(rho a_P):
+  /// plain SIMPLE diverges for diffusion-dominated cells of high aspect ratio (nu dt/h_y^2 >> 1
+  /// with h_x >> h_y, as on the paper's 1 x 1 x 1 mm grid with 6 cells across a 6 mm gap).
+  bool simplec = true;
+  double cfl_max = 0.5;
+  double dt_max_s = 1.0e-3;
+  bool quick = true;  ///< false: first-order upwind convection (for comparisons)
+  /// Builds the settings of a case: grid, fluid, numerics, `[flow]` forcing.
+  static FluidSettings from_case(const CaseParams& p);
+};
+
+/// What one step did.
+struct StepReport {
+  double dt_s = 0.0;
+  int simple_iterations = 0;
+  bool converged = false;
+  int momentum_krylov_iterations = 0;  ///< summed over components and SIMPLE iterations
+  int pressure_krylov_iterations = 0;  ///< summed over SIMPLE iterations
+  double continuity_residual = 0.0;    ///< last max |d a/dt + div(a u*)| * h / U before correction
+  double mean_pressure_gradient_pa_m = 0.0;
+};
+
+/// Owned box of this rank in cell indices: [lo, lo + size).
+struct OwnedBox {
+  std::array<std::int64_t, 3> lo{}, size{};
+};
+
+/// Ghosted local arrays of one rank, indexed [k][j][i] with global cell indices inside the
+/// ghosted box (DMDAVecGetArray convention). Face fields use the lower-face convention above.
+struct GhostBox {
+  std::array<std::int64_t, 3> lo{}, size{};  ///< ghosted box (may start below 0 where periodic)
+};
+
+/// Full restart state, this rank's owned values (x fastest over the owned box).
+struct FluidState {
+  OwnedBox box;
+  double time_s = 0.0, dt_prev_s = 0.0;
+  int steps = 0;
+  double mean_pressure_gradient_pa_m = 0.0;
+  /// u, v, w at levels n and n-1, p, alpha_f at n, n-1 and n+1: 10 owned arrays.
+  std::vector<std::vector<double>> fields;
+};
+
+class FluidSolver {
+ public:
+  explicit FluidSolver(const FluidSettings& s, MPI_Comm comm = PETSC_COMM_WORLD);
+  ~FluidSolver();
+  FluidSolver(const FluidSolver&) = delete;
+  FluidSolver& operator=(const FluidSolver&) = delete;
+
+  const FluidSettings& settings() const { return s_; }
+  OwnedBox owned_box() const;
+  GhostBox ghost_box() const;
+  MPI_Comm comm() const { return comm_; }
+
+  // ---- initial and given fields (tests, scenes) ----
+  /// Sets velocity component c (0 u, 1 v, 2 w) at every face from f(x, y, z) (m/s), at the
+  /// current and previous time levels (a start from a steady state).
+  void set_velocity(int c, const std::function<double(double, double, double)>& f);
+  /// Sets alpha_f at cell centres for the NEXT step (level n+1); the first call before any step
+  /// also sets levels n and n-1. Throws PhysicsError outside (0, 1].
+  void set_fluid_fraction(const std::function<double(double, double, double)>& f);
+  void set_body_acceleration(const std::array<double, 3>& g_m_s2) { s_.body_acceleration_m_s2 = g_m_s2; }
+
+  // ---- coupling interface (deposition on local arrays, ADD_VALUES assembly) ----
+  /// Zeroes the local deposition arrays: solid fraction (centres), explicit source S (N/m^3,
+  /// faces per component), drag coefficient K (kg/(m^3 s), faces) and K u_p (N/m^3, faces).
+  void begin_deposition();
+  /// Writable ghosted local arrays ([k][j][i], global indices of the ghost box). Particles add
+  /// their share with any kernel that stays within the ghost width (2 cells).
+  PetscScalar*** solid_fraction_local();
+  PetscScalar*** source_local(int c);
+  PetscScalar*** drag_coefficient_local(int c);
+  PetscScalar*** drag_momentum_local(int c);  ///< sum of K u_p (deposited particle velocity)
+  /// Adds the local arrays of all ranks (ADD_VALUES local-to-global), sets alpha_f = 1 - solid
+  /// fraction at level n+1 (PhysicsError when it leaves (0, 1]), and arms S, K, K u_p for the
+  /// next step. The arrays returned above are invalid afterwards.
+  void end_deposition();
+  /// Switches the explicit source and drag off again (they stay armed until changed).
+  void clear_coupling_sources();
+  /// Flux controller target (m/s) for the mean of alpha_f w; NaN switches it off.
+  void set_target_mean_flux_z(double v) { s_.target_mean_flux_z_m_s = v; }
+  /// Mean pressure gradient G in z (Pa/m); set by the controller or by hand when it is off.
+  double mean_pressure_gradient_pa_m() const { return G_; }
+  void set_mean_pressure_gradient_pa_m(double g) { G_ = g; }
+
+  /// Read access to ghosted u, v, w (c = 0..2), p (c = 3) and nu_t (c = 4), valid until the next
+  /// step; restore with restore_read().
+  const PetscScalar* const* const* read_local(int c);
+  void restore_read(int c);
+
+  // ---- time stepping ----
+  /// dt from CFL = max_c |u_c| dt / h_c <= cfl_max, never above dt_max_s.
+  double stable_dt() const;
+  /// Advances one step of size dt (s).
+  StepReport step(double dt_s);
+  double time_s() const { return time_; }
+  int steps_done() const { return steps_; }
+
+  // ---- diagnostics ----
+  /// Volume mean of alpha_f w over the domain (m/s).
+  double mean_flux_z() const;
+  /// Volume mean of velocity component c (m/s).
+  double mean_velocity(int c) const;
+  double max_abs_velocity(int c) const;
+  /// max over cells of |d a/dt + div(a u)| (1/s) for the last step's levels.
+  double max_continuity_defect() const;
+  /// Profile of component c averaged over x and z, per y cell (c = 1: per y face), all ranks.
+  std::vector<double> profile_y(int c) const;
+  /// Copy of one field on all ranks in natural order (x fastest): c = 0..2 velocity, 3 p,
+  /// 4 nu_t, 5 alpha_f (tests, small grids).
+  std::vector<double> gather(int c) const;
+
+  // ---- checkpoints ----
+  FluidState export_state() const;
+  void import_state(const FluidState& st);
+
+ private:
+  void create_layout();
+  void update_ghosts();
+  void compute_subgrid_viscosity();
+  void assemble_momentum(int c, double dt, double c0, double c1, double c2, bool first_iteration);
+  void apply_flux_controller();
+  double continuity_residual(double dt, double c0, double c1, double c2, Vec R);
+  void assemble_pressure();
+  void correct(Vec pcorr);
+
+  FluidSettings s_;
+  MPI_Comm comm_;
+  DM da_ = nullptr;    // box stencil, width 2: ghosted fields
+  DM dam_ = nullptr;   // star stencil, width 1, same ownership: matrices
+  Mat A_ = nullptr;    // momentum matrix (one component at a time)
+  Mat Ap_ = nullptr;   // pressure-correction matrix
+  KSP ksp_m_ = nullptr, ksp_p_ = nullptr;
+  MatNullSpace null_ = nullptr;
+
+  // global vectors
+  Vec U_[3]{}, Un_[3]{}, Unm1_[3]{}, P_ = nullptr, alpha_[3]{};  // alpha_[0]=n+1, [1]=n, [2]=n-1
+  Vec Ustar_prev_[3]{};  // iterate before the momentum solve (relaxation)
+  Vec D_[3]{};           // a_face / (rho a_P') per face (SIMPLE correction coefficient)
+  Vec S_[3]{}, K_[3]{}, KU_[3]{};  // coupling fields on faces
+  Vec nut_ = nullptr;
+  Vec rhs_ = nullptr, sol_ = nullptr, R_ = nullptr, pc_ = nullptr;
+  // ghosted local vectors
+  Vec Ul_[3]{}, Pl_ = nullptr, alphal_[3]{}, nutl_ = nullptr, pcl_ = nullptr, Dl_[3]{};
+  Vec dep_solid_ = nullptr, dep_S_[3]{}, dep_K_[3]{}, dep_KU_[3]{};
+  bool deposition_open_ = false;
+  bool coupling_armed_ = false;
+  bool alpha_initialised_ = false;
+  PetscScalar*** dep_arrays_[10]{};
+  PetscScalar*** read_arrays_[5]{};
+
+  double time_ = 0.0;
+  double dt_prev_ = 0.0;
+  int steps_ = 0;
+  double G_ = 0.0;
+  double last_c_[3] = {1.0, 1.0, 0.0};
+  double last_dt_ = 0.0;
+  double last_defect_ = 0.0;
+  int momentum_its_ = 0;
+};
+
+}  // namespace boycott::fluid
