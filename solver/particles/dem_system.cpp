@@ -1,0 +1,562 @@
+#include "particles/dem_system.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <unordered_map>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
+namespace boycott::particles {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::uint64_t pair_key(std::int64_t a, std::int64_t b) {
+  return (static_cast<std::uint64_t>(a) << 32) ^ static_cast<std::uint64_t>(b);
+}
+}  // namespace
+
+DemConfig DemConfig::from_case(const CaseParams& p) {
+  DemConfig c;
+  c.box.lo = {0.0, 0.0, 0.0};
+  c.box.len = {p.domain.length_x_m, p.domain.width_y_m, p.domain.height_z_m};
+  c.box.periodic = {true, p.domain.periodic_y, true};
+  if (!p.domain.periodic_y) {
+    c.walls.push_back(PlaneWall{0.0, 0.0, 0.0, 0.0, 1.0, 0.0});
+    c.walls.push_back(PlaneWall{0.0, p.domain.width_y_m, 0.0, 0.0, -1.0, 0.0});
+  }
+  c.gravity_m_s2 = p.gravity_vector();
+  c.dt_s = p.time.dt_dem_s;
+  c.skin_m = p.numerics.neighbor_skin_m;
+  c.contact = LinearSpringDashpot(p.contact.stiffness_n_m, p.contact.restitution, p.contact.tangential_damping_ratio,
+                                  p.contact.friction, p.contact.clip_attractive_normal);
+  c.rolling_model = p.contact.rolling_model;
+  c.rolling_friction = p.contact.rolling_friction;
+  return c;
+}
+
+DemSystem::DemSystem(const DemConfig& cfg) : cfg_(cfg) {
+  whx_.resize(cfg_.walls.size());
+  why_.resize(cfg_.walls.size());
+  whz_.resize(cfg_.walls.size());
+}
+
+void DemSystem::add_particle(std::int64_t gid, double x, double y, double z, double r, double rho) {
+  s_.add(gid, x, y, z, r, rho);
+  for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
+    whx_[w].push_back(0.0);
+    why_[w].push_back(0.0);
+    whz_[w].push_back(0.0);
+  }
+}
+
+void DemSystem::insert_random(std::int64_t count, double r, double rho, std::array<double, 3> lo,
+                              std::array<double, 3> hi, std::uint64_t seed, double gap_m) {
+  // Trial placement against a uniform grid of already placed centres (cell >= 2r + gap), so
+  // each trial costs O(1); bounded attempts so an overfull request fails instead of hanging.
+  std::mt19937_64 rng(seed);
+  const double dmin = 2.0 * r + gap_m;
+  std::array<int, 3> nc;
+  for (int d = 0; d < 3; ++d) nc[d] = std::max(1, static_cast<int>(cfg_.box.len[d] / dmin));
+  std::vector<std::vector<std::uint32_t>> cells(static_cast<std::size_t>(nc[0]) * nc[1] * nc[2]);
+  auto coord = [&](double p, int d) {
+    double f = (p - cfg_.box.lo[d]) / cfg_.box.len[d];
+    f -= std::floor(f);
+    return std::clamp(static_cast<int>(f * nc[d]), 0, nc[d] - 1);
+  };
+  for (std::size_t i = 0; i < s_.size(); ++i)
+    cells[coord(s_.x[i], 0) + nc[0] * (coord(s_.y[i], 1) + nc[1] * coord(s_.z[i], 2))].push_back(i);
+  std::array<std::uniform_real_distribution<double>, 3> U;
+  for (int d = 0; d < 3; ++d) U[d] = std::uniform_real_distribution<double>(lo[d], hi[d]);
+  std::int64_t next_id = s_.size() ? *std::max_element(s_.id.begin(), s_.id.end()) + 1 : 0;
+  const std::int64_t max_attempts = 2000 * count + 100000;
+  std::int64_t placed = 0, attempts = 0;
+  while (placed < count) {
+    if (++attempts > max_attempts)
+      throw InputError(fmt::format("could not insert {} particles of radius {} m without overlap after {} attempts "
+                                   "({} placed): the region is too full",
+                                   count, r, max_attempts, placed));
+    const double p[3] = {U[0](rng), U[1](rng), U[2](rng)};
+    bool ok = true;
+    for (const auto& w : cfg_.walls) {
+      const double dist = (p[0] - w.px) * w.nx + (p[1] - w.py) * w.ny + (p[2] - w.pz) * w.nz;
+      if (dist < r + 0.5 * gap_m) ok = false;
+    }
+    const int c[3] = {coord(p[0], 0), coord(p[1], 1), coord(p[2], 2)};
+    for (int oz = -1; oz <= 1 && ok; ++oz)
+      for (int oy = -1; oy <= 1 && ok; ++oy)
+        for (int ox = -1; ox <= 1 && ok; ++ox) {
+          const int k[3] = {c[0] + ox, c[1] + oy, c[2] + oz};
+          int kk[3];
+          bool skip = false;
+          for (int d = 0; d < 3; ++d) {
+            kk[d] = k[d];
+            if (k[d] < 0 || k[d] >= nc[d]) {
+              if (!cfg_.box.periodic[d]) skip = true;
+              kk[d] = (k[d] + nc[d]) % nc[d];
+            }
+          }
+          if (skip) continue;
+          for (std::uint32_t j : cells[kk[0] + nc[0] * (kk[1] + nc[1] * kk[2])]) {
+            const double dx = min_image(p[0] - s_.x[j], cfg_.box.len[0], cfg_.box.periodic[0]);
+            const double dy = min_image(p[1] - s_.y[j], cfg_.box.len[1], cfg_.box.periodic[1]);
+            const double dz = min_image(p[2] - s_.z[j], cfg_.box.len[2], cfg_.box.periodic[2]);
+            const double rr = r + s_.radius[j] + gap_m;
+            if (dx * dx + dy * dy + dz * dz < rr * rr) {
+              ok = false;
+              break;
+            }
+          }
+        }
+    if (!ok) continue;
+    cells[c[0] + nc[0] * (c[1] + nc[1] * c[2])].push_back(static_cast<std::uint32_t>(s_.size()));
+    add_particle(next_id++, p[0], p[1], p[2], r, rho);
+    ++placed;
+  }
+}
+
+void DemSystem::initialize() {
+  double rmax = 0.0;
+  for (double r : s_.radius) rmax = std::max(rmax, r);
+  cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
+  rebuild();
+  compute_forces();
+  initialized_ = true;
+}
+
+void DemSystem::force_rebuild() {
+  rebuild();
+  compute_forces();
+}
+
+bool DemSystem::needs_rebuild() const {
+  const double lim2 = 0.25 * cfg_.skin_m * cfg_.skin_m;
+  const std::size_t n = s_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double dx = s_.x[i] - ref_x_[i], dy = s_.y[i] - ref_y_[i], dz = s_.z[i] - ref_z_[i];
+    if (dx * dx + dy * dy + dz * dz > lim2) return true;
+  }
+  return false;
+}
+
+void DemSystem::collect_histories() {
+  // Contacts with a shear history, keyed by global ids so they survive reordering and rebuilds.
+  carry_a_.clear();
+  carry_b_.clear();
+  carry_h_.clear();
+  const std::size_t n = s_.size();
+  if (nl_.offsets.size() != n + 1) return;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
+      if (hx_[p] == 0.0 && hy_[p] == 0.0 && hz_[p] == 0.0) continue;
+      const std::int64_t a = s_.id[i], b = s_.id[nl_.neighbors[p]];
+      const double sg = a < b ? 1.0 : -1.0;
+      carry_a_.push_back(std::min(a, b));
+      carry_b_.push_back(std::max(a, b));
+      carry_h_.insert(carry_h_.end(), {sg * hx_[p], sg * hy_[p], sg * hz_[p]});
+    }
+}
+
+void DemSystem::rebuild() {
+  auto t0 = Clock::now();
+  collect_histories();
+  // Wrap periodic coordinates into the box, then store particles cell by cell.
+  for (int d = 0; d < 3; ++d) {
+    if (!cfg_.box.periodic[d]) continue;
+    auto& c = d == 0 ? s_.x : (d == 1 ? s_.y : s_.z);
+    const double lo = cfg_.box.lo[d], len = cfg_.box.len[d];
+    for (double& v : c) v -= len * std::floor((v - lo) / len);
+  }
+  const auto order = nl_.cell_order(s_, cfg_.box, cutoff_m_);
+  s_.permute(order);
+  std::vector<double> tmp(order.size());
+  for (auto* wh : {&whx_, &why_, &whz_})
+    for (auto& a : *wh) {
+      for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = a[order[k]];
+      a.swap(tmp);
+    }
+  nl_.build(s_, cfg_.box, cutoff_m_);
+  const std::size_t np = nl_.pair_count();
+  hx_.assign(np, 0.0);
+  hy_.assign(np, 0.0);
+  hz_.assign(np, 0.0);
+  if (!carry_a_.empty()) {
+    std::unordered_map<std::uint64_t, std::size_t> slot;
+    slot.reserve(carry_a_.size() * 2);
+    for (std::size_t q = 0; q < carry_a_.size(); ++q) slot[pair_key(carry_a_[q], carry_b_[q])] = q;
+    for (std::size_t i = 0; i < s_.size(); ++i)
+      for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
+        const std::int64_t a = s_.id[i], b = s_.id[nl_.neighbors[p]];
+        auto it = slot.find(pair_key(std::min(a, b), std::max(a, b)));
+        if (it == slot.end()) continue;
+        const double sg = a < b ? 1.0 : -1.0;
+        hx_[p] = sg * carry_h_[3 * it->second];
+        hy_[p] = sg * carry_h_[3 * it->second + 1];
+        hz_[p] = sg * carry_h_[3 * it->second + 2];
+      }
+  }
+  ref_x_ = s_.x;
+  ref_y_ = s_.y;
+  ref_z_ = s_.z;
+  ++rebuilds_;
+  seconds_neighbor += since(t0);
+}
+
+template <class Rolling>
+void DemSystem::compute_forces_impl(const Rolling& rolling) {
+  const std::size_t n = s_.size();
+  std::fill(s_.fx.begin(), s_.fx.end(), 0.0);
+  std::fill(s_.fy.begin(), s_.fy.end(), 0.0);
+  std::fill(s_.fz.begin(), s_.fz.end(), 0.0);
+  std::fill(s_.tx.begin(), s_.tx.end(), 0.0);
+  std::fill(s_.ty.begin(), s_.ty.end(), 0.0);
+  std::fill(s_.tz.begin(), s_.tz.end(), 0.0);
+  const LinearSpringDashpot& cm = cfg_.contact;
+  const double kn = cm.kn_n_m, kt = cm.kt_n_m, dt = cfg_.dt_s, mu = cm.friction;
+  const double Lx = cfg_.box.len[0], Ly = cfg_.box.len[1], Lz = cfg_.box.len[2];
+  const bool px = cfg_.box.periodic[0], py = cfg_.box.periodic[1], pz = cfg_.box.periodic[2];
+  const bool clip = cm.clip_attractive;
+  double* __restrict fx = s_.fx.data();
+  double* __restrict fy = s_.fy.data();
+  double* __restrict fz = s_.fz.data();
+  double* __restrict tx = s_.tx.data();
+  double* __restrict ty = s_.ty.data();
+  double* __restrict tz = s_.tz.data();
+  const double* __restrict x = s_.x.data();
+  const double* __restrict y = s_.y.data();
+  const double* __restrict z = s_.z.data();
+  const double* __restrict vx = s_.vx.data();
+  const double* __restrict vy = s_.vy.data();
+  const double* __restrict vz = s_.vz.data();
+  const double* __restrict wx = s_.wx.data();
+  const double* __restrict wy = s_.wy.data();
+  const double* __restrict wz = s_.wz.data();
+  const double* __restrict rad = s_.radius.data();
+  const double* __restrict mass = s_.mass.data();
+  const double* __restrict inertia = s_.inertia.data();
+  std::int64_t contacts = 0;
+
+  // Force on particle a from a contact with normal n (pointing into a), overlap delta, relative
+  // contact velocity (vrx, vry, vrz), effective mass, shear history h (updated in place).
+  // Returns the normal force magnitude (signed) and writes the tangential force.
+  auto contact = [&](double nx, double ny, double nz, double delta, double vrx, double vry, double vrz,
+                     double meff, double& hxr, double& hyr, double& hzr, double& ftx, double& fty,
+                     double& ftz) {
+    const double gn = cm.damping_factor * std::sqrt(meff * kn);
+    const double gt = cm.tangential_ratio * gn;
+    const double vn = vrx * nx + vry * ny + vrz * nz;
+    double fn = kn * delta - gn * vn;
+    if (clip) fn = std::max(fn, 0.0);
+    const double vtx = vrx - vn * nx, vty = vry - vn * ny, vtz = vrz - vn * nz;
+    // Shear spring: accumulate, then rotate back into the current tangent plane keeping its length.
+    double hx = hxr + vtx * dt, hy = hyr + vty * dt, hz = hzr + vtz * dt;
+    const double hn = hx * nx + hy * ny + hz * nz;
+    const double h2 = hx * hx + hy * hy + hz * hz;
+    hx -= hn * nx;
+    hy -= hn * ny;
+    hz -= hn * nz;
+    const double h2p = hx * hx + hy * hy + hz * hz;
+    if (h2p > 0.0) {
+      const double sc = std::sqrt(h2 / h2p);
+      hx *= sc;
+      hy *= sc;
+      hz *= sc;
+    }
+    ftx = -kt * hx - gt * vtx;
+    fty = -kt * hy - gt * vty;
+    ftz = -kt * hz - gt * vtz;
+    const double ft2 = ftx * ftx + fty * fty + ftz * ftz;
+    const double fc = mu * std::abs(fn);
+    if (ft2 > fc * fc) {
+      // Sliding (Eq. 10): cap the force, and reset the spring to what the capped force implies.
+      const double sc = fc / std::sqrt(ft2);
+      ftx *= sc;
+      fty *= sc;
+      ftz *= sc;
+      hx = -(ftx + gt * vtx) / kt;
+      hy = -(fty + gt * vty) / kt;
+      hz = -(ftz + gt * vtz) / kt;
+    }
+    hxr = hx;
+    hyr = hy;
+    hzr = hz;
+    return fn;
+  };
+
+  for (std::size_t i = 0; i < n; ++i) {
+    double fxi = 0.0, fyi = 0.0, fzi = 0.0, txi = 0.0, tyi = 0.0, tzi = 0.0;
+    const double xi = x[i], yi = y[i], zi = z[i], ri = rad[i], mi = mass[i];
+    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
+      const std::uint32_t j = nl_.neighbors[p];
+      const double dx = min_image(xi - x[j], Lx, px);
+      const double dy = min_image(yi - y[j], Ly, py);
+      const double dz = min_image(zi - z[j], Lz, pz);
+      const double rsum = ri + rad[j];
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      if (r2 >= rsum * rsum) {
+        hx_[p] = hy_[p] = hz_[p] = 0.0;
+        continue;
+      }
+      ++contacts;
+      const double r = std::sqrt(r2);
+      const double inv = 1.0 / r;
+      const double nx = dx * inv, ny = dy * inv, nz = dz * inv;
+      const double rj = rad[j];
+      // (R_i w_i + R_j w_j) x n: surface velocities of the two spheres at the contact point.
+      const double cx = ri * wx[i] + rj * wx[j], cy = ri * wy[i] + rj * wy[j], cz = ri * wz[i] + rj * wz[j];
+      const double vrx = vx[i] - vx[j] - (cy * nz - cz * ny);
+      const double vry = vy[i] - vy[j] - (cz * nx - cx * nz);
+      const double vrz = vz[i] - vz[j] - (cx * ny - cy * nx);
+      const double meff = mi * mass[j] / (mi + mass[j]);
+      double ftx, fty, ftz;
+      const double fn = contact(nx, ny, nz, rsum - r, vrx, vry, vrz, meff, hx_[p], hy_[p], hz_[p], ftx, fty, ftz);
+      const double Fx = fn * nx + ftx, Fy = fn * ny + fty, Fz = fn * nz + ftz;
+      fxi += Fx;
+      fyi += Fy;
+      fzi += Fz;
+      fx[j] -= Fx;
+      fy[j] -= Fy;
+      fz[j] -= Fz;
+      // Torque -R n x F_t on both spheres (the arm of j is +R_j n, its force -F_t).
+      const double mx = ny * ftz - nz * fty, my = nz * ftx - nx * ftz, mz = nx * fty - ny * ftx;
+      double rtx = 0.0, rty = 0.0, rtz = 0.0;
+      if constexpr (Rolling::enabled) {
+        const double orx = wx[i] - wx[j], ory = wy[i] - wy[j], orz = wz[i] - wz[j];
+        const double on = orx * nx + ory * ny + orz * nz;
+        const double otx = orx - on * nx, oty = ory - on * ny, otz = orz - on * nz;
+        const double om = std::sqrt(otx * otx + oty * oty + otz * otz);
+        if (om > 0.0) {
+          const double tau = rolling.mu_r * std::abs(fn);
+          // Cap: the pair's relative rolling may stop within this step but never reverse.
+          const double rate = tau * (ri / inertia[i] + rj / inertia[j]) * dt;
+          const double s = tau * std::min(1.0, om / rate) / om;
+          rtx = s * otx;
+          rty = s * oty;
+          rtz = s * otz;
+        }
+      }
+      txi += -ri * mx - ri * rtx;
+      tyi += -ri * my - ri * rty;
+      tzi += -ri * mz - ri * rtz;
+      tx[j] += -rj * mx + rj * rtx;
+      ty[j] += -rj * my + rj * rty;
+      tz[j] += -rj * mz + rj * rtz;
+    }
+    fx[i] += fxi;
+    fy[i] += fyi;
+    fz[i] += fzi;
+    tx[i] += txi;
+    ty[i] += tyi;
+    tz[i] += tzi;
+  }
+
+  // Walls: a sphere of infinite mass at rest; history per particle and wall.
+  for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
+    const PlaneWall& W = cfg_.walls[w];
+    double* __restrict whx = whx_[w].data();
+    double* __restrict why = why_[w].data();
+    double* __restrict whz = whz_[w].data();
+    for (std::size_t i = 0; i < n; ++i) {
+      const double dist = (x[i] - W.px) * W.nx + (y[i] - W.py) * W.ny + (z[i] - W.pz) * W.nz;
+      const double ri = rad[i];
+      if (dist >= ri) {
+        whx[i] = why[i] = whz[i] = 0.0;
+        continue;
+      }
+      ++contacts;
+      const double nx = W.nx, ny = W.ny, nz = W.nz;
+      const double cx = ri * wx[i], cy = ri * wy[i], cz = ri * wz[i];
+      const double vrx = vx[i] - (cy * nz - cz * ny);
+      const double vry = vy[i] - (cz * nx - cx * nz);
+      const double vrz = vz[i] - (cx * ny - cy * nx);
+      double ftx, fty, ftz;
+      const double fn = contact(nx, ny, nz, ri - dist, vrx, vry, vrz, mass[i], whx[i], why[i], whz[i], ftx, fty, ftz);
+      fx[i] += fn * nx + ftx;
+      fy[i] += fn * ny + fty;
+      fz[i] += fn * nz + ftz;
+      const double mx = ny * ftz - nz * fty, my = nz * ftx - nx * ftz, mz = nx * fty - ny * ftx;
+      double rtx = 0.0, rty = 0.0, rtz = 0.0;
+      if constexpr (Rolling::enabled) {
+        const double on = wx[i] * nx + wy[i] * ny + wz[i] * nz;
+        const double otx = wx[i] - on * nx, oty = wy[i] - on * ny, otz = wz[i] - on * nz;
+        const double om = std::sqrt(otx * otx + oty * oty + otz * otz);
+        if (om > 0.0) {
+          const double tau = rolling.mu_r * std::abs(fn);
+          const double rate = tau * ri / inertia[i] * dt;
+          const double s = tau * std::min(1.0, om / rate) / om;
+          rtx = s * otx;
+          rty = s * oty;
+          rtz = s * otz;
+        }
+      }
+      tx[i] += -ri * (mx + rtx);
+      ty[i] += -ri * (my + rty);
+      tz[i] += -ri * (mz + rtz);
+    }
+  }
+  contacts_ = contacts;
+}
+
+void DemSystem::compute_forces() {
+  auto t0 = Clock::now();
+  if (cfg_.rolling_model == "none" || cfg_.rolling_friction == 0.0) compute_forces_impl(RollingNone{});
+  else compute_forces_impl(RollingConstantDirectional{cfg_.rolling_friction});
+  seconds_force += since(t0);
+}
+
+void DemSystem::kick(double h) {
+  // Half kick of velocity Verlet with the drag implicit (backward Euler over the half step):
+  //   (M + h beta) v_new = M v + h (F + F_ext + m g + beta u_f),  M = m + m_add.
+  // beta -> infinity gives v = u_f + F/beta: stable for any particle response time.
+  const std::size_t n = s_.n_local;
+  const double gx = cfg_.gravity_m_s2[0], gy = cfg_.gravity_m_s2[1], gz = cfg_.gravity_m_s2[2];
+  for (std::size_t i = 0; i < n; ++i) {
+    const double m = s_.mass[i];
+    const double M = m + s_.madd[i];
+    const double b = s_.beta[i];
+    const double inv = 1.0 / (M + h * b);
+    s_.vx[i] = (M * s_.vx[i] + h * (s_.fx[i] + s_.ext_x[i] + m * gx + b * s_.ufx[i])) * inv;
+    s_.vy[i] = (M * s_.vy[i] + h * (s_.fy[i] + s_.ext_y[i] + m * gy + b * s_.ufy[i])) * inv;
+    s_.vz[i] = (M * s_.vz[i] + h * (s_.fz[i] + s_.ext_z[i] + m * gz + b * s_.ufz[i])) * inv;
+    const double hi = h / s_.inertia[i];
+    s_.wx[i] += hi * s_.tx[i];
+    s_.wy[i] += hi * s_.ty[i];
+    s_.wz[i] += hi * s_.tz[i];
+  }
+}
+
+void DemSystem::drift() {
+  const std::size_t n = s_.n_local;
+  const double dt = cfg_.dt_s;
+  for (std::size_t i = 0; i < n; ++i) {
+    s_.x[i] += dt * s_.vx[i];
+    s_.y[i] += dt * s_.vy[i];
+    s_.z[i] += dt * s_.vz[i];
+  }
+}
+
+void DemSystem::step() {
+  if (!initialized_) initialize();
+  auto t0 = Clock::now();
+  kick(0.5 * cfg_.dt_s);
+  drift();
+  seconds_integrate += since(t0);
+  if (needs_rebuild()) rebuild();
+  compute_forces();
+  t0 = Clock::now();
+  kick(0.5 * cfg_.dt_s);
+  seconds_integrate += since(t0);
+  time_ += cfg_.dt_s;
+  ++steps_;
+}
+
+double DemSystem::kinetic_energy_j() const {
+  double e = 0.0;
+  for (std::size_t i = 0; i < s_.n_local; ++i) {
+    e += 0.5 * s_.mass[i] * (s_.vx[i] * s_.vx[i] + s_.vy[i] * s_.vy[i] + s_.vz[i] * s_.vz[i]);
+    e += 0.5 * s_.inertia[i] * (s_.wx[i] * s_.wx[i] + s_.wy[i] * s_.wy[i] + s_.wz[i] * s_.wz[i]);
+  }
+  return e;
+}
+
+double DemSystem::spring_energy_j() const {
+  const double kn = cfg_.contact.kn_n_m, kt = cfg_.contact.kt_n_m;
+  double e = 0.0;
+  for (std::size_t i = 0; i < s_.size(); ++i)
+    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
+      const std::uint32_t j = nl_.neighbors[p];
+      const double dx = min_image(s_.x[i] - s_.x[j], cfg_.box.len[0], cfg_.box.periodic[0]);
+      const double dy = min_image(s_.y[i] - s_.y[j], cfg_.box.len[1], cfg_.box.periodic[1]);
+      const double dz = min_image(s_.z[i] - s_.z[j], cfg_.box.len[2], cfg_.box.periodic[2]);
+      const double ov = s_.radius[i] + s_.radius[j] - std::sqrt(dx * dx + dy * dy + dz * dz);
+      if (ov > 0.0) e += 0.5 * kn * ov * ov + 0.5 * kt * (hx_[p] * hx_[p] + hy_[p] * hy_[p] + hz_[p] * hz_[p]);
+    }
+  for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
+    const PlaneWall& W = cfg_.walls[w];
+    for (std::size_t i = 0; i < s_.size(); ++i) {
+      const double ov = s_.radius[i] - ((s_.x[i] - W.px) * W.nx + (s_.y[i] - W.py) * W.ny + (s_.z[i] - W.pz) * W.nz);
+      if (ov > 0.0)
+        e += 0.5 * kn * ov * ov +
+             0.5 * kt * (whx_[w][i] * whx_[w][i] + why_[w][i] * why_[w][i] + whz_[w][i] * whz_[w][i]);
+    }
+  }
+  return e;
+}
+
+DemState DemSystem::export_state() const {
+  DemState st;
+  st.store = s_;
+  st.ref_x = ref_x_;
+  st.ref_y = ref_y_;
+  st.ref_z = ref_z_;
+  for (std::size_t i = 0; i < s_.size(); ++i)
+    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
+      if (hx_[p] == 0.0 && hy_[p] == 0.0 && hz_[p] == 0.0) continue;
+      const std::int64_t a = s_.id[i], b = s_.id[nl_.neighbors[p]];
+      const double sg = a < b ? 1.0 : -1.0;
+      st.pair_id_a.push_back(std::min(a, b));
+      st.pair_id_b.push_back(std::max(a, b));
+      st.pair_hx.push_back(sg * hx_[p]);
+      st.pair_hy.push_back(sg * hy_[p]);
+      st.pair_hz.push_back(sg * hz_[p]);
+    }
+  for (std::size_t w = 0; w < cfg_.walls.size(); ++w)
+    for (std::size_t i = 0; i < s_.size(); ++i)
+      st.wall_h.insert(st.wall_h.end(), {whx_[w][i], why_[w][i], whz_[w][i]});
+  st.steps = steps_;
+  st.time_s = time_;
+  return st;
+}
+
+void DemSystem::import_state(const DemState& st) {
+  s_ = st.store;
+  const std::size_t n = s_.size();
+  for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
+    whx_[w].resize(n);
+    why_[w].resize(n);
+    whz_[w].resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      whx_[w][i] = st.wall_h[3 * (w * n + i)];
+      why_[w][i] = st.wall_h[3 * (w * n + i) + 1];
+      whz_[w][i] = st.wall_h[3 * (w * n + i) + 2];
+    }
+  }
+  double rmax = 0.0;
+  for (double r : s_.radius) rmax = std::max(rmax, r);
+  cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
+  // Build the list at the stored reference positions, so that the next rebuild happens at the
+  // same step as in the uninterrupted run, then restore the histories onto it.
+  ParticleStore at_ref = s_;
+  at_ref.x = st.ref_x;
+  at_ref.y = st.ref_y;
+  at_ref.z = st.ref_z;
+  nl_.build(at_ref, cfg_.box, cutoff_m_);
+  ref_x_ = st.ref_x;
+  ref_y_ = st.ref_y;
+  ref_z_ = st.ref_z;
+  hx_.assign(nl_.pair_count(), 0.0);
+  hy_.assign(nl_.pair_count(), 0.0);
+  hz_.assign(nl_.pair_count(), 0.0);
+  std::unordered_map<std::uint64_t, std::size_t> slot;
+  for (std::size_t q = 0; q < st.pair_id_a.size(); ++q) slot[pair_key(st.pair_id_a[q], st.pair_id_b[q])] = q;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
+      const std::int64_t a = s_.id[i], b = s_.id[nl_.neighbors[p]];
+      auto it = slot.find(pair_key(std::min(a, b), std::max(a, b)));
+      if (it == slot.end()) continue;
+      const double sg = a < b ? 1.0 : -1.0;
+      hx_[p] = sg * st.pair_hx[it->second];
+      hy_[p] = sg * st.pair_hy[it->second];
+      hz_[p] = sg * st.pair_hz[it->second];
+    }
+  steps_ = st.steps;
+  time_ = st.time_s;
+  initialized_ = true;
+}
+
+}  // namespace boycott::particles

@@ -1,0 +1,95 @@
+#include "particles/neighbor_list.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace boycott::particles {
+
+namespace {
+int cell_coord(double p, double lo, double len, int n, bool periodic) {
+  double f = (p - lo) / len;
+  if (periodic) f -= std::floor(f);
+  int c = static_cast<int>(f * n);
+  return std::clamp(c, 0, n - 1);
+}
+}  // namespace
+
+void NeighborList::bin(const ParticleStore& s, const BoxGeometry& g, double cutoff) {
+  for (int d = 0; d < 3; ++d) {
+    if (g.periodic[d] && g.len[d] < 2.0 * cutoff)
+      throw std::invalid_argument(fmt::format(
+          "periodic length {} m in direction {} is below twice the neighbour cutoff {} m", g.len[d], d, cutoff));
+    nc_[d] = std::max(1, static_cast<int>(std::floor(g.len[d] / cutoff)));
+  }
+  const std::size_t n = s.size();
+  const std::size_t ncell = static_cast<std::size_t>(nc_[0]) * nc_[1] * nc_[2];
+  cell_of_.resize(n);
+  cell_start_.assign(ncell + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int cx = cell_coord(s.x[i], g.lo[0], g.len[0], nc_[0], g.periodic[0]);
+    const int cy = cell_coord(s.y[i], g.lo[1], g.len[1], nc_[1], g.periodic[1]);
+    const int cz = cell_coord(s.z[i], g.lo[2], g.len[2], nc_[2], g.periodic[2]);
+    cell_of_[i] = cx + nc_[0] * (cy + nc_[1] * cz);
+    ++cell_start_[cell_of_[i] + 1];
+  }
+  for (std::size_t c = 0; c < ncell; ++c) cell_start_[c + 1] += cell_start_[c];
+  cell_items_.resize(n);
+  std::vector<std::uint32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) cell_items_[fill[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+}
+
+std::vector<std::size_t> NeighborList::cell_order(const ParticleStore& s, const BoxGeometry& g, double cutoff) const {
+  NeighborList tmp;
+  tmp.bin(s, g, cutoff);
+  return std::vector<std::size_t>(tmp.cell_items_.begin(), tmp.cell_items_.end());
+}
+
+void NeighborList::build(const ParticleStore& s, const BoxGeometry& g, double cutoff) {
+  bin(s, g, cutoff);
+  const std::size_t n = s.size();
+  const double cut2 = cutoff * cutoff;
+  // Neighbour cell offsets per direction, deduplicated where a periodic direction has < 3 cells.
+  std::array<std::vector<int>, 3> offs;
+  for (int d = 0; d < 3; ++d) {
+    if (nc_[d] == 1) offs[d] = {0};
+    else if (nc_[d] == 2) offs[d] = g.periodic[d] ? std::vector<int>{0, 1} : std::vector<int>{-1, 0, 1};
+    else offs[d] = {-1, 0, 1};
+  }
+  offsets.assign(n + 1, 0);
+  neighbors.clear();
+  neighbors.reserve(n * 8);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int c = cell_of_[i];
+    const int cx = c % nc_[0], cy = (c / nc_[0]) % nc_[1], cz = c / (nc_[0] * nc_[1]);
+    for (int oz : offs[2]) {
+      int kz = cz + oz;
+      if (g.periodic[2]) kz = (kz + nc_[2]) % nc_[2];
+      else if (kz < 0 || kz >= nc_[2]) continue;
+      for (int oy : offs[1]) {
+        int ky = cy + oy;
+        if (g.periodic[1]) ky = (ky + nc_[1]) % nc_[1];
+        else if (ky < 0 || ky >= nc_[1]) continue;
+        for (int ox : offs[0]) {
+          int kx = cx + ox;
+          if (g.periodic[0]) kx = (kx + nc_[0]) % nc_[0];
+          else if (kx < 0 || kx >= nc_[0]) continue;
+          const int nb = kx + nc_[0] * (ky + nc_[1] * kz);
+          for (std::uint32_t q = cell_start_[nb]; q < cell_start_[nb + 1]; ++q) {
+            const std::uint32_t j = cell_items_[q];
+            if (j <= i) continue;
+            const double dx = min_image(s.x[i] - s.x[j], g.len[0], g.periodic[0]);
+            const double dy = min_image(s.y[i] - s.y[j], g.len[1], g.periodic[1]);
+            const double dz = min_image(s.z[i] - s.z[j], g.len[2], g.periodic[2]);
+            if (dx * dx + dy * dy + dz * dz < cut2) neighbors.push_back(j);
+          }
+        }
+      }
+    }
+    offsets[i + 1] = static_cast<std::uint32_t>(neighbors.size());
+  }
+}
+
+}  // namespace boycott::particles

@@ -1,0 +1,45 @@
+#pragma once
+// O(N) linked-cell neighbour search producing a half Verlet list (each pair once, j > i) in CSR
+// form. Pairs are kept when their centre distance (minimum image in periodic directions) is
+// below cutoff = 2 r_max + skin; the list stays valid until some particle has moved skin/2.
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "particles/particle_store.hpp"
+
+namespace boycott::particles {
+
+struct BoxGeometry {
+  std::array<double, 3> lo = {0.0, 0.0, 0.0};   ///< m
+  std::array<double, 3> len = {1.0, 1.0, 1.0};  ///< m
+  std::array<bool, 3> periodic = {true, false, true};
+};
+
+class NeighborList {
+ public:
+  /// Bins particles [0, n) into cells of at least `cutoff` and builds the half list.
+  void build(const ParticleStore& s, const BoxGeometry& g, double cutoff_m);
+  /// Storage order that groups particles cell by cell (x fastest), for cache locality.
+  std::vector<std::size_t> cell_order(const ParticleStore& s, const BoxGeometry& g, double cutoff_m) const;
+
+  std::size_t pair_count() const { return neighbors.size(); }
+
+  std::vector<std::uint32_t> offsets;    ///< size n + 1; pairs of i are [offsets[i], offsets[i+1])
+  std::vector<std::uint32_t> neighbors;  ///< j of each pair, j > i
+
+ private:
+  void bin(const ParticleStore& s, const BoxGeometry& g, double cutoff_m);
+  std::array<int, 3> nc_{};
+  std::vector<int> cell_of_;
+  std::vector<std::uint32_t> cell_start_, cell_items_;
+};
+
+/// Minimum-image difference in one periodic direction (len > 0), or the plain difference.
+inline double min_image(double d, double len, bool periodic) {
+  return periodic ? d - len * std::nearbyint(d / len) : d;
+}
+
+}  // namespace boycott::particles

@@ -1,0 +1,44 @@
+#pragma once
+// Particle data, structure of arrays. Local particles occupy [0, n_local); ghost copies (periodic
+// or MPI halo images, later) follow in [n_local, size()). Ids are global and never reused, so
+// contact histories and checkpoints refer to particles independently of storage order.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace boycott::particles {
+
+struct ParticleStore {
+  std::size_t n_local = 0;
+
+  std::vector<std::int64_t> id;
+  std::vector<double> x, y, z;     ///< position, m
+  std::vector<double> vx, vy, vz;  ///< velocity, m/s
+  std::vector<double> wx, wy, wz;  ///< angular velocity, rad/s
+  std::vector<double> fx, fy, fz;  ///< contact force, N (recomputed every step)
+  std::vector<double> tx, ty, tz;  ///< contact torque, N m
+  std::vector<double> radius, mass, inertia;  ///< m, kg, kg m^2 (solid sphere: 2/5 m r^2)
+
+  // Coupling hook: (m + m_add) dv/dt = F_contact + F_ext + m g + beta (u_f - v), drag implicit.
+  std::vector<double> ext_x, ext_y, ext_z;  ///< explicit external force, N
+  std::vector<double> beta;                 ///< implicit linear drag coefficient, kg/s
+  std::vector<double> ufx, ufy, ufz;        ///< fluid velocity the drag pulls toward, m/s
+  std::vector<double> madd;                 ///< added mass, kg
+
+  std::size_t size() const { return id.size(); }
+
+  /// Appends a local particle at rest (before any ghost is created).
+  void add(std::int64_t gid, double px, double py, double pz, double r, double density_kg_m3);
+
+  /// Reorders every per-particle array by `order` (new index k holds old particle order[k]).
+  void permute(const std::vector<std::size_t>& order);
+
+  template <class F>
+  void for_each_array(F&& f) {
+    for (auto* a : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &mass,
+                    &inertia, &ext_x, &ext_y, &ext_z, &beta, &ufx, &ufy, &ufz, &madd})
+      f(*a);
+  }
+};
+
+}  // namespace boycott::particles
