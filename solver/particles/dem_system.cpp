@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
-#include <unordered_map>
 
 #include <fmt/format.h>
 
@@ -124,24 +123,49 @@ void DemSystem::initialize() {
   double rmax = 0.0;
   for (double r : s_.radius) rmax = std::max(rmax, r);
   cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
+  update_uniform_mass();
   rebuild();
   compute_forces();
   initialized_ = true;
 }
 
+void DemSystem::update_uniform_mass() {
+  uniform_mass_kg_ = s_.size() ? s_.mass[0] : 0.0;
+  for (double m : s_.mass)
+    if (m != uniform_mass_kg_) uniform_mass_kg_ = 0.0;
+}
+
 void DemSystem::force_rebuild() {
+  update_uniform_mass();
   rebuild();
   compute_forces();
 }
 
 bool DemSystem::needs_rebuild() const {
-  const double lim2 = 0.25 * cfg_.skin_m * cfg_.skin_m;
+  // A pair's distance changes by at most |D_i - D_j| <= |D_i - c| + |D_j - c| for any common
+  // vector c, D the displacements since the last build. With c the mean displacement, a uniform
+  // drift of the whole packing (a settling bed in a periodic box) does not force rebuilds, and
+  // the list stays exact while every |D_i - c| < skin/2. Walls are not in the list: every
+  // particle is tested against every wall each step.
   const std::size_t n = s_.size();
+  if (n == 0) return false;
+  double cx = 0.0, cy = 0.0, cz = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    const double dx = s_.x[i] - ref_x_[i], dy = s_.y[i] - ref_y_[i], dz = s_.z[i] - ref_z_[i];
-    if (dx * dx + dy * dy + dz * dz > lim2) return true;
+    cx += s_.x[i] - ref_x_[i];
+    cy += s_.y[i] - ref_y_[i];
+    cz += s_.z[i] - ref_z_[i];
   }
-  return false;
+  const double inv = 1.0 / static_cast<double>(n);
+  cx *= inv;
+  cy *= inv;
+  cz *= inv;
+  const double lim2 = 0.25 * cfg_.skin_m * cfg_.skin_m;
+  double worst = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double dx = s_.x[i] - ref_x_[i] - cx, dy = s_.y[i] - ref_y_[i] - cy, dz = s_.z[i] - ref_z_[i] - cz;
+    worst = std::max(worst, dx * dx + dy * dy + dz * dz);
+  }
+  return worst > lim2;
 }
 
 void DemSystem::collect_histories() {
@@ -153,12 +177,12 @@ void DemSystem::collect_histories() {
   if (nl_.offsets.size() != n + 1) return;
   for (std::size_t i = 0; i < n; ++i)
     for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
-      if (hx_[p] == 0.0 && hy_[p] == 0.0 && hz_[p] == 0.0) continue;
+      if (h_[3 * p] == 0.0 && h_[3 * p + 1] == 0.0 && h_[3 * p + 2] == 0.0) continue;
       const std::int64_t a = s_.id[i], b = s_.id[nl_.neighbors[p]];
       const double sg = a < b ? 1.0 : -1.0;
       carry_a_.push_back(std::min(a, b));
       carry_b_.push_back(std::max(a, b));
-      carry_h_.insert(carry_h_.end(), {sg * hx_[p], sg * hy_[p], sg * hz_[p]});
+      carry_h_.insert(carry_h_.end(), {sg * h_[3 * p], sg * h_[3 * p + 1], sg * h_[3 * p + 2]});
     }
 }
 
@@ -172,7 +196,7 @@ void DemSystem::rebuild() {
     const double lo = cfg_.box.lo[d], len = cfg_.box.len[d];
     for (double& v : c) v -= len * std::floor((v - lo) / len);
   }
-  const auto order = nl_.cell_order(s_, cfg_.box, cutoff_m_);
+  const auto order = nl_.bin_and_order(s_, cfg_.box, cutoff_m_);
   s_.permute(order);
   std::vector<double> tmp(order.size());
   for (auto* wh : {&whx_, &why_, &whz_})
@@ -180,31 +204,42 @@ void DemSystem::rebuild() {
       for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = a[order[k]];
       a.swap(tmp);
     }
-  nl_.build(s_, cfg_.box, cutoff_m_);
-  const std::size_t np = nl_.pair_count();
-  hx_.assign(np, 0.0);
-  hy_.assign(np, 0.0);
-  hz_.assign(np, 0.0);
-  if (!carry_a_.empty()) {
-    std::unordered_map<std::uint64_t, std::size_t> slot;
-    slot.reserve(carry_a_.size() * 2);
-    for (std::size_t q = 0; q < carry_a_.size(); ++q) slot[pair_key(carry_a_[q], carry_b_[q])] = q;
-    for (std::size_t i = 0; i < s_.size(); ++i)
-      for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
-        const std::int64_t a = s_.id[i], b = s_.id[nl_.neighbors[p]];
-        auto it = slot.find(pair_key(std::min(a, b), std::max(a, b)));
-        if (it == slot.end()) continue;
-        const double sg = a < b ? 1.0 : -1.0;
-        hx_[p] = sg * carry_h_[3 * it->second];
-        hy_[p] = sg * carry_h_[3 * it->second + 1];
-        hz_[p] = sg * carry_h_[3 * it->second + 2];
-      }
-  }
+  nl_.build_binned(s_, cfg_.box, cutoff_m_);
+  restore_histories(carry_a_, carry_b_, carry_h_);
   ref_x_ = s_.x;
   ref_y_ = s_.y;
   ref_z_ = s_.z;
   ++rebuilds_;
   seconds_neighbor += since(t0);
+}
+
+void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const std::vector<std::int64_t>& idb,
+                                  const std::vector<double>& h) {
+  const std::size_t np = nl_.pair_count();
+  h_.assign(3 * np, 0.0);
+  if (ida.empty()) return;
+  // Sorted (key, slot) table; only pairs that overlap now can carry a history (it is reset
+  // whenever a pair separates), so only those are looked up.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> table(ida.size());
+  for (std::size_t q = 0; q < ida.size(); ++q) table[q] = {pair_key(ida[q], idb[q]), static_cast<std::uint32_t>(q)};
+  std::sort(table.begin(), table.end());
+  for (std::size_t i = 0; i < s_.size(); ++i)
+    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
+      const std::uint32_t j = nl_.neighbors[p];
+      const double dx = min_image(s_.x[i] - s_.x[j], cfg_.box.len[0], cfg_.box.periodic[0]);
+      const double dy = min_image(s_.y[i] - s_.y[j], cfg_.box.len[1], cfg_.box.periodic[1]);
+      const double dz = min_image(s_.z[i] - s_.z[j], cfg_.box.len[2], cfg_.box.periodic[2]);
+      const double rs = s_.radius[i] + s_.radius[j];
+      if (dx * dx + dy * dy + dz * dz >= rs * rs) continue;
+      const std::int64_t a = s_.id[i], b = s_.id[j];
+      const std::uint64_t key = pair_key(std::min(a, b), std::max(a, b));
+      auto it = std::lower_bound(table.begin(), table.end(), std::pair<std::uint64_t, std::uint32_t>{key, 0});
+      if (it == table.end() || it->first != key) continue;
+      const double sg = a < b ? 1.0 : -1.0;
+      h_[3 * p] = sg * h[3 * it->second];
+      h_[3 * p + 1] = sg * h[3 * it->second + 1];
+      h_[3 * p + 2] = sg * h[3 * it->second + 2];
+    }
 }
 
 template <class Rolling>
@@ -240,14 +275,15 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   const double* __restrict mass = s_.mass.data();
   const double* __restrict inertia = s_.inertia.data();
   std::int64_t contacts = 0;
+  const bool uniform = uniform_mass_kg_ > 0.0;
+  const double gn_pair = cm.gamma_n(0.5 * uniform_mass_kg_), gn_wall = cm.gamma_n(uniform_mass_kg_);
 
   // Force on particle a from a contact with normal n (pointing into a), overlap delta, relative
   // contact velocity (vrx, vry, vrz), effective mass, shear history h (updated in place).
   // Returns the normal force magnitude (signed) and writes the tangential force.
   auto contact = [&](double nx, double ny, double nz, double delta, double vrx, double vry, double vrz,
-                     double meff, double& hxr, double& hyr, double& hzr, double& ftx, double& fty,
+                     double gn, double& hxr, double& hyr, double& hzr, double& ftx, double& fty,
                      double& ftz) {
-    const double gn = cm.damping_factor * std::sqrt(meff * kn);
     const double gt = cm.tangential_ratio * gn;
     const double vn = vrx * nx + vry * ny + vrz * nz;
     double fn = kn * delta - gn * vn;
@@ -299,7 +335,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       const double rsum = ri + rad[j];
       const double r2 = dx * dx + dy * dy + dz * dz;
       if (r2 >= rsum * rsum) {
-        hx_[p] = hy_[p] = hz_[p] = 0.0;
+        h_[3 * p] = h_[3 * p + 1] = h_[3 * p + 2] = 0.0;
         continue;
       }
       ++contacts;
@@ -312,9 +348,10 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       const double vrx = vx[i] - vx[j] - (cy * nz - cz * ny);
       const double vry = vy[i] - vy[j] - (cz * nx - cx * nz);
       const double vrz = vz[i] - vz[j] - (cx * ny - cy * nx);
-      const double meff = mi * mass[j] / (mi + mass[j]);
+      // gamma_n needs sqrt(m_eff k_n): a constant when all masses are equal (the usual case).
+      const double gn = uniform ? gn_pair : cm.damping_factor * std::sqrt(mi * mass[j] / (mi + mass[j]) * kn);
       double ftx, fty, ftz;
-      const double fn = contact(nx, ny, nz, rsum - r, vrx, vry, vrz, meff, hx_[p], hy_[p], hz_[p], ftx, fty, ftz);
+      const double fn = contact(nx, ny, nz, rsum - r, vrx, vry, vrz, gn, h_[3 * p], h_[3 * p + 1], h_[3 * p + 2], ftx, fty, ftz);
       const double Fx = fn * nx + ftx, Fy = fn * ny + fty, Fz = fn * nz + ftz;
       fxi += Fx;
       fyi += Fy;
@@ -375,7 +412,8 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       const double vry = vy[i] - (cz * nx - cx * nz);
       const double vrz = vz[i] - (cx * ny - cy * nx);
       double ftx, fty, ftz;
-      const double fn = contact(nx, ny, nz, ri - dist, vrx, vry, vrz, mass[i], whx[i], why[i], whz[i], ftx, fty, ftz);
+      const double fn = contact(nx, ny, nz, ri - dist, vrx, vry, vrz,
+                                uniform ? gn_wall : cm.damping_factor * std::sqrt(mass[i] * kn), whx[i], why[i], whz[i], ftx, fty, ftz);
       fx[i] += fn * nx + ftx;
       fy[i] += fn * ny + fty;
       fz[i] += fn * nz + ftz;
@@ -415,28 +453,34 @@ void DemSystem::kick(double h) {
   // beta -> infinity gives v = u_f + F/beta: stable for any particle response time.
   const std::size_t n = s_.n_local;
   const double gx = cfg_.gravity_m_s2[0], gy = cfg_.gravity_m_s2[1], gz = cfg_.gravity_m_s2[2];
-  for (std::size_t i = 0; i < n; ++i) {
-    const double m = s_.mass[i];
-    const double M = m + s_.madd[i];
-    const double b = s_.beta[i];
-    const double inv = 1.0 / (M + h * b);
-    s_.vx[i] = (M * s_.vx[i] + h * (s_.fx[i] + s_.ext_x[i] + m * gx + b * s_.ufx[i])) * inv;
-    s_.vy[i] = (M * s_.vy[i] + h * (s_.fy[i] + s_.ext_y[i] + m * gy + b * s_.ufy[i])) * inv;
-    s_.vz[i] = (M * s_.vz[i] + h * (s_.fz[i] + s_.ext_z[i] + m * gz + b * s_.ufz[i])) * inv;
-    const double hi = h / s_.inertia[i];
-    s_.wx[i] += hi * s_.tx[i];
-    s_.wy[i] += hi * s_.ty[i];
-    s_.wz[i] += hi * s_.tz[i];
+  const double* __restrict m = s_.mass.data();
+  const double* __restrict ma = s_.madd.data();
+  const double* __restrict b = s_.beta.data();
+  const double* __restrict I = s_.inertia.data();
+  for (int c = 0; c < 3; ++c) {
+    // One component at a time keeps the streams few enough to vectorise.
+    double* __restrict v = (c == 0 ? s_.vx : c == 1 ? s_.vy : s_.vz).data();
+    const double* __restrict f = (c == 0 ? s_.fx : c == 1 ? s_.fy : s_.fz).data();
+    const double* __restrict e = (c == 0 ? s_.ext_x : c == 1 ? s_.ext_y : s_.ext_z).data();
+    const double* __restrict u = (c == 0 ? s_.ufx : c == 1 ? s_.ufy : s_.ufz).data();
+    const double g = c == 0 ? gx : c == 1 ? gy : gz;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double M = m[i] + ma[i];
+      v[i] = (M * v[i] + h * (f[i] + e[i] + m[i] * g + b[i] * u[i])) / (M + h * b[i]);
+    }
+    double* __restrict w = (c == 0 ? s_.wx : c == 1 ? s_.wy : s_.wz).data();
+    const double* __restrict t = (c == 0 ? s_.tx : c == 1 ? s_.ty : s_.tz).data();
+    for (std::size_t i = 0; i < n; ++i) w[i] += h * t[i] / I[i];
   }
 }
 
 void DemSystem::drift() {
   const std::size_t n = s_.n_local;
   const double dt = cfg_.dt_s;
-  for (std::size_t i = 0; i < n; ++i) {
-    s_.x[i] += dt * s_.vx[i];
-    s_.y[i] += dt * s_.vy[i];
-    s_.z[i] += dt * s_.vz[i];
+  for (int c = 0; c < 3; ++c) {
+    double* __restrict x = (c == 0 ? s_.x : c == 1 ? s_.y : s_.z).data();
+    const double* __restrict v = (c == 0 ? s_.vx : c == 1 ? s_.vy : s_.vz).data();
+    for (std::size_t i = 0; i < n; ++i) x[i] += dt * v[i];
   }
 }
 
@@ -474,7 +518,7 @@ double DemSystem::spring_energy_j() const {
       const double dy = min_image(s_.y[i] - s_.y[j], cfg_.box.len[1], cfg_.box.periodic[1]);
       const double dz = min_image(s_.z[i] - s_.z[j], cfg_.box.len[2], cfg_.box.periodic[2]);
       const double ov = s_.radius[i] + s_.radius[j] - std::sqrt(dx * dx + dy * dy + dz * dz);
-      if (ov > 0.0) e += 0.5 * kn * ov * ov + 0.5 * kt * (hx_[p] * hx_[p] + hy_[p] * hy_[p] + hz_[p] * hz_[p]);
+      if (ov > 0.0) e += 0.5 * kn * ov * ov + 0.5 * kt * (h_[3 * p] * h_[3 * p] + h_[3 * p + 1] * h_[3 * p + 1] + h_[3 * p + 2] * h_[3 * p + 2]);
     }
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
     const PlaneWall& W = cfg_.walls[w];
@@ -496,14 +540,14 @@ DemState DemSystem::export_state() const {
   st.ref_z = ref_z_;
   for (std::size_t i = 0; i < s_.size(); ++i)
     for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
-      if (hx_[p] == 0.0 && hy_[p] == 0.0 && hz_[p] == 0.0) continue;
+      if (h_[3 * p] == 0.0 && h_[3 * p + 1] == 0.0 && h_[3 * p + 2] == 0.0) continue;
       const std::int64_t a = s_.id[i], b = s_.id[nl_.neighbors[p]];
       const double sg = a < b ? 1.0 : -1.0;
       st.pair_id_a.push_back(std::min(a, b));
       st.pair_id_b.push_back(std::max(a, b));
-      st.pair_hx.push_back(sg * hx_[p]);
-      st.pair_hy.push_back(sg * hy_[p]);
-      st.pair_hz.push_back(sg * hz_[p]);
+      st.pair_hx.push_back(sg * h_[3 * p]);
+      st.pair_hy.push_back(sg * h_[3 * p + 1]);
+      st.pair_hz.push_back(sg * h_[3 * p + 2]);
     }
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w)
     for (std::size_t i = 0; i < s_.size(); ++i)
@@ -529,6 +573,7 @@ void DemSystem::import_state(const DemState& st) {
   double rmax = 0.0;
   for (double r : s_.radius) rmax = std::max(rmax, r);
   cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
+  update_uniform_mass();
   // Build the list at the stored reference positions, so that the next rebuild happens at the
   // same step as in the uninterrupted run, then restore the histories onto it.
   ParticleStore at_ref = s_;
@@ -539,21 +584,13 @@ void DemSystem::import_state(const DemState& st) {
   ref_x_ = st.ref_x;
   ref_y_ = st.ref_y;
   ref_z_ = st.ref_z;
-  hx_.assign(nl_.pair_count(), 0.0);
-  hy_.assign(nl_.pair_count(), 0.0);
-  hz_.assign(nl_.pair_count(), 0.0);
-  std::unordered_map<std::uint64_t, std::size_t> slot;
-  for (std::size_t q = 0; q < st.pair_id_a.size(); ++q) slot[pair_key(st.pair_id_a[q], st.pair_id_b[q])] = q;
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
-      const std::int64_t a = s_.id[i], b = s_.id[nl_.neighbors[p]];
-      auto it = slot.find(pair_key(std::min(a, b), std::max(a, b)));
-      if (it == slot.end()) continue;
-      const double sg = a < b ? 1.0 : -1.0;
-      hx_[p] = sg * st.pair_hx[it->second];
-      hy_[p] = sg * st.pair_hy[it->second];
-      hz_[p] = sg * st.pair_hz[it->second];
-    }
+  std::vector<double> h(3 * st.pair_id_a.size());
+  for (std::size_t q = 0; q < st.pair_id_a.size(); ++q) {
+    h[3 * q] = st.pair_hx[q];
+    h[3 * q + 1] = st.pair_hy[q];
+    h[3 * q + 2] = st.pair_hz[q];
+  }
+  restore_histories(st.pair_id_a, st.pair_id_b, h);
   steps_ = st.steps;
   time_ = st.time_s;
   initialized_ = true;

@@ -88,14 +88,19 @@ class DemSystem {
   bool needs_rebuild() const;
   void rebuild();
   void collect_histories();
+  void update_uniform_mass();
+  void restore_histories(const std::vector<std::int64_t>& ida, const std::vector<std::int64_t>& idb,
+                         const std::vector<double>& h);
 
   DemConfig cfg_;
   ParticleStore s_;
   NeighborList nl_;
   double cutoff_m_ = 0.0;
+  double uniform_mass_kg_ = 0.0;  ///< > 0 when every particle has this mass
   std::vector<double> ref_x_, ref_y_, ref_z_;
-  // Tangential spring displacement per list pair (seen from the lower-index particle i), m.
-  std::vector<double> hx_, hy_, hz_;
+  // Tangential spring displacement per list pair (seen from the lower-index particle i), m;
+  // x, y, z interleaved so a pair's history is one cache line.
+  std::vector<double> h_;
   // Per wall, per particle: tangential displacement, m.
   std::vector<std::vector<double>> whx_, why_, whz_;
   std::vector<std::int64_t> carry_a_, carry_b_;

@@ -41,14 +41,25 @@ void NeighborList::bin(const ParticleStore& s, const BoxGeometry& g, double cuto
   for (std::size_t i = 0; i < n; ++i) cell_items_[fill[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
 }
 
-std::vector<std::size_t> NeighborList::cell_order(const ParticleStore& s, const BoxGeometry& g, double cutoff) const {
-  NeighborList tmp;
-  tmp.bin(s, g, cutoff);
-  return std::vector<std::size_t>(tmp.cell_items_.begin(), tmp.cell_items_.end());
+std::vector<std::size_t> NeighborList::bin_and_order(const ParticleStore& s, const BoxGeometry& g, double cutoff) {
+  bin(s, g, cutoff);
+  std::vector<std::size_t> order(cell_items_.begin(), cell_items_.end());
+  // The bins as they will be once the particles are stored in this order.
+  std::vector<int> cell_sorted(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    cell_sorted[k] = cell_of_[order[k]];
+    cell_items_[k] = static_cast<std::uint32_t>(k);
+  }
+  cell_of_.swap(cell_sorted);
+  return order;
 }
 
 void NeighborList::build(const ParticleStore& s, const BoxGeometry& g, double cutoff) {
   bin(s, g, cutoff);
+  build_binned(s, g, cutoff);
+}
+
+void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, double cutoff) {
   const std::size_t n = s.size();
   const double cut2 = cutoff * cutoff;
   // Neighbour cell offsets per direction, deduplicated where a periodic direction has < 3 cells.
