@@ -60,6 +60,7 @@ class DemSystem {
   void initialize();
   /// One velocity-Verlet step of dt.
   void step();
+  /// Rebuilds the neighbour list now (re-sorts and wraps; forces and histories are kept).
   void force_rebuild();
 
   double time_s() const { return time_; }
@@ -89,6 +90,7 @@ class DemSystem {
   void rebuild();
   void collect_histories();
   void update_uniform_mass();
+  void predict_velocities(bool from_half_step);
   void restore_histories(const std::vector<std::int64_t>& ida, const std::vector<std::int64_t>& idb,
                          const std::vector<double>& h);
 
@@ -96,7 +98,8 @@ class DemSystem {
   ParticleStore s_;
   NeighborList nl_;
   double cutoff_m_ = 0.0;
-  double uniform_mass_kg_ = 0.0;  ///< > 0 when every particle has this mass
+  double uniform_mass_kg_ = 0.0;
+  std::vector<double> pred_[6], old_[6];  ///< v, w seen by the forces; v, w at the step's start  ///< > 0 when every particle has this mass
   std::vector<double> ref_x_, ref_y_, ref_z_;
   // Tangential spring displacement per list pair (seen from the lower-index particle i), m;
   // x, y, z interleaved so a pair's history is one cache line.
