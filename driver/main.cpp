@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
   if (qcases->parsed())
     return run_guarded([&] {
       boycott::driver::Database db(q_db, boycott::driver::OpenMode::kExisting);
-      std::fputs(boycott::driver::format_cases(boycott::driver::case_states(db, q_study, 1 << 30)).c_str(), stdout);
+      std::fputs(boycott::driver::format_cases(boycott::driver::case_states(db, q_study, 2)).c_str(), stdout);
       return 0;
     });
 

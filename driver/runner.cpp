@@ -255,8 +255,10 @@ int study_run(const StudyRunOptions& opt) {
       if (code == 0) return;
       finish_attempt(db, j.attempt, code, why);
       std::fprintf(stderr, "%s failed: %s\n", where.c_str(), why.c_str());
-    } else if (code == kExitInterrupted) {
-      finish_attempt(db, j.attempt, code, "interrupted after a checkpoint");
+    } else if (code == kExitInterrupted || code == 128 + SIGTERM || code == 128 + SIGINT) {
+      // 128 + signal: stopped before it could install its handlers; it resumes like 75.
+      finish_attempt(db, j.attempt, code,
+                     code == kExitInterrupted ? "interrupted after a checkpoint" : "stopped by a signal while starting");
       if (!stopping && !g_stop_signal.load()) queue.push_front(c);  // stopped from outside: resume at once
       return;
     } else {

@@ -133,7 +133,7 @@ std::vector<CaseState> case_states(Database& db, const std::string& study, int r
       "SELECT sc.study, sc.group_name, c.id, c.angle_deg, "
       " EXISTS(SELECT 1 FROM results r WHERE r.case_id = c.id), "
       " (SELECT COUNT(*) FROM attempts a WHERE a.case_id = c.id AND a.exit_status IS NOT NULL "
-      "    AND a.exit_status NOT IN (0, 75)), "
+      "    AND a.exit_status NOT IN (0, 75, 130, 143)), "
       " (SELECT COUNT(*) FROM attempts a WHERE a.case_id = c.id AND a.exit_status = 2), "
       " EXISTS(SELECT 1 FROM attempts a WHERE a.case_id = c.id AND a.ended_at IS NULL), "
       " (SELECT a.exit_status FROM attempts a WHERE a.case_id = c.id AND a.ended_at IS NOT NULL ORDER BY a.id DESC "
@@ -158,7 +158,7 @@ std::vector<CaseState> case_states(Database& db, const std::string& study, int r
     if (done) c.status = CaseStatus::kDone;
     else if (open) c.status = CaseStatus::kRunning;
     else if (c.input_error || c.failures > retries) c.status = CaseStatus::kFailed;
-    else if (c.last_exit == 75) c.status = CaseStatus::kInterrupted;
+    else if (c.last_exit == 75 || c.last_exit == 130 || c.last_exit == 143) c.status = CaseStatus::kInterrupted;
     else c.status = CaseStatus::kPending;
     out.push_back(std::move(c));
   }

@@ -9,7 +9,8 @@ it was interrupted): <<w_p>> = -0.01 (1 + 0.5 sin(theta)) * (viscosity/1e-3)^-0.
 Exit 75 on SIGTERM/SIGINT after a checkpoint; exit 3 once per run folder when seed == 13 and
 FAKE_FAIL_SEED13 is set (a retried failure); exit 3 always when seed == 14 (a failure for good).
 """
-import json, math, os, signal, sys, time, tomllib
+import json, math, os, signal, sys, time
+import tomllib
 
 def write_atomic(path, text):
     tmp = path + ".tmp"
@@ -18,6 +19,11 @@ def write_atomic(path, text):
     os.replace(tmp, path)
 
 def main():
+    stop = {"sig": 0}
+    def on_stop(sig, frame):
+        stop["sig"] = sig
+    signal.signal(signal.SIGTERM, on_stop)
+    signal.signal(signal.SIGINT, on_stop)
     args = sys.argv[1:]
     if args[:2] != ["case", "run"] or "--out" not in args:
         print("usage: fake_solver.py case run CASE --out DIR", file=sys.stderr)
@@ -31,11 +37,6 @@ def main():
         print(f"error: cannot read case file '{case_file}': {e}", file=sys.stderr)
         return 2
     os.makedirs(out, exist_ok=True)
-    stop = {"sig": 0}
-    def on_stop(sig, frame):
-        stop["sig"] = sig
-    signal.signal(signal.SIGTERM, on_stop)
-    signal.signal(signal.SIGINT, on_stop)
 
     seed = p.get("seed", 1)
     if seed == 14:
