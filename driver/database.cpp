@@ -16,7 +16,9 @@ Statement::Statement(sqlite3* db, const std::string& sql) : db_(db) {
   if (sqlite3_prepare_v2(db, sql.c_str(), -1, &st_, nullptr) != SQLITE_OK)
     throw DatabaseError(fmt::format("database: cannot prepare '{}': {}", sql, sqlite3_errmsg(db)));
 }
-Statement::~Statement() { sqlite3_finalize(st_); }
+Statement::~Statement() {
+  sqlite3_finalize(st_);
+}
 
 Statement& Statement::bind(int i, const std::string& v) {
   sqlite3_bind_text(st_, i, v.c_str(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
@@ -40,13 +42,19 @@ bool Statement::step() {
   if (rc == SQLITE_DONE) return false;
   throw DatabaseError(fmt::format("database: {}", sqlite3_errmsg(db_)));
 }
-bool Statement::is_null(int col) const { return sqlite3_column_type(st_, col) == SQLITE_NULL; }
+bool Statement::is_null(int col) const {
+  return sqlite3_column_type(st_, col) == SQLITE_NULL;
+}
 std::string Statement::text(int col) const {
   const auto* t = sqlite3_column_text(st_, col);
   return t ? std::string(reinterpret_cast<const char*>(t)) : std::string();
 }
-double Statement::real(int col) const { return sqlite3_column_double(st_, col); }
-std::int64_t Statement::integer(int col) const { return sqlite3_column_int64(st_, col); }
+double Statement::real(int col) const {
+  return sqlite3_column_double(st_, col);
+}
+std::int64_t Statement::integer(int col) const {
+  return sqlite3_column_int64(st_, col);
+}
 
 Database::Database(const std::string& path, OpenMode mode, int target_version) : path_(path) {
   struct stat sb {};
@@ -81,9 +89,13 @@ Database::Database(const std::string& path, OpenMode mode, int target_version) :
   }
 }
 
-Database::~Database() { sqlite3_close(db_); }
+Database::~Database() {
+  sqlite3_close(db_);
+}
 
-int Database::latest_version() { return static_cast<int>(schema_files().size()); }
+int Database::latest_version() {
+  return static_cast<int>(schema_files().size());
+}
 
 int Database::version() {
   Statement st(db_, "PRAGMA user_version");
@@ -100,7 +112,9 @@ void Database::exec(const std::string& sql) {
   }
 }
 
-void Database::exec_noexcept(const char* sql) { sqlite3_exec(db_, sql, nullptr, nullptr, nullptr); }
+void Database::exec_noexcept(const char* sql) {
+  sqlite3_exec(db_, sql, nullptr, nullptr, nullptr);
+}
 
 void Database::migrate(int target) {
   const auto& files = schema_files();
@@ -116,7 +130,8 @@ void Database::migrate(int target) {
       try {
         exec(files[static_cast<std::size_t>(v)].sql);
       } catch (const DatabaseError& e) {
-        throw DatabaseError(fmt::format("migration {} failed: {}", files[static_cast<std::size_t>(v)].name, e.what()));
+        throw DatabaseError(
+            fmt::format("migration {} failed: {}", files[static_cast<std::size_t>(v)].name, e.what()));
       }
       exec(fmt::format("PRAGMA user_version = {}", v + 1));
     });
@@ -126,9 +141,10 @@ void Database::migrate(int target) {
 
 std::string utc_now() {
   const auto now = std::chrono::system_clock::now();
-  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  const auto ms =
+      std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
   const std::time_t t = std::chrono::system_clock::to_time_t(now);
-  std::tm tm {};
+  std::tm tm{};
   gmtime_r(&t, &tm);
   char buf[32];
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);

@@ -6,8 +6,8 @@
 #include <fstream>
 #include <iostream>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "core/error.hpp"
 #include "core/version.hpp"
@@ -44,7 +44,8 @@ int run_guarded(const std::function<int()>& fn) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"boycott: unresolved CFD-DEM of proppant settling in inclined narrow channels, and its study driver"};
+  CLI::App app{
+      "boycott: unresolved CFD-DEM of proppant settling in inclined narrow channels, and its study driver"};
   app.require_subcommand(1);
   app.set_version_flag("--version", fmt::format("boycott {}+{}", boycott::kVersion, boycott::kGitRevision));
 
@@ -71,7 +72,8 @@ int main(int argc, char** argv) {
   auto* study_cmd = app.add_subcommand("study", "run a study (a matrix of cases) into a database");
   study_cmd->require_subcommand(1);
   boycott::driver::StudyRunOptions sopt;
-  auto* srun = study_cmd->add_subcommand("run", "run what is missing, resume interrupted cases, retry failed ones");
+  auto* srun =
+      study_cmd->add_subcommand("run", "run what is missing, resume interrupted cases, retry failed ones");
   srun->add_option("study", sopt.study_file, "study file (TOML)")->required();
   srun->add_option("--db", sopt.db_path, "results database (SQLite)")->required();
   srun->add_option("--jobs", sopt.jobs, "cases run at once")->capture_default_str();
@@ -113,8 +115,9 @@ int main(int argc, char** argv) {
       const auto fmt_kind = boycott::driver::parse_curve_format(q_format);
       boycott::driver::Database db(q_db, boycott::driver::OpenMode::kExisting);
       const auto pts = boycott::driver::query_curve(db, q_study, q_group);
-      if (pts.empty()) throw boycott::InputError(fmt::format("no finished cases of study '{}'{} in '{}'", q_study,
-                                                             q_group.empty() ? "" : " group '" + q_group + "'", q_db));
+      if (pts.empty())
+        throw boycott::InputError(fmt::format("no finished cases of study '{}'{} in '{}'", q_study,
+                                              q_group.empty() ? "" : " group '" + q_group + "'", q_db));
       std::fputs(boycott::driver::format_curve(pts, fmt_kind).c_str(), stdout);
       if (!q_plot.empty()) {
         std::ofstream out(q_plot);
@@ -134,7 +137,8 @@ int main(int argc, char** argv) {
     run_opt.petsc_options = run->remaining();
     return run_guarded([&] { return boycott::driver::case_run(run_opt, argc, argv); });
   }
-  if (check->parsed()) return run_guarded([&] { return boycott::driver::case_check(check_file, check_sets); });
+  if (check->parsed())
+    return run_guarded([&] { return boycott::driver::case_check(check_file, check_sets); });
   if (keys->parsed()) return run_guarded([&] { return boycott::driver::case_keys(); });
   return 0;
 }

@@ -32,7 +32,9 @@ namespace boycott::driver {
 namespace {
 
 std::atomic<int> g_stop_signal{0};
-extern "C" void on_stop(int sig) { g_stop_signal.store(sig); }
+extern "C" void on_stop(int sig) {
+  g_stop_signal.store(sig);
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -118,10 +120,12 @@ std::string fmt_duration(double s) {
 
 }  // namespace
 
-std::string runs_root(const std::string& db_path) { return db_path + ".runs"; }
+std::string runs_root(const std::string& db_path) {
+  return db_path + ".runs";
+}
 
-std::vector<std::string> case_command(const std::vector<std::string>& solver, int ranks, const std::string& case_file,
-                                      const std::string& out_dir) {
+std::vector<std::string> case_command(const std::vector<std::string>& solver, int ranks,
+                                      const std::string& case_file, const std::string& out_dir) {
   std::vector<std::string> argv;
   if (ranks > 1) argv = {"mpirun", "-n", std::to_string(ranks), "--allow-run-as-root"};
   argv.insert(argv.end(), solver.begin(), solver.end());
@@ -158,9 +162,12 @@ int study_run(const StudyRunOptions& opt) {
   int n_done = 0, n_failed = 0;
   for (const auto& s : case_states(db, study.name, opt.retries)) {
     failures[s.id] = s.failures;
-    if (s.status == CaseStatus::kDone) ++n_done;
-    else if (s.status == CaseStatus::kFailed) ++n_failed;
-    else if (by_id.count(s.id)) queue.push_back(by_id[s.id]);
+    if (s.status == CaseStatus::kDone)
+      ++n_done;
+    else if (s.status == CaseStatus::kFailed)
+      ++n_failed;
+    else if (by_id.count(s.id))
+      queue.push_back(by_id[s.id]);
   }
   const int n_total = static_cast<int>(study.cases.size());
 
@@ -176,7 +183,8 @@ int study_run(const StudyRunOptions& opt) {
     j.dir = root / c->id;
     fs::create_directories(j.dir);
     j.lock_fd = ::open((j.dir / ".lock").c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
-    if (j.lock_fd < 0) throw std::runtime_error(fmt::format("cannot create '{}'", (j.dir / ".lock").string()));
+    if (j.lock_fd < 0)
+      throw std::runtime_error(fmt::format("cannot create '{}'", (j.dir / ".lock").string()));
     // Held by the solver as long as it lives: a solver orphaned by a killed driver is still
     // checkpointing, and a second driver must not start the case twice.
     if (::flock(j.lock_fd, LOCK_EX | LOCK_NB) != 0) {
@@ -208,7 +216,7 @@ int study_run(const StudyRunOptions& opt) {
     const pid_t pid = fork();
     if (pid < 0) throw std::runtime_error("fork failed");
     if (pid == 0) {
-      setpgid(0, 0);  // Ctrl-C reaches the driver only; it forwards the stop to the case.
+      setpgid(0, 0);                     // Ctrl-C reaches the driver only; it forwards the stop to the case.
       prctl(PR_SET_PDEATHSIG, SIGTERM);  // driver killed with -9: the case checkpoints and stops
       if (getppid() != parent) _exit(75);
       fcntl(j.lock_fd, F_SETFD, 0);  // the solver inherits the run folder's lock
@@ -235,8 +243,8 @@ int study_run(const StudyRunOptions& opt) {
 
   auto finish = [&](Job& j, int code) {
     const StudyCase* c = j.c;
-    const std::string where = fmt::format("case {} ({} {}={:g} deg)", c->id, c->group, "angle",
-                                          c->params.gravity.angle_deg);
+    const std::string where =
+        fmt::format("case {} ({} {}={:g} deg)", c->id, c->group, "angle", c->params.gravity.angle_deg);
     if (code == 0) {
       std::string why;
       try {
@@ -257,8 +265,9 @@ int study_run(const StudyRunOptions& opt) {
       std::fprintf(stderr, "%s failed: %s\n", where.c_str(), why.c_str());
     } else if (code == kExitInterrupted || code == 128 + SIGTERM || code == 128 + SIGINT) {
       // 128 + signal: stopped before it could install its handlers; it resumes like 75.
-      finish_attempt(db, j.attempt, code,
-                     code == kExitInterrupted ? "interrupted after a checkpoint" : "stopped by a signal while starting");
+      finish_attempt(
+          db, j.attempt, code,
+          code == kExitInterrupted ? "interrupted after a checkpoint" : "stopped by a signal while starting");
       if (!stopping && !g_stop_signal.load()) queue.push_front(c);  // stopped from outside: resume at once
       return;
     } else {
@@ -273,8 +282,10 @@ int study_run(const StudyRunOptions& opt) {
       fs::rename(j.dir, fs::path(j.dir.string() + fmt::format(".bad-{}", j.attempt)), ec);
     }
     const int f = ++failures[c->id];
-    if (code != kExitInputError && f <= opt.retries && !stopping) queue.push_back(c);
-    else ++n_failed;
+    if (code != kExitInputError && f <= opt.retries && !stopping)
+      queue.push_back(c);
+    else
+      ++n_failed;
   };
 
   auto draw = [&] {
@@ -282,26 +293,34 @@ int study_run(const StudyRunOptions& opt) {
     std::string s;
     if (printed_lines > 0) s += fmt::format("\033[{}A", printed_lines);
     s += "\033[J";
-    double remaining_s = 0;
+    double remaining_s = 0, estimated_case_s = 0;
+    int estimated = 0, unknown = 0;  // unknown: running cases without a rate yet
     std::string rows;
     for (const auto& j : running) {
       const double t = simulated_time(j.dir);
       const double wall = std::chrono::duration<double>(Clock::now() - j.started).count();
       const double rate = wall > 0 ? (t - j.t_start_s) / wall : 0;
       const double end = j.c->params.time.end_s;
-      remaining_s += rate > 0 ? (end - t) / rate : NAN;
-      rows += fmt::format("  {} {:<12} {:5.1f} deg  t = {:8.3f} / {:g} s  {:8.4f} sim s/s\n", j.c->id, j.c->group,
-                          j.c->params.gravity.angle_deg, t, end, rate);
+      remaining_s += rate > 0 ? (end - t) / rate : 0.0;
+      unknown += rate > 0 ? 0 : 1;
+      if (rate > 0) {
+        estimated_case_s += end / rate;
+        ++estimated;
+      }
+      rows += fmt::format("  {} {:<12} {:5.1f} deg  t = {:8.3f} / {:g} s  {:8.4f} sim s/s\n", j.c->id,
+                          j.c->group, j.c->params.gravity.angle_deg, t, end, rate);
     }
-    double per_case = NAN;
+    // Mean wall time of the cases finished in this run, else an estimate from the running ones.
+    double per_case = estimated > 0 ? estimated_case_s / estimated : NAN;
     if (!finished_wall_s.empty()) {
       per_case = 0;
       for (double w : finished_wall_s) per_case += w;
       per_case /= static_cast<double>(finished_wall_s.size());
     }
-    const double eta = (remaining_s + static_cast<double>(queue.size()) * per_case) / opt.jobs;
-    s += fmt::format("study {}: {} done, {} running, {} failed, {} pending; ETA {}{}\n", study.name, n_done,
-                     running.size(), n_failed, queue.size(), fmt_duration(eta), stopping ? " (stopping)" : "");
+    const double eta = (remaining_s + static_cast<double>(queue.size() + unknown) * per_case) / opt.jobs;
+    s +=
+        fmt::format("study {}: {} done, {} running, {} failed, {} pending; ETA {}{}\n", study.name, n_done,
+                    running.size(), n_failed, queue.size(), fmt_duration(eta), stopping ? " (stopping)" : "");
     s += rows;
     printed_lines = 1 + static_cast<int>(running.size());
     std::fputs(s.c_str(), stdout);
@@ -374,12 +393,13 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
     auto it = known.find(c.id);
     const char* st = it == known.end() ? "pending" : to_string(it->second.status);
     ++counts[st];
-    lines += fmt::format("{:<16} {:<12} {:6.1f} {:<12} {}\n", c.id, c.group, c.params.gravity.angle_deg, st,
-                         it != known.end() && it->second.status != CaseStatus::kDone ? it->second.last_error : "");
+    lines +=
+        fmt::format("{:<16} {:<12} {:6.1f} {:<12} {}\n", c.id, c.group, c.params.gravity.angle_deg, st,
+                    it != known.end() && it->second.status != CaseStatus::kDone ? it->second.last_error : "");
   }
-  std::printf("study %s: %zu cases: %d done, %d running, %d failed, %d interrupted, %d pending\n", study.name.c_str(),
-              study.cases.size(), counts["done"], counts["running"], counts["failed"], counts["interrupted"],
-              counts["pending"]);
+  std::printf("study %s: %zu cases: %d done, %d running, %d failed, %d interrupted, %d pending\n",
+              study.name.c_str(), study.cases.size(), counts["done"], counts["running"], counts["failed"],
+              counts["interrupted"], counts["pending"]);
   std::printf("%-16s %-12s %6s %-12s %s\n", "case", "group", "angle", "status", "last error");
   std::fputs(lines.c_str(), stdout);
   return 0;

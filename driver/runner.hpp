@@ -26,7 +26,7 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
 std::string runs_root(const std::string& db_path);
 
 /// The launcher: argv for one case, wrapped in mpirun when ranks > 1.
-std::vector<std::string> case_command(const std::vector<std::string>& solver, int ranks, const std::string& case_file,
-                                      const std::string& out_dir);
+std::vector<std::string> case_command(const std::vector<std::string>& solver, int ranks,
+                                      const std::string& case_file, const std::string& out_dir);
 
 }  // namespace boycott::driver

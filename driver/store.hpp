@@ -20,7 +20,8 @@ std::int64_t begin_attempt(Database& db, const std::string& case_id, int ranks, 
 /// Closes an attempt that produced no result (failure or interruption).
 void finish_attempt(Database& db, std::int64_t attempt, int exit_status, const std::string& error_text);
 /// Closes the attempt and stores the result from the solver's summary.json, in one transaction.
-void record_result(Database& db, std::int64_t attempt, const std::string& case_id, const nlohmann::json& summary);
+void record_result(Database& db, std::int64_t attempt, const std::string& case_id,
+                   const nlohmann::json& summary);
 
 enum class CaseStatus { kPending, kRunning, kDone, kFailed, kInterrupted };
 const char* to_string(CaseStatus s);
@@ -29,8 +30,8 @@ struct CaseState {
   std::string study, group, id;
   double angle_deg = 0;
   CaseStatus status = CaseStatus::kPending;
-  int failures = 0;        ///< attempts that ended with a failure exit code
-  int last_exit = -1;      ///< -1: none
+  int failures = 0;    ///< attempts that ended with a failure exit code
+  int last_exit = -1;  ///< -1: none
   std::string last_error;
   bool input_error = false;  ///< an attempt exited 2: retrying cannot help
 };
@@ -43,7 +44,7 @@ struct CurvePoint {
   std::string group;
   std::string case_id;
   double angle_deg = 0;
-  double w_m_s = 0, w_err_m_s = 0;  ///< <<w_p>> and its standard error
+  double w_m_s = 0, w_err_m_s = 0;         ///< <<w_p>> and its standard error
   std::optional<double> r_acc, r_acc_err;  ///< <<w_p>>/<<w_p>>(90 deg); unset without a 90 deg case
 };
 

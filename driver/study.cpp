@@ -13,7 +13,9 @@
 namespace boycott::driver {
 namespace {
 
-std::string quote(const std::string& s) { return nlohmann::json(s).dump(); }
+std::string quote(const std::string& s) {
+  return nlohmann::json(s).dump();
+}
 
 /// A TOML value written back as TOML text, for apply_override.
 std::string toml_text(const toml::node& n) {
@@ -30,11 +32,14 @@ std::string toml_text(const toml::node& n) {
 }
 
 /// Flattens {fluid = {viscosity = 1}} and {"fluid.viscosity" = 1} alike into dotted keys.
-void flatten(const toml::table& t, const std::string& prefix, std::vector<std::pair<std::string, const toml::node*>>& out) {
+void flatten(const toml::table& t, const std::string& prefix,
+             std::vector<std::pair<std::string, const toml::node*>>& out) {
   for (const auto& [k, node] : t) {
     std::string name = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
-    if (const auto* sub = node.as_table()) flatten(*sub, name, out);
-    else out.emplace_back(name, &node);
+    if (const auto* sub = node.as_table())
+      flatten(*sub, name, out);
+    else
+      out.emplace_back(name, &node);
   }
 }
 
@@ -59,7 +64,8 @@ std::vector<Axis> read_axes(const toml::table& root) {
     for (const auto& [key, node] : entries) {
       check_known_key(key, "[matrix]");
       const auto* a = node->as_array();
-      if (!a || a->empty()) throw InputError(fmt::format("[matrix] '{}' must be a non-empty list of values", key));
+      if (!a || a->empty())
+        throw InputError(fmt::format("[matrix] '{}' must be a non-empty list of values", key));
       Axis ax;
       ax.keys = {key};
       for (const auto& e : *a) ax.points.push_back({toml_text(e)});
@@ -77,14 +83,16 @@ std::vector<Axis> read_axes(const toml::table& root) {
     for (const auto& [key, node] : entries) {
       check_known_key(key, "[zip]");
       const auto* a = node->as_array();
-      if (!a || a->empty()) throw InputError(fmt::format("[zip] '{}' must be a non-empty list of values", key));
+      if (!a || a->empty())
+        throw InputError(fmt::format("[zip] '{}' must be a non-empty list of values", key));
       if (ax.keys.empty()) {
         len = a->size();
         first = key;
         ax.points.resize(len);
       } else if (a->size() != len) {
-        throw InputError(fmt::format("[zip] '{}' has {} values but '{}' has {}: zipped lists must be equally long", key,
-                                     a->size(), first, len));
+        throw InputError(
+            fmt::format("[zip] '{}' has {} values but '{}' has {}: zipped lists must be equally long", key,
+                        a->size(), first, len));
       }
       ax.keys.push_back(key);
       for (std::size_t i = 0; i < len; ++i) ax.points[i].push_back(toml_text(*a->get(i)));
@@ -125,13 +133,14 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
   static const std::set<std::string> kTopKeys = {"name", "base", "group", "matrix", "zip"};
   for (const auto& [k, node] : root)
     if (!kTopKeys.count(std::string(k.str())))
-      throw InputError(fmt::format("{}: unknown study key '{}' (expected name, base, group, matrix, zip)", origin,
-                                   k.str()));
+      throw InputError(fmt::format("{}: unknown study key '{}' (expected name, base, group, matrix, zip)",
+                                   origin, k.str()));
 
   Study s;
   s.source_text = text;
   auto name = root["name"].value<std::string>();
-  if (!name || name->empty()) throw InputError(fmt::format("{}: the study needs a non-empty string 'name'", origin));
+  if (!name || name->empty())
+    throw InputError(fmt::format("{}: the study needs a non-empty string 'name'", origin));
   s.name = *name;
 
   std::string base_text;
@@ -161,7 +170,8 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
       if (!gt) throw InputError("[[group]] entries must be tables");
       Group g;
       auto gname = (*gt)["name"].value<std::string>();
-      if (!gname || gname->empty()) throw InputError("[[group]]: every group needs a non-empty string 'name'");
+      if (!gname || gname->empty())
+        throw InputError("[[group]]: every group needs a non-empty string 'name'");
       g.name = *gname;
       for (const auto& [k, node] : *gt) {
         if (k.str() != "name" && k.str() != "set")

@@ -21,7 +21,7 @@ struct StudyCase {
 
 struct Study {
   std::string name;
-  std::string source_text;  ///< the study file as read, stored in the database
+  std::string source_text;          ///< the study file as read, stored in the database
   std::vector<std::string> groups;  ///< in file order
   std::vector<StudyCase> cases;     ///< group by group, matrix x zip within each
 };

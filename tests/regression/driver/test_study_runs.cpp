@@ -32,7 +32,9 @@ struct TempDir {
   ~TempDir() { fs::remove_all(path); }
 };
 
-void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+void write(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
 std::string read(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::stringstream ss;
@@ -66,7 +68,8 @@ struct Run {
 };
 
 /// Starts `boycott args...` with extra environment; stdout and stderr go to files in dir.
-pid_t spawn(const std::vector<std::string>& args, const fs::path& dir, const std::map<std::string, std::string>& env) {
+pid_t spawn(const std::vector<std::string>& args, const fs::path& dir,
+            const std::map<std::string, std::string>& env) {
   const pid_t pid = fork();
   if (pid == 0) {
     for (const auto& [k, v] : env) setenv(k.c_str(), v.c_str(), 1);
@@ -91,13 +94,15 @@ Run wait_run(pid_t pid, const fs::path& dir) {
   return r;
 }
 
-Run run(const std::vector<std::string>& args, const fs::path& dir, std::map<std::string, std::string> env = {}) {
+Run run(const std::vector<std::string>& args, const fs::path& dir,
+        std::map<std::string, std::string> env = {}) {
   env.try_emplace("FAKE_STEP_WALL_S", "0.01");
   return wait_run(spawn(args, dir, env), dir);
 }
 
 std::vector<std::string> study_run(const fs::path& study, const fs::path& db, int jobs = 2) {
-  return {"study", "run", study.string(), "--db", db.string(), "--jobs", std::to_string(jobs), "--solver-command",
+  return {"study",     "run",    study.string(),       "--db",
+          db.string(), "--jobs", std::to_string(jobs), "--solver-command",
           kSolver};
 }
 
@@ -111,8 +116,9 @@ std::int64_t count(const fs::path& db, const std::string& sql) {
 /// case id -> (mean, stderr, particle_steps) as recorded.
 std::map<std::string, std::tuple<double, double, std::int64_t>> results(const fs::path& db) {
   bd::Database d(db.string(), bd::OpenMode::kExisting);
-  auto st = d.prepare("SELECT case_id, mean_settling_velocity_m_s, settling_velocity_stderr_m_s, particle_steps "
-                      "FROM results");
+  auto st = d.prepare(
+      "SELECT case_id, mean_settling_velocity_m_s, settling_velocity_stderr_m_s, particle_steps "
+      "FROM results");
   std::map<std::string, std::tuple<double, double, std::int64_t>> out;
   while (st.step()) out[st.text(0)] = {st.real(1), st.real(2), st.integer(3)};
   return out;
@@ -131,8 +137,9 @@ TEST(StudyRun, RunsEveryCaseOnceAndQueryCurveMatchesTheCaseSummaries) {
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 6);
   // --jobs 3: some attempts overlapped in time.
-  EXPECT_GE(count(db, "SELECT MAX((SELECT COUNT(*) FROM attempts b WHERE b.started_at <= a.started_at AND "
-                      "b.ended_at > a.started_at)) FROM attempts a"),
+  EXPECT_GE(count(db,
+                  "SELECT MAX((SELECT COUNT(*) FROM attempts b WHERE b.started_at <= a.started_at AND "
+                  "b.ended_at > a.started_at)) FROM attempts a"),
             2);
 
   const auto q = run({"query", "curve", "--db", db.string(), "--study", "small", "--format", "json", "--plot",
@@ -143,27 +150,31 @@ TEST(StudyRun, RunsEveryCaseOnceAndQueryCurveMatchesTheCaseSummaries) {
   ASSERT_EQ(curve.size(), 6u);
   std::map<std::string, double> w90;
   for (const auto& p : curve) {
-    const auto summary = nlohmann::json::parse(read(fs::path(db.string() + ".runs") / p["case_id"].get<std::string>() /
-                                                    "summary.json"));
-    EXPECT_DOUBLE_EQ(p["mean_settling_velocity_m_s"].get<double>(), summary["mean_settling_velocity_m_s"].get<double>());
+    const auto summary = nlohmann::json::parse(
+        read(fs::path(db.string() + ".runs") / p["case_id"].get<std::string>() / "summary.json"));
+    EXPECT_DOUBLE_EQ(p["mean_settling_velocity_m_s"].get<double>(),
+                     summary["mean_settling_velocity_m_s"].get<double>());
     EXPECT_DOUBLE_EQ(p["stderr_m_s"].get<double>(), summary["settling_velocity_stderr_m_s"].get<double>());
     if (p["angle_deg"] == 90.0) w90[p["group"]] = summary["mean_settling_velocity_m_s"].get<double>();
   }
   for (const auto& p : curve)
-    EXPECT_NEAR(p["r_acc"].get<double>(), p["mean_settling_velocity_m_s"].get<double>() / w90[p["group"]], 1e-12);
+    EXPECT_NEAR(p["r_acc"].get<double>(), p["mean_settling_velocity_m_s"].get<double>() / w90[p["group"]],
+                1e-12);
   const auto svg = read(d.path / "c.svg");
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
   // One polyline per group in each of the two panels.
   std::size_t lines = 0;
-  for (auto pos = svg.find("<polyline"); pos != std::string::npos; pos = svg.find("<polyline", pos + 1)) ++lines;
+  for (auto pos = svg.find("<polyline"); pos != std::string::npos; pos = svg.find("<polyline", pos + 1))
+    ++lines;
   EXPECT_EQ(lines, 4u);
 
   // A second run has nothing to do.
   const auto again = run(study_run(d.path / "s.toml", db), d.path);
   EXPECT_EQ(again.rc, 0);
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 6);
-  const auto csv = run({"query", "curve", "--db", db.string(), "--study", "small", "--group", "Ga", "--format", "csv"},
-                       d.path);
+  const auto csv =
+      run({"query", "curve", "--db", db.string(), "--study", "small", "--group", "Ga", "--format", "csv"},
+          d.path);
   EXPECT_EQ(std::count(csv.out.begin(), csv.out.end(), '\n'), 4);
   const auto status = run({"study", "status", (d.path / "s.toml").string(), "--db", db.string()}, d.path);
   EXPECT_NE(status.out.find("6 cases: 6 done"), std::string::npos) << status.out;
@@ -181,7 +192,8 @@ TEST(StudyRun, KillNineAtRandomMomentsThenRerunEndsWithTheUninterruptedResults) 
   std::mt19937 rng(12345);
   std::uniform_int_distribution<int> delay_ms(30, 600);
   // The commit delay widens the moment of the result transaction so that some kills land in it.
-  const std::map<std::string, std::string> env = {{"FAKE_STEP_WALL_S", "0.02"}, {"BOYCOTT_TEST_COMMIT_DELAY_S", "0.05"}};
+  const std::map<std::string, std::string> env = {{"FAKE_STEP_WALL_S", "0.02"},
+                                                  {"BOYCOTT_TEST_COMMIT_DELAY_S", "0.05"}};
   for (int k = 0; k < 6; ++k) {
     const pid_t pid = spawn(study_run(d.path / "s.toml", db), d.path, env);
     std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms(rng)));
@@ -251,15 +263,17 @@ seed = [1, 13, 14]
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 2);
   // seed 13 fails once then succeeds; seed 14 fails on its first try and its one retry.
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 3"), 3);
-  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE error_text = 'error: the run became unphysical: NaN in the "
-                      "pressure'"),
-            1);
+  EXPECT_EQ(
+      count(db,
+            "SELECT COUNT(*) FROM attempts WHERE error_text = 'error: the run became unphysical: NaN in the "
+            "pressure'"),
+      1);
   // A rerun does not try the exhausted case again.
   const auto again = run(args, d.path);
   EXPECT_EQ(again.rc, 1);
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 5);
-  const auto status = run({"study", "status", (d.path / "s.toml").string(), "--db", db.string(), "--retries", "1"},
-                          d.path);
+  const auto status =
+      run({"study", "status", (d.path / "s.toml").string(), "--db", db.string(), "--retries", "1"}, d.path);
   EXPECT_NE(status.out.find("2 done, 0 running, 1 failed"), std::string::npos) << status.out;
   EXPECT_NE(status.out.find("alpha_f = -0.2"), std::string::npos) << status.out;
 }

@@ -70,7 +70,9 @@ TEST(StudyDatabase, SchemaIsCreatedFromResultsSchemaFiles) {
   bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
   EXPECT_EQ(db.version(), bd::Database::latest_version());
   for (const char* t : {"studies", "cases", "study_cases", "case_values", "attempts", "results"})
-    EXPECT_EQ(count(db, std::string("SELECT COUNT(*) FROM sqlite_master WHERE type='table' AND name='") + t + "'"), 1)
+    EXPECT_EQ(
+        count(db, std::string("SELECT COUNT(*) FROM sqlite_master WHERE type='table' AND name='") + t + "'"),
+        1)
         << t;
   auto st = db.prepare("PRAGMA journal_mode");
   st.step();
@@ -87,13 +89,14 @@ TEST(StudyDatabase, Version1DatabaseMigratesToVersion2KeepingItsRows) {
     EXPECT_FALSE(has_column(v1, "attempts", "run_dir"));
     bd::register_study(v1, study);
     // A version-1 attempt, written the way a version-1 program did (no run_dir column).
-    v1.exec("INSERT INTO attempts(case_id, started_at, host, ranks, program_version) VALUES ('" + study.cases[0].id +
-            "', '2026-01-01T00:00:00Z', 'h', 1, '0.0.1')");
+    v1.exec("INSERT INTO attempts(case_id, started_at, host, ranks, program_version) VALUES ('" +
+            study.cases[0].id + "', '2026-01-01T00:00:00Z', 'h', 1, '0.0.1')");
   }
   bd::Database v2(path, bd::OpenMode::kExisting);
   EXPECT_EQ(v2.version(), 2);
   EXPECT_TRUE(has_column(v2, "attempts", "run_dir"));
-  EXPECT_EQ(count(v2, "SELECT COUNT(*) FROM sqlite_master WHERE type='index' AND name='attempts_by_case'"), 1);
+  EXPECT_EQ(count(v2, "SELECT COUNT(*) FROM sqlite_master WHERE type='index' AND name='attempts_by_case'"),
+            1);
   EXPECT_EQ(count(v2, "SELECT COUNT(*) FROM cases"), 4);
   EXPECT_EQ(count(v2, "SELECT COUNT(*) FROM attempts WHERE run_dir IS NULL"), 1);
 }
@@ -179,11 +182,15 @@ TEST(StudyDatabase, CurveRatioAndPropagatedErrorFollowTheRecordedResults) {
   bd::register_study(db, study);
   for (const auto& c : study.cases) {
     const double w = -0.01 * (c.params.gravity.angle_deg == 90.0 ? 1.0 : 1.5) * (c.group == "b" ? 0.5 : 1.0);
-    const nlohmann::json summary = {{"scene", "inclined_settling"}, {"case_id", c.id},
-                                    {"status", "done"},             {"mean_settling_velocity_m_s", w},
+    const nlohmann::json summary = {{"scene", "inclined_settling"},
+                                    {"case_id", c.id},
+                                    {"status", "done"},
+                                    {"mean_settling_velocity_m_s", w},
                                     {"settling_velocity_stderr_m_s", std::abs(w) * 0.02},
-                                    {"simulated_time_s", 2.0},      {"wall_time_s", 1.0},
-                                    {"particle_steps", 1000},       {"max_rel_error_vs_analytic", 0.01}};
+                                    {"simulated_time_s", 2.0},
+                                    {"wall_time_s", 1.0},
+                                    {"particle_steps", 1000},
+                                    {"max_rel_error_vs_analytic", 0.01}};
     bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, summary);
   }
   const auto pts = bd::query_curve(db, "s");
@@ -199,7 +206,9 @@ TEST(StudyDatabase, CurveRatioAndPropagatedErrorFollowTheRecordedResults) {
   EXPECT_EQ(pts[2].group, "b");
   EXPECT_DOUBLE_EQ(pts[2].w_m_s, -0.0075);
   EXPECT_EQ(bd::query_curve(db, "s", "b").size(), 2u);
-  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results WHERE validation_errors_json LIKE '%max_rel_error_vs_analytic%' "
-                      "AND average_from_s = 1.0 AND average_to_s = 2.0"),
-            4);
+  EXPECT_EQ(
+      count(db,
+            "SELECT COUNT(*) FROM results WHERE validation_errors_json LIKE '%max_rel_error_vs_analytic%' "
+            "AND average_from_s = 1.0 AND average_to_s = 2.0"),
+      4);
 }

@@ -71,12 +71,16 @@ TEST(StudyExpansion, PaperStudyHas64DistinctValidCases) {
   std::set<double> angles;
   for (const auto& c : s.cases) {
     angles.insert(c.params.gravity.angle_deg);
-    if (c.group == "Ga145.6") EXPECT_DOUBLE_EQ(c.params.fluid.viscosity_pa_s, 1.0e-2);
+    if (c.group == "Ga145.6") {
+      EXPECT_DOUBLE_EQ(c.params.fluid.viscosity_pa_s, 1.0e-2);
+    }
     if (c.group == "Sr0.0667") {
       EXPECT_DOUBLE_EQ(c.params.particles.diameter_m, 0.4e-3);
       EXPECT_EQ(c.params.particles.count, 405000);
     }
-    if (c.group == "Sg1.5") EXPECT_DOUBLE_EQ(c.params.particles.density_kg_m3, 1500.0);
+    if (c.group == "Sg1.5") {
+      EXPECT_DOUBLE_EQ(c.params.particles.density_kg_m3, 1500.0);
+    }
     if (c.group == "base") {
       EXPECT_EQ(c.params.particles.count, 120000);
       EXPECT_NEAR(c.params.solid_fraction(), 0.113, 0.001);
@@ -119,9 +123,15 @@ name = "z"
 )");
   ASSERT_EQ(s.cases.size(), 6u);
   for (const auto& c : s.cases) {
-    if (c.params.particles.diameter_m == 0.4e-3) EXPECT_EQ(c.params.particles.count, 4000);
-    if (c.params.particles.diameter_m == 0.6e-3) EXPECT_EQ(c.params.particles.count, 1200);
-    if (c.params.particles.diameter_m == 0.8e-3) EXPECT_EQ(c.params.particles.count, 500);
+    if (c.params.particles.diameter_m == 0.4e-3) {
+      EXPECT_EQ(c.params.particles.count, 4000);
+    }
+    if (c.params.particles.diameter_m == 0.6e-3) {
+      EXPECT_EQ(c.params.particles.count, 1200);
+    }
+    if (c.params.particles.diameter_m == 0.8e-3) {
+      EXPECT_EQ(c.params.particles.count, 500);
+    }
   }
   EXPECT_EQ(s.cases[0].group, "base");  // no [[group]]: one group named base
 }
@@ -136,16 +146,21 @@ TEST(StudyExpansion, CaseFileWrittenForTheSolverHasTheSameId) {
 
 TEST(StudyExpansionErrors, NameTheOffendingKey) {
   EXPECT_NE(error_of("name = \"x\"\n[base\n").find("malformed TOML"), std::string::npos);
-  EXPECT_NE(error_of("name = \"x\"\n[base.fluid]\nviscosityy = 1e-3\n").find("fluid.viscosityy"), std::string::npos);
+  EXPECT_NE(error_of("name = \"x\"\n[base.fluid]\nviscosityy = 1e-3\n").find("fluid.viscosityy"),
+            std::string::npos);
   EXPECT_NE(error_of("name = \"x\"\n[[group]]\nname = \"g\"\nset = { \"fluid.viscosity\" = -1e-3 }\n")
                 .find("fluid.viscosity = -0.001 is out of range"),
             std::string::npos);
-  EXPECT_NE(error_of("name = \"x\"\n[base.particles]\ncount = 100\n[matrix]\n\"particles.diameter\" = [1e-3, 7e-3]\n").find("does not fit the channel"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(
+          "name = \"x\"\n[base.particles]\ncount = 100\n[matrix]\n\"particles.diameter\" = [1e-3, 7e-3]\n")
+          .find("does not fit the channel"),
+      std::string::npos);
   EXPECT_NE(error_of("name = \"x\"\n[matrix]\n\"gravity.angel_deg\" = [10]\n").find("gravity.angel_deg"),
             std::string::npos);
-  EXPECT_NE(error_of("name = \"x\"\n[zip]\n\"seed\" = [1, 2]\n\"gravity.angle_deg\" = [10]\n").find("equally long"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of("name = \"x\"\n[zip]\n\"seed\" = [1, 2]\n\"gravity.angle_deg\" = [10]\n").find("equally long"),
+      std::string::npos);
   EXPECT_NE(error_of("[base]\nseed = 2\n").find("'name'"), std::string::npos);
   EXPECT_NE(error_of("name = \"x\"\nmatrx = 1\n").find("'matrx'"), std::string::npos);
   EXPECT_NE(error_of("name = \"x\"\n[[group]]\nname = \"a\"\n[[group]]\nname = \"b\"\n").find("same case"),
@@ -158,8 +173,8 @@ TEST(StudyLauncher, WrapsTheCaseInMpirunForSeveralRanks) {
   const auto one = bd::case_command({"boycott"}, 1, "c.toml", "d");
   EXPECT_EQ(one, (std::vector<std::string>{"boycott", "case", "run", "c.toml", "--out", "d", "--quiet"}));
   const auto four = bd::case_command({"boycott"}, 4, "c.toml", "d");
-  EXPECT_EQ(four, (std::vector<std::string>{"mpirun", "-n", "4", "--allow-run-as-root", "boycott", "case", "run",
-                                            "c.toml", "--out", "d", "--quiet"}));
+  EXPECT_EQ(four, (std::vector<std::string>{"mpirun", "-n", "4", "--allow-run-as-root", "boycott", "case",
+                                            "run", "c.toml", "--out", "d", "--quiet"}));
 }
 
 TEST(StudyExpansion, DemoStudyIsValidWithThePaperSolidFraction) {
