@@ -191,6 +191,16 @@ int study_run(const StudyRunOptions& opt) {
       ::close(j.lock_fd);
       return false;
     }
+    {
+      // Another driver on the same database may have finished it meanwhile.
+      auto st = db.prepare("SELECT 1 FROM results WHERE case_id = ?1");
+      st.bind(1, c->id);
+      if (st.step()) {
+        ++n_done;
+        ::close(j.lock_fd);
+        return true;
+      }
+    }
     const fs::path case_file = j.dir / "case.toml";
     if (!fs::exists(case_file)) write_atomic(case_file, case_to_toml(c->params));
     j.attempt = begin_attempt(db, c->id, opt.ranks, j.dir.string());
@@ -392,6 +402,12 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
   for (const auto& c : study.cases) {
     auto it = known.find(c.id);
     const char* st = it == known.end() ? "pending" : to_string(it->second.status);
+    if (it != known.end() && it->second.status == CaseStatus::kRunning) {
+      // An open attempt whose folder nobody holds: its driver died (kill -9, power loss).
+      const int fd = ::open((fs::path(runs_root(db_path)) / c.id / ".lock").c_str(), O_RDWR | O_CLOEXEC);
+      if (fd >= 0 && ::flock(fd, LOCK_EX | LOCK_NB) == 0) st = "interrupted";
+      if (fd >= 0) ::close(fd);
+    }
     ++counts[st];
     lines +=
         fmt::format("{:<16} {:<12} {:6.1f} {:<12} {}\n", c.id, c.group, c.params.gravity.angle_deg, st,

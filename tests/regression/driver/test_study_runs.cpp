@@ -200,6 +200,11 @@ TEST(StudyRun, KillNineAtRandomMomentsThenRerunEndsWithTheUninterruptedResults) 
     ::kill(pid, SIGKILL);
     wait_run(pid, d.path);
   }
+  // The orphaned solvers got SIGTERM from the kernel (parent death) and stop at a checkpoint;
+  // once they are gone nothing holds the run folders and status must not claim "running".
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  const auto status = run({"study", "status", (d.path / "s.toml").string(), "--db", db.string()}, d.path);
+  EXPECT_NE(status.out.find(" 0 running"), std::string::npos) << status.out;
   const auto r = run(study_run(d.path / "s.toml", db), d.path);
   ASSERT_EQ(r.rc, 0) << r.err;
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
@@ -318,4 +323,36 @@ TEST(StudyRunBadInput, OneLineErrorNonZeroExitAndTheDatabaseUnchanged) {
   EXPECT_NE(newer.err.find("newer"), std::string::npos) << newer.err;
   EXPECT_EQ(std::count(newer.err.begin(), newer.err.end(), '\n'), 1) << newer.err;
   EXPECT_EQ(read(db), v99);
+}
+
+TEST(StudyRun, UnusableCheckpointIsSetAsideAndTheCaseRerunFromTheStart) {
+  TempDir d;
+  write(d.path / "s.toml", kStudy);
+  const auto ref_db = d.path / "ref.db";
+  ASSERT_EQ(run(study_run(d.path / "s.toml", ref_db), d.path).rc, 0);
+  const auto reference = results(ref_db);
+
+  const auto db = d.path / "s.db";
+  const pid_t pid = spawn(study_run(d.path / "s.toml", db), d.path, {{"FAKE_STEP_WALL_S", "0.1"}});
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  ::kill(pid, SIGINT);
+  ASSERT_EQ(wait_run(pid, d.path).rc, 75);
+  std::string dir;
+  {
+    bd::Database c(db.string(), bd::OpenMode::kExisting);
+    auto st = c.prepare("SELECT run_dir FROM attempts WHERE exit_status = 75 LIMIT 1");
+    ASSERT_TRUE(st.step());
+    dir = st.text(0);
+  }
+  write(fs::path(dir) / "checkpoint.json", "{\"step\": 3, \"su");  // cut short
+  const auto r = run(study_run(d.path / "s.toml", db), d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 4 AND error_text LIKE '%unusable%'"),
+            1);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
+  EXPECT_EQ(results(db), reference);
+  bool set_aside = false;
+  for (const auto& e : fs::directory_iterator(fs::path(dir).parent_path()))
+    set_aside |= e.path().filename().string().find(".bad-") != std::string::npos;
+  EXPECT_TRUE(set_aside);
 }
