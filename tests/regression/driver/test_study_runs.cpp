@@ -356,3 +356,22 @@ TEST(StudyRun, UnusableCheckpointIsSetAsideAndTheCaseRerunFromTheStart) {
     set_aside |= e.path().filename().string().find(".bad-") != std::string::npos;
   EXPECT_TRUE(set_aside);
 }
+
+TEST(StudyRun, TwoDriversOnOneDatabaseRunEveryCaseExactlyOnce) {
+  TempDir d;
+  write(d.path / "s.toml", kStudy);
+  const auto db = d.path / "s.db";
+  fs::create_directories(d.path / "a");
+  fs::create_directories(d.path / "b");
+  const std::map<std::string, std::string> env = {{"FAKE_STEP_WALL_S", "0.02"}};
+  const pid_t a = spawn(study_run(d.path / "s.toml", db), d.path / "a", env);
+  const pid_t b = spawn(study_run(d.path / "s.toml", db), d.path / "b", env);
+  const auto ra = wait_run(a, d.path / "a");
+  const auto rb = wait_run(b, d.path / "b");
+  EXPECT_EQ(ra.rc, 0) << ra.err;
+  EXPECT_EQ(rb.rc, 0) << rb.err;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
+  // The run folder's lock keeps the second driver off a case the first one runs.
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 0"), 6);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status IS NOT 0"), 0);
+}
