@@ -1,14 +1,21 @@
 // boycott: the command-line front end. Subcommands follow design brief section 7.
+#include <unistd.h>
+
 #include <csignal>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "core/error.hpp"
 #include "core/version.hpp"
 #include "driver/case_commands.hpp"
+#include "driver/curve.hpp"
+#include "driver/database.hpp"
+#include "driver/runner.hpp"
+#include "driver/store.hpp"
 
 namespace {
 
@@ -24,6 +31,10 @@ int run_guarded(const std::function<int()>& fn) {
   } catch (const boycott::CheckpointError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return boycott::kExitCheckpointError;
+  } catch (const boycott::driver::DatabaseError& e) {
+    // An unusable database (unwritable path, newer schema) is bad input to the driver.
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return boycott::kExitInputError;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return boycott::kExitFailure;
@@ -33,7 +44,8 @@ int run_guarded(const std::function<int()>& fn) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"boycott: unresolved CFD-DEM of proppant settling in inclined narrow channels, and its study driver"};
+  CLI::App app{
+      "boycott: unresolved CFD-DEM of proppant settling in inclined narrow channels, and its study driver"};
   app.require_subcommand(1);
   app.set_version_flag("--version", fmt::format("boycott {}+{}", boycott::kVersion, boycott::kGitRevision));
 
@@ -56,13 +68,77 @@ int main(int argc, char** argv) {
 
   auto* keys = case_cmd->add_subcommand("keys", "list every case key and its default");
 
+  // ---- study ----
+  auto* study_cmd = app.add_subcommand("study", "run a study (a matrix of cases) into a database");
+  study_cmd->require_subcommand(1);
+  boycott::driver::StudyRunOptions sopt;
+  auto* srun =
+      study_cmd->add_subcommand("run", "run what is missing, resume interrupted cases, retry failed ones");
+  srun->add_option("study", sopt.study_file, "study file (TOML)")->required();
+  srun->add_option("--db", sopt.db_path, "results database (SQLite)")->required();
+  srun->add_option("--jobs", sopt.jobs, "cases run at once")->capture_default_str();
+  srun->add_option("--retries", sopt.retries, "failed attempts retried per case")->capture_default_str();
+  srun->add_option("--ranks", sopt.ranks, "MPI ranks per case (mpirun -n K)")->capture_default_str();
+  // For tests and for other solver builds: the command that runs one case.
+  srun->add_option("--solver-command", sopt.solver_command, "")->group("");
+  std::string status_file, status_db;
+  int status_retries = 2;
+  auto* sstatus = study_cmd->add_subcommand("status", "report the cases of a study and their status");
+  sstatus->add_option("study", status_file, "study file (TOML)")->required();
+  sstatus->add_option("--db", status_db, "results database (SQLite)")->required();
+  sstatus->add_option("--retries", status_retries, "as given to study run")->capture_default_str();
+
+  // ---- query ----
+  auto* query_cmd = app.add_subcommand("query", "read results from a study database");
+  query_cmd->require_subcommand(1);
+  std::string q_db, q_study, q_group, q_format = "table", q_plot;
+  auto* qcurve = query_cmd->add_subcommand("curve", "<<w_p>> and r_acc per group and angle");
+  qcurve->add_option("--db", q_db, "results database")->required();
+  qcurve->add_option("--study", q_study, "study name")->required();
+  qcurve->add_option("--group", q_group, "only this group");
+  qcurve->add_option("--format", q_format, "table, csv or json")->capture_default_str();
+  qcurve->add_option("--plot", q_plot, "also draw the curves (SVG, like Fig. 14 of the paper)");
+  auto* qcases = query_cmd->add_subcommand("cases", "list cases and their status");
+  qcases->add_option("--db", q_db, "results database")->required();
+  qcases->add_option("--study", q_study, "only this study");
+
   CLI11_PARSE(app, argc, argv);
+
+  if (srun->parsed()) {
+    sopt.progress = isatty(STDOUT_FILENO);
+    return run_guarded([&] { return boycott::driver::study_run(sopt); });
+  }
+  if (sstatus->parsed())
+    return run_guarded([&] { return boycott::driver::study_status(status_file, status_db, status_retries); });
+  if (qcurve->parsed())
+    return run_guarded([&] {
+      const auto fmt_kind = boycott::driver::parse_curve_format(q_format);
+      boycott::driver::Database db(q_db, boycott::driver::OpenMode::kExisting);
+      const auto pts = boycott::driver::query_curve(db, q_study, q_group);
+      if (pts.empty())
+        throw boycott::InputError(fmt::format("no finished cases of study '{}'{} in '{}'", q_study,
+                                              q_group.empty() ? "" : " group '" + q_group + "'", q_db));
+      std::fputs(boycott::driver::format_curve(pts, fmt_kind).c_str(), stdout);
+      if (!q_plot.empty()) {
+        std::ofstream out(q_plot);
+        out << boycott::driver::curve_svg(pts, fmt::format("study {}", q_study));
+        if (!out) throw std::runtime_error(fmt::format("cannot write '{}'", q_plot));
+      }
+      return 0;
+    });
+  if (qcases->parsed())
+    return run_guarded([&] {
+      boycott::driver::Database db(q_db, boycott::driver::OpenMode::kExisting);
+      std::fputs(boycott::driver::format_cases(boycott::driver::case_states(db, q_study, 2)).c_str(), stdout);
+      return 0;
+    });
 
   if (run->parsed()) {
     run_opt.petsc_options = run->remaining();
     return run_guarded([&] { return boycott::driver::case_run(run_opt, argc, argv); });
   }
-  if (check->parsed()) return run_guarded([&] { return boycott::driver::case_check(check_file, check_sets); });
+  if (check->parsed())
+    return run_guarded([&] { return boycott::driver::case_check(check_file, check_sets); });
   if (keys->parsed()) return run_guarded([&] { return boycott::driver::case_keys(); });
   return 0;
 }

@@ -1,0 +1,203 @@
+#include "driver/curve.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+
+namespace boycott::driver {
+
+CurveFormat parse_curve_format(const std::string& s) {
+  if (s == "table") return CurveFormat::kTable;
+  if (s == "csv") return CurveFormat::kCsv;
+  if (s == "json") return CurveFormat::kJson;
+  throw InputError(fmt::format("--format {} is not known: must be table, csv or json", s));
+}
+
+std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
+  std::string s;
+  auto opt = [](const std::optional<double>& v) { return v ? fmt::format("{:.6g}", *v) : std::string(); };
+  if (f == CurveFormat::kCsv) {
+    s = "group,angle_deg,mean_settling_velocity_m_s,stderr_m_s,r_acc,r_acc_err,case_id\n";
+    for (const auto& p : pts)
+      s += fmt::format("{},{:g},{:.9g},{:.9g},{},{},{}\n", p.group, p.angle_deg, p.w_m_s, p.w_err_m_s,
+                       opt(p.r_acc), opt(p.r_acc_err), p.case_id);
+  } else if (f == CurveFormat::kJson) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto& p : pts) {
+      nlohmann::json e = {{"group", p.group},
+                          {"angle_deg", p.angle_deg},
+                          {"mean_settling_velocity_m_s", p.w_m_s},
+                          {"stderr_m_s", p.w_err_m_s},
+                          {"case_id", p.case_id}};
+      e["r_acc"] = p.r_acc ? nlohmann::json(*p.r_acc) : nlohmann::json(nullptr);
+      e["r_acc_err"] = p.r_acc_err ? nlohmann::json(*p.r_acc_err) : nlohmann::json(nullptr);
+      j.push_back(e);
+    }
+    s = j.dump(2) + "\n";
+  } else if (pts.empty()) {
+    s = "(no finished cases)\n";
+  } else {
+    s = fmt::format("{:<12} {:>6}  {:>24}  {:>18}\n", "group", "angle", "<<w_p>> (mm/s)", "r_acc");
+    for (const auto& p : pts) {
+      const std::string r = p.r_acc ? fmt::format("{:.3f} +- {:.3f}", *p.r_acc, *p.r_acc_err) : "-";
+      s += fmt::format("{:<12} {:>6g}  {:>11.4f} +- {:<9.4f}  {:>18}\n", p.group, p.angle_deg, p.w_m_s * 1e3,
+                       p.w_err_m_s * 1e3, r);
+    }
+  }
+  return s;
+}
+
+namespace {
+
+struct Panel {
+  double x0, y0, w, h;  // pixel box of the plot area
+  double vmin, vmax;    // data range of y
+  double px(double angle) const { return x0 + (angle - 10.0) / 85.0 * w; }
+  double py(double v) const { return y0 + h - (v - vmin) / (vmax - vmin) * h; }
+};
+
+/// Round numbers for ticks over [lo, hi].
+std::vector<double> ticks(double lo, double hi) {
+  const double span = hi - lo;
+  const double raw = span / 5.0;
+  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = mag;
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * mag >= raw) {
+      step = m * mag;
+      break;
+    }
+  std::vector<double> t;
+  for (double v = std::ceil(lo / step) * step; v <= hi + 1e-9 * span; v += step)
+    t.push_back(std::abs(v) < 1e-12 * step ? 0.0 : v);
+  return t;
+}
+
+const char* kColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd",
+                         "#ff7f0e", "#8c564b", "#e377c2", "#17becf"};
+const char* kMarks[] = {"circle", "square", "diamond", "triangle"};
+
+std::string marker(const char* kind, double x, double y, const char* color) {
+  const std::string k = kind;
+  if (k == "circle") return fmt::format("<circle cx='{:.1f}' cy='{:.1f}' r='4' fill='{}'/>", x, y, color);
+  if (k == "square")
+    return fmt::format("<rect x='{:.1f}' y='{:.1f}' width='8' height='8' fill='{}'/>", x - 4, y - 4, color);
+  if (k == "diamond")
+    return fmt::format(
+        "<polygon points='{:.1f},{:.1f} {:.1f},{:.1f} {:.1f},{:.1f} {:.1f},{:.1f}' fill='{}'/>", x, y - 5,
+        x + 5, y, x, y + 5, x - 5, y, color);
+  return fmt::format("<polygon points='{:.1f},{:.1f} {:.1f},{:.1f} {:.1f},{:.1f}' fill='{}'/>", x, y - 5,
+                     x + 5, y + 4, x - 5, y + 4, color);
+}
+
+std::string xml_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '<')
+      o += "&lt;";
+    else if (c == '>')
+      o += "&gt;";
+    else if (c == '&')
+      o += "&amp;";
+    else if (c == '\'')
+      o += "&apos;";
+    else
+      o += c;
+  }
+  return o;
+}
+
+}  // namespace
+
+std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& title) {
+  std::vector<std::string> groups;
+  for (const auto& p : pts)
+    if (std::find(groups.begin(), groups.end(), p.group) == groups.end()) groups.push_back(p.group);
+
+  std::string s =
+      "<svg xmlns='http://www.w3.org/2000/svg' width='1000' height='440' font-family='sans-serif' "
+      "font-size='13'>\n<rect width='1000' height='440' fill='white'/>\n";
+  s += fmt::format("<text x='500' y='22' text-anchor='middle' font-size='15'>{}</text>\n", xml_escape(title));
+  for (int panel = 0; panel < 2; ++panel) {
+    // Left: <<w_p>> in mm/s; right: r_acc (dimensionless).
+    auto value = [&](const CurvePoint& p) -> std::optional<std::pair<double, double>> {
+      if (panel == 0) return std::pair{p.w_m_s * 1e3, p.w_err_m_s * 1e3};
+      if (!p.r_acc) return std::nullopt;
+      return std::pair{*p.r_acc, *p.r_acc_err};
+    };
+    double lo = INFINITY, hi = -INFINITY;
+    for (const auto& p : pts)
+      if (auto v = value(p)) {
+        lo = std::min(lo, v->first - v->second);
+        hi = std::max(hi, v->first + v->second);
+      }
+    if (!std::isfinite(lo)) lo = 0, hi = 1;
+    if (panel == 1) lo = std::min(lo, 1.0), hi = std::max(hi, 1.0);
+    if (hi - lo < 1e-12) lo -= 0.5, hi += 0.5;
+    const double pad = 0.08 * (hi - lo);
+    Panel pn{80.0 + panel * 490.0, 50.0, 400.0, 320.0, lo - pad, hi + pad};
+    s += fmt::format("<rect x='{}' y='{}' width='{}' height='{}' fill='none' stroke='black'/>\n", pn.x0,
+                     pn.y0, pn.w, pn.h);
+    for (double a = 15; a <= 90; a += 15)
+      s += fmt::format(
+          "<line x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' stroke='black'/><text x='{0:.1f}' "
+          "y='{3:.1f}' text-anchor='middle'>{4:g}</text>\n",
+          pn.px(a), pn.y0 + pn.h, pn.y0 + pn.h - 5, pn.y0 + pn.h + 18, a);
+    for (double v : ticks(pn.vmin, pn.vmax))
+      s += fmt::format(
+          "<line x1='{0:.1f}' y1='{1:.1f}' x2='{2:.1f}' y2='{1:.1f}' stroke='#ddd'/><text x='{3:.1f}' "
+          "y='{4:.1f}' text-anchor='end'>{5:g}</text>\n",
+          pn.x0, pn.py(v), pn.x0 + pn.w, pn.x0 - 6, pn.py(v) + 4, v);
+    s += fmt::format("<text x='{:.1f}' y='{:.1f}' text-anchor='middle'>inclination angle θ (deg)</text>\n",
+                     pn.x0 + pn.w / 2, pn.y0 + pn.h + 40);
+    s += fmt::format(
+        "<text transform='translate({:.1f},{:.1f}) rotate(-90)' text-anchor='middle'>{}</text>\n", pn.x0 - 55,
+        pn.y0 + pn.h / 2, panel == 0 ? "⟨⟨w_p⟩⟩ (mm/s)" : "r_acc = ⟨⟨w_p⟩⟩ / ⟨⟨w_p⟩⟩(90°)");
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      const char* color = kColors[g % 8];
+      std::string line;
+      std::string marks;
+      for (const auto& p : pts) {
+        if (p.group != groups[g]) continue;
+        auto v = value(p);
+        if (!v) continue;
+        const double x = pn.px(p.angle_deg), y = pn.py(v->first);
+        line += fmt::format("{:.1f},{:.1f} ", x, y);
+        if (v->second > 0)
+          marks += fmt::format(
+              "<line x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' stroke='{3}'/>"
+              "<line x1='{4:.1f}' y1='{1:.1f}' x2='{5:.1f}' y2='{1:.1f}' stroke='{3}'/>"
+              "<line x1='{4:.1f}' y1='{2:.1f}' x2='{5:.1f}' y2='{2:.1f}' stroke='{3}'/>\n",
+              x, pn.py(v->first - v->second), pn.py(v->first + v->second), color, x - 3, x + 3);
+        marks += marker(kMarks[g % 4], x, y, color) + "\n";
+      }
+      if (!line.empty())
+        s += fmt::format(
+            "<polyline class='group' data-group='{}' points='{}' fill='none' stroke='{}' "
+            "stroke-width='1.5'/>\n",
+            xml_escape(groups[g]), line, color);
+      s += marks;
+      if (panel == 1)
+        s += fmt::format("{}<text x='{:.1f}' y='{:.1f}'>{}</text>\n",
+                         marker(kMarks[g % 4], pn.x0 + 18, pn.y0 + 18 + 18.0 * g, color), pn.x0 + 28,
+                         pn.y0 + 22 + 18.0 * g, xml_escape(groups[g]));
+    }
+  }
+  s += "</svg>\n";
+  return s;
+}
+
+std::string format_cases(const std::vector<CaseState>& cases) {
+  std::string s = fmt::format("{:<12} {:<12} {:<16} {:>6} {:<12} {:>8}  {}\n", "study", "group", "case",
+                              "angle", "status", "failures", "last error");
+  for (const auto& c : cases)
+    s += fmt::format("{:<12} {:<12} {:<16} {:>6g} {:<12} {:>8}  {}\n", c.study, c.group, c.id, c.angle_deg,
+                     to_string(c.status), c.failures, c.status == CaseStatus::kDone ? "" : c.last_error);
+  return s;
+}
+
+}  // namespace boycott::driver

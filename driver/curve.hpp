@@ -1,0 +1,20 @@
+#pragma once
+// The correlation curve <<w_p>>(theta) and r_acc(theta) as text and as an SVG in the layout of
+// Zeng et al. (2021) Fig. 14: settling velocity (left) and acceleration ratio (right) vs angle.
+#include <string>
+#include <vector>
+
+#include "driver/store.hpp"
+
+namespace boycott::driver {
+
+enum class CurveFormat { kTable, kCsv, kJson };
+CurveFormat parse_curve_format(const std::string& s);
+
+std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f);
+/// Both panels, one line per group with error bars.
+std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& title);
+
+std::string format_cases(const std::vector<CaseState>& cases);
+
+}  // namespace boycott::driver

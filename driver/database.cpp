@@ -1,0 +1,154 @@
+#include "driver/database.hpp"
+
+#include <sqlite3.h>
+#include <sys/stat.h>
+
+#include <chrono>
+#include <ctime>
+
+#include <fmt/format.h>
+
+#include "driver/schema_files.hpp"
+
+namespace boycott::driver {
+
+Statement::Statement(sqlite3* db, const std::string& sql) : db_(db) {
+  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &st_, nullptr) != SQLITE_OK)
+    throw DatabaseError(fmt::format("database: cannot prepare '{}': {}", sql, sqlite3_errmsg(db)));
+}
+Statement::~Statement() {
+  sqlite3_finalize(st_);
+}
+
+Statement& Statement::bind(int i, const std::string& v) {
+  sqlite3_bind_text(st_, i, v.c_str(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
+  return *this;
+}
+Statement& Statement::bind(int i, double v) {
+  sqlite3_bind_double(st_, i, v);
+  return *this;
+}
+Statement& Statement::bind(int i, std::int64_t v) {
+  sqlite3_bind_int64(st_, i, v);
+  return *this;
+}
+Statement& Statement::bind_null(int i) {
+  sqlite3_bind_null(st_, i);
+  return *this;
+}
+bool Statement::step() {
+  const int rc = sqlite3_step(st_);
+  if (rc == SQLITE_ROW) return true;
+  if (rc == SQLITE_DONE) return false;
+  throw DatabaseError(fmt::format("database: {}", sqlite3_errmsg(db_)));
+}
+bool Statement::is_null(int col) const {
+  return sqlite3_column_type(st_, col) == SQLITE_NULL;
+}
+std::string Statement::text(int col) const {
+  const auto* t = sqlite3_column_text(st_, col);
+  return t ? std::string(reinterpret_cast<const char*>(t)) : std::string();
+}
+double Statement::real(int col) const {
+  return sqlite3_column_double(st_, col);
+}
+std::int64_t Statement::integer(int col) const {
+  return sqlite3_column_int64(st_, col);
+}
+
+Database::Database(const std::string& path, OpenMode mode, int target_version) : path_(path) {
+  struct stat sb {};
+  const bool exists = ::stat(path.c_str(), &sb) == 0;
+  if (!exists && mode == OpenMode::kExisting) throw DatabaseError(fmt::format("no database at '{}'", path));
+  const int flags = SQLITE_OPEN_READWRITE | (mode == OpenMode::kCreate ? SQLITE_OPEN_CREATE : 0);
+  if (sqlite3_open_v2(path.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
+    std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw DatabaseError(fmt::format("cannot open database '{}': {}", path, msg));
+  }
+  try {
+    // Several drivers (or a driver and a query) may share the file: wait for locks, never fail.
+    sqlite3_busy_timeout(db_, 30000);
+    const int v = version();
+    if (v > latest_version())
+      throw DatabaseError(fmt::format(
+          "database '{}' has schema version {}, newer than this program's {}: use a newer boycott", path, v,
+          latest_version()));
+    exec("PRAGMA journal_mode = WAL");
+    exec("PRAGMA synchronous = NORMAL");
+    exec("PRAGMA foreign_keys = ON");
+    migrate(target_version < 0 ? latest_version() : target_version);
+  } catch (const DatabaseError& e) {
+    sqlite3_close(db_);
+    db_ = nullptr;
+    // SQLite's own words for a path it cannot create are vague; name the file.
+    std::string what = e.what();
+    if (what.find(path) == std::string::npos) what = fmt::format("database '{}': {}", path, what);
+    throw DatabaseError(what);
+  }
+}
+
+Database::~Database() {
+  sqlite3_close(db_);
+}
+
+int Database::latest_version() {
+  return static_cast<int>(schema_files().size());
+}
+
+int Database::version() {
+  Statement st(db_, "PRAGMA user_version");
+  st.step();
+  return static_cast<int>(st.integer(0));
+}
+
+void Database::exec(const std::string& sql) {
+  char* err = nullptr;
+  if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {
+    std::string msg = err ? err : sqlite3_errmsg(db_);
+    sqlite3_free(err);
+    throw DatabaseError(msg);
+  }
+}
+
+void Database::exec_noexcept(const char* sql) {
+  sqlite3_exec(db_, sql, nullptr, nullptr, nullptr);
+}
+
+void Database::migrate(int target) {
+  const auto& files = schema_files();
+  while (true) {
+    // Re-read the version inside each transaction: another process may have migrated meanwhile.
+    bool done = false;
+    transaction([&] {
+      const int v = version();
+      if (v >= target) {
+        done = true;
+        return;
+      }
+      try {
+        exec(files[static_cast<std::size_t>(v)].sql);
+      } catch (const DatabaseError& e) {
+        throw DatabaseError(
+            fmt::format("migration {} failed: {}", files[static_cast<std::size_t>(v)].name, e.what()));
+      }
+      exec(fmt::format("PRAGMA user_version = {}", v + 1));
+    });
+    if (done) return;
+  }
+}
+
+std::string utc_now() {
+  const auto now = std::chrono::system_clock::now();
+  const auto ms =
+      std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  const std::time_t t = std::chrono::system_clock::to_time_t(now);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
+  return fmt::format("{}.{:03d}Z", buf, static_cast<int>(ms));
+}
+
+}  // namespace boycott::driver

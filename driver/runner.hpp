@@ -1,0 +1,32 @@
+#pragma once
+// `boycott study run|status`: runs the missing cases of a study as child processes
+// (`boycott case run CASE --out DIR`, optionally under mpirun), records every attempt and result
+// in the study database, and resumes, skips or retries cases from what the database says.
+#include <string>
+#include <vector>
+
+namespace boycott::driver {
+
+struct StudyRunOptions {
+  std::string study_file;
+  std::string db_path;
+  int jobs = 1;
+  int retries = 2;  ///< failed attempts allowed beyond the first, over all runs of the study
+  int ranks = 1;    ///< > 1: each case under `mpirun -n ranks`
+  /// The solver command line (split at spaces); empty: $BOYCOTT_SOLVER_COMMAND, else this program.
+  std::string solver_command;
+  bool progress = false;  ///< live display (on when stdout is a terminal)
+};
+
+/// Exit code: 0 all cases done, 75 stopped by a signal, 1 some case failed for good.
+int study_run(const StudyRunOptions& opt);
+int study_status(const std::string& study_file, const std::string& db_path, int retries);
+
+/// The folder where the cases of the database at db_path run: <db_path>.runs/<case_id>/.
+std::string runs_root(const std::string& db_path);
+
+/// The launcher: argv for one case, wrapped in mpirun when ranks > 1.
+std::vector<std::string> case_command(const std::vector<std::string>& solver, int ranks,
+                                      const std::string& case_file, const std::string& out_dir);
+
+}  // namespace boycott::driver

@@ -1,0 +1,272 @@
+#include "driver/store.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "core/version.hpp"
+
+namespace boycott::driver {
+
+namespace {
+std::string hostname() {
+  char buf[256] = {};
+  if (gethostname(buf, sizeof buf - 1) != 0) return "unknown";
+  return buf;
+}
+std::string program_version() {
+  return fmt::format("{}+{}", kVersion, kGitRevision);
+}
+std::optional<double> number_of(const std::string& toml_value) {
+  char* end = nullptr;
+  const double v = std::strtod(toml_value.c_str(), &end);
+  if (end == toml_value.c_str() || *end != '\0') return std::nullopt;
+  return v;
+}
+std::optional<double> json_number(const nlohmann::json& j, const char* key) {
+  if (j.contains(key) && j[key].is_number()) return j[key].get<double>();
+  return std::nullopt;
+}
+}  // namespace
+
+void register_study(Database& db, const Study& s) {
+  db.transaction([&] {
+    const auto now = utc_now();
+    db.prepare(
+          "INSERT INTO studies(name, source_toml, created_at, updated_at) VALUES (?1, ?2, ?3, ?3) "
+          "ON CONFLICT(name) DO UPDATE SET source_toml = excluded.source_toml, updated_at = "
+          "excluded.updated_at")
+        .bind(1, s.name)
+        .bind(2, s.source_text)
+        .bind(3, now)
+        .run();
+    // Membership follows the study file as it is now (groups may have been renamed).
+    db.prepare("DELETE FROM study_cases WHERE study = ?1").bind(1, s.name).run();
+    std::int64_t pos = 0;
+    for (const auto& c : s.cases) {
+      db.prepare(
+            "INSERT OR IGNORE INTO cases(id, scene, angle_deg, params_json, created_at) VALUES "
+            "(?1,?2,?3,?4,?5)")
+          .bind(1, c.id)
+          .bind(2, c.params.scene)
+          .bind(3, c.params.gravity.angle_deg)
+          .bind(4, to_json(c.params).dump())
+          .bind(5, now)
+          .run();
+      db.prepare(
+            "INSERT OR IGNORE INTO study_cases(study, group_name, case_id, position) VALUES (?1,?2,?3,?4)")
+          .bind(1, s.name)
+          .bind(2, c.group)
+          .bind(3, c.id)
+          .bind(4, pos++)
+          .run();
+      for (const auto& [k, v] : c.swept)
+        db.prepare("INSERT OR IGNORE INTO case_values(case_id, key, value, value_num) VALUES (?1,?2,?3,?4)")
+            .bind(1, c.id)
+            .bind(2, k)
+            .bind(3, v)
+            .bind(4, number_of(v))
+            .run();
+    }
+  });
+}
+
+std::int64_t begin_attempt(Database& db, const std::string& case_id, int ranks, const std::string& run_dir) {
+  std::int64_t id = 0;
+  db.transaction([&] {
+    const auto now = utc_now();
+    db.prepare(
+          "UPDATE attempts SET ended_at = ?2, error_text = 'abandoned: the driver stopped without recording "
+          "an "
+          "end' WHERE case_id = ?1 AND ended_at IS NULL")
+        .bind(1, case_id)
+        .bind(2, now)
+        .run();
+    db.prepare(
+          "INSERT INTO attempts(case_id, started_at, host, ranks, program_version, run_dir) "
+          "VALUES (?1, ?2, ?3, ?4, ?5, ?6)")
+        .bind(1, case_id)
+        .bind(2, now)
+        .bind(3, hostname())
+        .bind(4, ranks)
+        .bind(5, program_version())
+        .bind(6, run_dir)
+        .run();
+    auto st = db.prepare("SELECT last_insert_rowid()");
+    st.step();
+    id = st.integer(0);
+  });
+  return id;
+}
+
+void finish_attempt(Database& db, std::int64_t attempt, int exit_status, const std::string& error_text) {
+  db.transaction([&] {
+    db.prepare("UPDATE attempts SET ended_at = ?2, exit_status = ?3, error_text = ?4 WHERE id = ?1")
+        .bind(1, attempt)
+        .bind(2, utc_now())
+        .bind(3, exit_status)
+        .bind(4, error_text)
+        .run();
+  });
+}
+
+void record_result(Database& db, std::int64_t attempt, const std::string& case_id,
+                   const nlohmann::json& summary) {
+  nlohmann::json errors = nlohmann::json::object();
+  for (const auto& [k, v] : summary.items())
+    if (k.find("error") != std::string::npos && k != "settling_velocity_stderr_m_s") errors[k] = v;
+  const auto params = summary.contains("params") ? summary["params"] : nlohmann::json();
+  db.transaction([&] {
+    const auto now = utc_now();
+    db.prepare("UPDATE attempts SET ended_at = ?2, exit_status = 0, error_text = NULL WHERE id = ?1")
+        .bind(1, attempt)
+        .bind(2, now)
+        .run();
+    // Read the averaging window from the case itself: the summary need not repeat it.
+    auto pst = db.prepare("SELECT params_json FROM cases WHERE id = ?1");
+    pst.bind(1, case_id);
+    std::optional<double> from, to;
+    if (pst.step()) {
+      const auto p = nlohmann::json::parse(pst.text(0));
+      from = p["time"]["average_from"].get<double>();
+      to = p["time"]["end"].get<double>();
+    }
+    if (auto t = json_number(summary, "simulated_time_s")) to = t;
+    std::optional<std::int64_t> steps;
+    if (summary.contains("particle_steps") && summary["particle_steps"].is_number())
+      steps = summary["particle_steps"].get<std::int64_t>();
+    db.prepare(
+          "INSERT OR REPLACE INTO results(case_id, attempt_id, mean_settling_velocity_m_s, "
+          "settling_velocity_stderr_m_s, average_from_s, average_to_s, wall_time_s, particle_steps, "
+          "validation_errors_json, summary_json, recorded_at) VALUES (?1,?2,?3,?4,?5,?6,?7,?8,?9,?10,?11)")
+        .bind(1, case_id)
+        .bind(2, attempt)
+        .bind(3, json_number(summary, "mean_settling_velocity_m_s"))
+        .bind(4, json_number(summary, "settling_velocity_stderr_m_s"))
+        .bind(5, from)
+        .bind(6, to)
+        .bind(7, json_number(summary, "wall_time_s"))
+        .bind(8, steps)
+        .bind(9, errors.dump())
+        .bind(10, summary.dump())
+        .bind(11, now)
+        .run();
+    // Test hook: widens the window in which a kill -9 lands inside this transaction.
+    if (const char* d = std::getenv("BOYCOTT_TEST_COMMIT_DELAY_S"))
+      std::this_thread::sleep_for(std::chrono::duration<double>(std::atof(d)));
+  });
+}
+
+const char* to_string(CaseStatus s) {
+  switch (s) {
+    case CaseStatus::kPending:
+      return "pending";
+    case CaseStatus::kRunning:
+      return "running";
+    case CaseStatus::kDone:
+      return "done";
+    case CaseStatus::kFailed:
+      return "failed";
+    case CaseStatus::kInterrupted:
+      return "interrupted";
+  }
+  return "?";
+}
+
+std::vector<CaseState> case_states(Database& db, const std::string& study, int retries) {
+  std::vector<CaseState> out;
+  auto st = db.prepare(
+      "SELECT sc.study, sc.group_name, c.id, c.angle_deg, "
+      " EXISTS(SELECT 1 FROM results r WHERE r.case_id = c.id), "
+      " (SELECT COUNT(*) FROM attempts a WHERE a.case_id = c.id AND a.exit_status IS NOT NULL "
+      "    AND a.exit_status NOT IN (0, 75, 130, 143)), "
+      " (SELECT COUNT(*) FROM attempts a WHERE a.case_id = c.id AND a.exit_status = 2 "
+      "    AND a.program_version = ?2), "
+      " EXISTS(SELECT 1 FROM attempts a WHERE a.case_id = c.id AND a.ended_at IS NULL), "
+      " (SELECT a.exit_status FROM attempts a WHERE a.case_id = c.id AND a.ended_at IS NOT NULL ORDER BY "
+      "a.id DESC "
+      "    LIMIT 1), "
+      " (SELECT a.error_text FROM attempts a WHERE a.case_id = c.id AND a.ended_at IS NOT NULL ORDER BY a.id "
+      "DESC "
+      "    LIMIT 1) "
+      "FROM study_cases sc JOIN cases c ON c.id = sc.case_id "
+      "WHERE (?1 = '' OR sc.study = ?1) ORDER BY sc.study, sc.position");
+  // A case the solver refused as bad input is final only for this program version: a newer solver
+  // (one that implements the scene, say) gets to try it again.
+  st.bind(1, study).bind(2, program_version());
+  while (st.step()) {
+    CaseState c;
+    c.study = st.text(0);
+    c.group = st.text(1);
+    c.id = st.text(2);
+    c.angle_deg = st.real(3);
+    const bool done = st.integer(4) != 0;
+    c.failures = static_cast<int>(st.integer(5));
+    c.input_error = st.integer(6) > 0;
+    const bool open = st.integer(7) != 0;
+    c.last_exit = st.is_null(8) ? -1 : static_cast<int>(st.integer(8));
+    c.last_error = st.text(9);
+    if (done)
+      c.status = CaseStatus::kDone;
+    else if (open)
+      c.status = CaseStatus::kRunning;
+    else if (c.input_error || c.failures > retries)
+      c.status = CaseStatus::kFailed;
+    else if (c.last_exit == 75 || c.last_exit == 130 || c.last_exit == 143)
+      c.status = CaseStatus::kInterrupted;
+    else
+      c.status = CaseStatus::kPending;
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+std::vector<CurvePoint> query_curve(Database& db, const std::string& study, const std::string& group) {
+  auto st = db.prepare(
+      "SELECT sc.group_name, c.id, c.angle_deg, r.mean_settling_velocity_m_s, "
+      "r.settling_velocity_stderr_m_s, "
+      " MIN(sc.position) AS pos FROM study_cases sc JOIN cases c ON c.id = sc.case_id "
+      "JOIN results r ON r.case_id = c.id WHERE sc.study = ?1 AND (?2 = '' OR sc.group_name = ?2) "
+      "AND r.mean_settling_velocity_m_s IS NOT NULL GROUP BY sc.group_name, c.id");
+  st.bind(1, study).bind(2, group);
+  std::vector<CurvePoint> pts;
+  std::map<std::string, std::int64_t> group_pos;
+  while (st.step()) {
+    CurvePoint p;
+    p.group = st.text(0);
+    p.case_id = st.text(1);
+    p.angle_deg = st.real(2);
+    p.w_m_s = st.real(3);
+    p.w_err_m_s = st.is_null(4) ? 0.0 : st.real(4);
+    auto& gp = group_pos.try_emplace(p.group, st.integer(5)).first->second;
+    gp = std::min(gp, st.integer(5));
+    pts.push_back(p);
+  }
+  std::stable_sort(pts.begin(), pts.end(), [&](const CurvePoint& a, const CurvePoint& b) {
+    if (a.group != b.group) return group_pos[a.group] < group_pos[b.group];
+    return a.angle_deg < b.angle_deg;
+  });
+  // r_acc = w / w90 with first-order error propagation of independent standard errors.
+  for (auto& p : pts) {
+    const CurvePoint* ref = nullptr;
+    for (const auto& q : pts)
+      if (q.group == p.group && q.angle_deg == 90.0) ref = &q;
+    if (!ref || ref->w_m_s == 0.0) continue;
+    const double r = p.w_m_s / ref->w_m_s;
+    p.r_acc = r;
+    const double rel_p = p.w_m_s != 0.0 ? p.w_err_m_s / p.w_m_s : 0.0;
+    const double rel_ref = ref->w_err_m_s / ref->w_m_s;
+    // At 90 deg itself the ratio is exactly 1 (the same number over itself).
+    p.r_acc_err = (&p == ref || p.case_id == ref->case_id) ? 0.0 : std::abs(r) * std::hypot(rel_p, rel_ref);
+  }
+  return pts;
+}
+
+}  // namespace boycott::driver

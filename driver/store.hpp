@@ -1,0 +1,54 @@
+#pragma once
+// What the driver writes to and reads from the study database; each function that writes is
+// one transaction.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "driver/database.hpp"
+#include "driver/study.hpp"
+
+namespace boycott::driver {
+
+/// Inserts the study, its cases and their swept values (existing cases are kept as they are).
+void register_study(Database& db, const Study& s);
+
+/// Opens an attempt; closes any attempt of the case left open by a driver that died.
+std::int64_t begin_attempt(Database& db, const std::string& case_id, int ranks, const std::string& run_dir);
+/// Closes an attempt that produced no result (failure or interruption).
+void finish_attempt(Database& db, std::int64_t attempt, int exit_status, const std::string& error_text);
+/// Closes the attempt and stores the result from the solver's summary.json, in one transaction.
+void record_result(Database& db, std::int64_t attempt, const std::string& case_id,
+                   const nlohmann::json& summary);
+
+enum class CaseStatus { kPending, kRunning, kDone, kFailed, kInterrupted };
+const char* to_string(CaseStatus s);
+
+struct CaseState {
+  std::string study, group, id;
+  double angle_deg = 0;
+  CaseStatus status = CaseStatus::kPending;
+  int failures = 0;    ///< attempts that ended with a failure exit code
+  int last_exit = -1;  ///< -1: none
+  std::string last_error;
+  bool input_error = false;  ///< an attempt exited 2: retrying cannot help
+};
+
+/// Cases of one study (or all, study empty) with their status; `retries` decides when a failing
+/// case counts as failed rather than pending.
+std::vector<CaseState> case_states(Database& db, const std::string& study, int retries);
+
+struct CurvePoint {
+  std::string group;
+  std::string case_id;
+  double angle_deg = 0;
+  double w_m_s = 0, w_err_m_s = 0;         ///< <<w_p>> and its standard error
+  std::optional<double> r_acc, r_acc_err;  ///< <<w_p>>/<<w_p>>(90 deg); unset without a 90 deg case
+};
+
+/// The correlation curve of finished cases, per group in study order, by angle.
+std::vector<CurvePoint> query_curve(Database& db, const std::string& study, const std::string& group = "");
+
+}  // namespace boycott::driver

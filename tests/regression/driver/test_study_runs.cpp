@@ -1,0 +1,377 @@
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "driver/database.hpp"
+
+namespace bd = boycott::driver;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kSolver = std::string("python3 ") + FAKE_SOLVER;
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    char tmpl[] = "/tmp/boycott_runtest_XXXXXX";
+    path = mkdtemp(tmpl);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+void write(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// 2 groups x 3 angles; every fake case is 8 steps of FAKE_STEP_WALL_S.
+const char* kStudy = R"(
+name = "small"
+[base]
+scene = "inclined_settling"
+seed = 1
+[base.particles]
+count = 1000
+[base.time]
+end = 0.8
+average_from = 0.4
+[[group]]
+name = "base"
+[[group]]
+name = "Ga"
+set = { "fluid.viscosity" = 1.0e-2 }
+[matrix]
+"gravity.angle_deg" = [30, 60, 90]
+)";
+
+struct Run {
+  int rc = -1;
+  std::string out, err;
+};
+
+/// Starts `boycott args...` with extra environment; stdout and stderr go to files in dir.
+pid_t spawn(const std::vector<std::string>& args, const fs::path& dir,
+            const std::map<std::string, std::string>& env) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    for (const auto& [k, v] : env) setenv(k.c_str(), v.c_str(), 1);
+    freopen((dir / "stdout.txt").c_str(), "w", stdout);
+    freopen((dir / "stderr.txt").c_str(), "w", stderr);
+    std::vector<char*> argv{const_cast<char*>(BOYCOTT_BIN)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(BOYCOTT_BIN, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+Run wait_run(pid_t pid, const fs::path& dir) {
+  int st = 0;
+  waitpid(pid, &st, 0);
+  Run r;
+  r.rc = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+  r.out = read(dir / "stdout.txt");
+  r.err = read(dir / "stderr.txt");
+  return r;
+}
+
+Run run(const std::vector<std::string>& args, const fs::path& dir,
+        std::map<std::string, std::string> env = {}) {
+  env.try_emplace("FAKE_STEP_WALL_S", "0.01");
+  return wait_run(spawn(args, dir, env), dir);
+}
+
+std::vector<std::string> study_run(const fs::path& study, const fs::path& db, int jobs = 2) {
+  return {"study",     "run",    study.string(),       "--db",
+          db.string(), "--jobs", std::to_string(jobs), "--solver-command",
+          kSolver};
+}
+
+std::int64_t count(const fs::path& db, const std::string& sql) {
+  bd::Database d(db.string(), bd::OpenMode::kExisting);
+  auto st = d.prepare(sql);
+  st.step();
+  return st.integer(0);
+}
+
+/// case id -> (mean, stderr, particle_steps) as recorded.
+std::map<std::string, std::tuple<double, double, std::int64_t>> results(const fs::path& db) {
+  bd::Database d(db.string(), bd::OpenMode::kExisting);
+  auto st = d.prepare(
+      "SELECT case_id, mean_settling_velocity_m_s, settling_velocity_stderr_m_s, particle_steps "
+      "FROM results");
+  std::map<std::string, std::tuple<double, double, std::int64_t>> out;
+  while (st.step()) out[st.text(0)] = {st.real(1), st.real(2), st.integer(3)};
+  return out;
+}
+
+}  // namespace
+
+TEST(StudyRun, RunsEveryCaseOnceAndQueryCurveMatchesTheCaseSummaries) {
+  TempDir d;
+  write(d.path / "s.toml", kStudy);
+  const auto db = d.path / "s.db";
+  const auto r = run(study_run(d.path / "s.toml", db, 3), d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_NE(r.out.find("6 of 6 cases done"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("r_acc"), std::string::npos) << "the curve is printed at the end";
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 6);
+  // --jobs 3: some attempts overlapped in time.
+  EXPECT_GE(count(db,
+                  "SELECT MAX((SELECT COUNT(*) FROM attempts b WHERE b.started_at <= a.started_at AND "
+                  "b.ended_at > a.started_at)) FROM attempts a"),
+            2);
+
+  const auto q = run({"query", "curve", "--db", db.string(), "--study", "small", "--format", "json", "--plot",
+                      (d.path / "c.svg").string()},
+                     d.path);
+  ASSERT_EQ(q.rc, 0) << q.err;
+  const auto curve = nlohmann::json::parse(q.out);
+  ASSERT_EQ(curve.size(), 6u);
+  std::map<std::string, double> w90;
+  for (const auto& p : curve) {
+    const auto summary = nlohmann::json::parse(
+        read(fs::path(db.string() + ".runs") / p["case_id"].get<std::string>() / "summary.json"));
+    EXPECT_DOUBLE_EQ(p["mean_settling_velocity_m_s"].get<double>(),
+                     summary["mean_settling_velocity_m_s"].get<double>());
+    EXPECT_DOUBLE_EQ(p["stderr_m_s"].get<double>(), summary["settling_velocity_stderr_m_s"].get<double>());
+    if (p["angle_deg"] == 90.0) w90[p["group"]] = summary["mean_settling_velocity_m_s"].get<double>();
+  }
+  for (const auto& p : curve)
+    EXPECT_NEAR(p["r_acc"].get<double>(), p["mean_settling_velocity_m_s"].get<double>() / w90[p["group"]],
+                1e-12);
+  const auto svg = read(d.path / "c.svg");
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  // One polyline per group in each of the two panels.
+  std::size_t lines = 0;
+  for (auto pos = svg.find("<polyline"); pos != std::string::npos; pos = svg.find("<polyline", pos + 1))
+    ++lines;
+  EXPECT_EQ(lines, 4u);
+
+  // A second run has nothing to do.
+  const auto again = run(study_run(d.path / "s.toml", db), d.path);
+  EXPECT_EQ(again.rc, 0);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 6);
+  const auto csv =
+      run({"query", "curve", "--db", db.string(), "--study", "small", "--group", "Ga", "--format", "csv"},
+          d.path);
+  EXPECT_EQ(std::count(csv.out.begin(), csv.out.end(), '\n'), 4);
+  const auto status = run({"study", "status", (d.path / "s.toml").string(), "--db", db.string()}, d.path);
+  EXPECT_NE(status.out.find("6 cases: 6 done"), std::string::npos) << status.out;
+}
+
+TEST(StudyRun, KillNineAtRandomMomentsThenRerunEndsWithTheUninterruptedResults) {
+  TempDir d;
+  write(d.path / "s.toml", kStudy);
+  const auto ref_db = d.path / "ref.db";
+  ASSERT_EQ(run(study_run(d.path / "s.toml", ref_db), d.path).rc, 0);
+  const auto reference = results(ref_db);
+  ASSERT_EQ(reference.size(), 6u);
+
+  const auto db = d.path / "s.db";
+  std::mt19937 rng(12345);
+  std::uniform_int_distribution<int> delay_ms(30, 600);
+  // The commit delay widens the moment of the result transaction so that some kills land in it.
+  const std::map<std::string, std::string> env = {{"FAKE_STEP_WALL_S", "0.02"},
+                                                  {"BOYCOTT_TEST_COMMIT_DELAY_S", "0.05"}};
+  for (int k = 0; k < 6; ++k) {
+    const pid_t pid = spawn(study_run(d.path / "s.toml", db), d.path, env);
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms(rng)));
+    ::kill(pid, SIGKILL);
+    wait_run(pid, d.path);
+  }
+  // The orphaned solvers got SIGTERM from the kernel (parent death) and stop at a checkpoint;
+  // once they are gone nothing holds the run folders and status must not claim "running".
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  const auto status = run({"study", "status", (d.path / "s.toml").string(), "--db", db.string()}, d.path);
+  EXPECT_NE(status.out.find(" 0 running"), std::string::npos) << status.out;
+  const auto r = run(study_run(d.path / "s.toml", db), d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE ended_at IS NULL"), 0);
+  EXPECT_GE(count(db, "SELECT COUNT(*) FROM attempts WHERE error_text LIKE 'abandoned%'"), 1)
+      << "some kill landed while a case was running";
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status NOT IN (0, 75, 130, 143)"), 0)
+      << "no interruption may count as a failure";
+  const auto got = results(db);
+  ASSERT_EQ(got.size(), reference.size());
+  for (const auto& [id, v] : reference) {
+    ASSERT_TRUE(got.count(id)) << id;
+    EXPECT_DOUBLE_EQ(std::get<0>(got.at(id)), std::get<0>(v)) << id;
+    EXPECT_DOUBLE_EQ(std::get<1>(got.at(id)), std::get<1>(v)) << id;
+    EXPECT_EQ(std::get<2>(got.at(id)), std::get<2>(v)) << id;
+  }
+}
+
+TEST(StudyRun, SigintStopsCasesAtACheckpointAndRerunResumesThem) {
+  TempDir d;
+  write(d.path / "s.toml", kStudy);
+  const auto db = d.path / "s.db";
+  const pid_t pid = spawn(study_run(d.path / "s.toml", db), d.path, {{"FAKE_STEP_WALL_S", "0.1"}});
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  ::kill(pid, SIGINT);
+  const auto stopped = wait_run(pid, d.path);
+  EXPECT_EQ(stopped.rc, 75) << stopped.err;
+  EXPECT_NE(stopped.out.find("run the same command to resume"), std::string::npos);
+  EXPECT_GE(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 75"), 1);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE ended_at IS NULL"), 0);
+  // The interrupted case left a checkpoint part-way.
+  bd::Database d75(db.string(), bd::OpenMode::kExisting);
+  auto st = d75.prepare("SELECT run_dir FROM attempts WHERE exit_status = 75 LIMIT 1");
+  ASSERT_TRUE(st.step());
+  const auto ckpt = nlohmann::json::parse(read(fs::path(st.text(0)) / "checkpoint.json"));
+  EXPECT_GT(ckpt["step"].get<int>(), 0);
+  EXPECT_LT(ckpt["step"].get<int>(), 8);
+
+  const auto r = run(study_run(d.path / "s.toml", db), d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
+}
+
+TEST(StudyRun, FailedCasesAreRetriedBoundedlyAndTheReasonIsRecorded) {
+  TempDir d;
+  write(d.path / "s.toml", R"(
+name = "f"
+[base.particles]
+count = 1000
+[base.time]
+end = 0.3
+average_from = 0.1
+[matrix]
+seed = [1, 13, 14]
+)");
+  const auto db = d.path / "s.db";
+  auto args = study_run(d.path / "s.toml", db);
+  args.insert(args.end(), {"--retries", "1"});
+  const auto r = run(args, d.path, {{"FAKE_FAIL_SEED13", "1"}});
+  EXPECT_EQ(r.rc, 1) << "a case failed for good";
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 2);
+  // seed 13 fails once then succeeds; seed 14 fails on its first try and its one retry.
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 3"), 3);
+  EXPECT_EQ(
+      count(db,
+            "SELECT COUNT(*) FROM attempts WHERE error_text = 'error: the run became unphysical: NaN in the "
+            "pressure'"),
+      1);
+  // A rerun does not try the exhausted case again.
+  const auto again = run(args, d.path);
+  EXPECT_EQ(again.rc, 1);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 5);
+  const auto status =
+      run({"study", "status", (d.path / "s.toml").string(), "--db", db.string(), "--retries", "1"}, d.path);
+  EXPECT_NE(status.out.find("2 done, 0 running, 1 failed"), std::string::npos) << status.out;
+  EXPECT_NE(status.out.find("alpha_f = -0.2"), std::string::npos) << status.out;
+}
+
+TEST(StudyRunBadInput, OneLineErrorNonZeroExitAndTheDatabaseUnchanged) {
+  TempDir d;
+  write(d.path / "s.toml", kStudy);
+  const auto db = d.path / "s.db";
+  ASSERT_EQ(run(study_run(d.path / "s.toml", db), d.path).rc, 0);
+  {
+    bd::Database c(db.string(), bd::OpenMode::kExisting);
+    c.exec("PRAGMA wal_checkpoint(TRUNCATE)");
+  }
+  const auto before = read(db);
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"name = \"small\"\n[base\nscene = 1\n", "malformed TOML"},
+      {"name = \"small\"\n[base.fluid]\nviscosty = 1e-3\n", "fluid.viscosty"},
+      {"name = \"small\"\n[base.fluid]\nviscosity = -1e-3\n", "fluid.viscosity"},
+      {"name = \"small\"\n[matrix]\n\"particles.diameter\" = [0.5e-3, 0.01]\n", "does not fit the channel"},
+  };
+  for (const auto& [text, expect] : bad) {
+    write(d.path / "bad.toml", text);
+    const auto r = run(study_run(d.path / "bad.toml", db), d.path);
+    EXPECT_EQ(r.rc, 2) << text;
+    EXPECT_NE(r.err.find(expect), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(read(db), before) << text;
+  }
+  const auto unwritable = run(study_run(d.path / "s.toml", "/nonexistent_dir/sub/s.db"), d.path);
+  EXPECT_NE(unwritable.rc, 0);
+  EXPECT_NE(unwritable.err.find("/nonexistent_dir/sub/s.db"), std::string::npos) << unwritable.err;
+  EXPECT_EQ(std::count(unwritable.err.begin(), unwritable.err.end(), '\n'), 1) << unwritable.err;
+
+  {
+    bd::Database c(db.string(), bd::OpenMode::kExisting);
+    c.exec("PRAGMA user_version = 99");
+    c.exec("PRAGMA wal_checkpoint(TRUNCATE)");
+  }
+  const auto v99 = read(db);
+  const auto newer = run(study_run(d.path / "s.toml", db), d.path);
+  EXPECT_NE(newer.rc, 0);
+  EXPECT_NE(newer.err.find("newer"), std::string::npos) << newer.err;
+  EXPECT_EQ(std::count(newer.err.begin(), newer.err.end(), '\n'), 1) << newer.err;
+  EXPECT_EQ(read(db), v99);
+}
+
+TEST(StudyRun, UnusableCheckpointIsSetAsideAndTheCaseRerunFromTheStart) {
+  TempDir d;
+  write(d.path / "s.toml", kStudy);
+  const auto ref_db = d.path / "ref.db";
+  ASSERT_EQ(run(study_run(d.path / "s.toml", ref_db), d.path).rc, 0);
+  const auto reference = results(ref_db);
+
+  const auto db = d.path / "s.db";
+  const pid_t pid = spawn(study_run(d.path / "s.toml", db), d.path, {{"FAKE_STEP_WALL_S", "0.1"}});
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  ::kill(pid, SIGINT);
+  ASSERT_EQ(wait_run(pid, d.path).rc, 75);
+  std::string dir;
+  {
+    bd::Database c(db.string(), bd::OpenMode::kExisting);
+    auto st = c.prepare("SELECT run_dir FROM attempts WHERE exit_status = 75 LIMIT 1");
+    ASSERT_TRUE(st.step());
+    dir = st.text(0);
+  }
+  write(fs::path(dir) / "checkpoint.json", "{\"step\": 3, \"su");  // cut short
+  const auto r = run(study_run(d.path / "s.toml", db), d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 4 AND error_text LIKE '%unusable%'"),
+            1);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
+  EXPECT_EQ(results(db), reference);
+  bool set_aside = false;
+  for (const auto& e : fs::directory_iterator(fs::path(dir).parent_path()))
+    set_aside |= e.path().filename().string().find(".bad-") != std::string::npos;
+  EXPECT_TRUE(set_aside);
+}
+
+TEST(StudyRun, TwoDriversOnOneDatabaseRunEveryCaseExactlyOnce) {
+  TempDir d;
+  write(d.path / "s.toml", kStudy);
+  const auto db = d.path / "s.db";
+  fs::create_directories(d.path / "a");
+  fs::create_directories(d.path / "b");
+  const std::map<std::string, std::string> env = {{"FAKE_STEP_WALL_S", "0.02"}};
+  const pid_t a = spawn(study_run(d.path / "s.toml", db), d.path / "a", env);
+  const pid_t b = spawn(study_run(d.path / "s.toml", db), d.path / "b", env);
+  const auto ra = wait_run(a, d.path / "a");
+  const auto rb = wait_run(b, d.path / "b");
+  EXPECT_EQ(ra.rc, 0) << ra.err;
+  EXPECT_EQ(rb.rc, 0) << rb.err;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
+  // The run folder's lock keeps the second driver off a case the first one runs.
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 0"), 6);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status IS NOT 0"), 0);
+}

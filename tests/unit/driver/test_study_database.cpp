@@ -1,0 +1,214 @@
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include "driver/database.hpp"
+#include "driver/schema_files.hpp"
+#include "driver/store.hpp"
+#include "driver/study.hpp"
+
+namespace bd = boycott::driver;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    char tmpl[] = "/tmp/boycott_dbtest_XXXXXX";
+    path = mkdtemp(tmpl);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+std::string file_bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::int64_t count(bd::Database& db, const std::string& sql) {
+  auto st = db.prepare(sql);
+  st.step();
+  return st.integer(0);
+}
+
+bool has_column(bd::Database& db, const std::string& table, const std::string& col) {
+  auto st = db.prepare("SELECT COUNT(*) FROM pragma_table_info('" + table + "') WHERE name = '" + col + "'");
+  st.step();
+  return st.integer(0) == 1;
+}
+
+const char* kStudy = R"(
+name = "s"
+[base.time]
+end = 2.0
+average_from = 1.0
+[[group]]
+name = "a"
+[[group]]
+name = "b"
+set = { "fluid.viscosity" = 2e-3 }
+[matrix]
+"gravity.angle_deg" = [45, 90]
+)";
+
+}  // namespace
+
+TEST(StudyDatabase, SchemaIsCreatedFromResultsSchemaFiles) {
+  TempDir d;
+  ASSERT_GE(bd::schema_files().size(), 2u);
+  EXPECT_EQ(bd::schema_files()[0].name, "001_initial.sql");
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  EXPECT_EQ(db.version(), bd::Database::latest_version());
+  for (const char* t : {"studies", "cases", "study_cases", "case_values", "attempts", "results"})
+    EXPECT_EQ(
+        count(db, std::string("SELECT COUNT(*) FROM sqlite_master WHERE type='table' AND name='") + t + "'"),
+        1)
+        << t;
+  auto st = db.prepare("PRAGMA journal_mode");
+  st.step();
+  EXPECT_EQ(st.text(0), "wal");
+}
+
+TEST(StudyDatabase, Version1DatabaseMigratesToVersion2KeepingItsRows) {
+  TempDir d;
+  const auto path = (d.path / "r.db").string();
+  const auto study = bd::expand_study_string(kStudy);
+  {
+    bd::Database v1(path, bd::OpenMode::kCreate, 1);
+    ASSERT_EQ(v1.version(), 1);
+    EXPECT_FALSE(has_column(v1, "attempts", "run_dir"));
+    bd::register_study(v1, study);
+    // A version-1 attempt, written the way a version-1 program did (no run_dir column).
+    v1.exec("INSERT INTO attempts(case_id, started_at, host, ranks, program_version) VALUES ('" +
+            study.cases[0].id + "', '2026-01-01T00:00:00Z', 'h', 1, '0.0.1')");
+  }
+  bd::Database v2(path, bd::OpenMode::kExisting);
+  EXPECT_EQ(v2.version(), 2);
+  EXPECT_TRUE(has_column(v2, "attempts", "run_dir"));
+  EXPECT_EQ(count(v2, "SELECT COUNT(*) FROM sqlite_master WHERE type='index' AND name='attempts_by_case'"),
+            1);
+  EXPECT_EQ(count(v2, "SELECT COUNT(*) FROM cases"), 4);
+  EXPECT_EQ(count(v2, "SELECT COUNT(*) FROM attempts WHERE run_dir IS NULL"), 1);
+}
+
+TEST(StudyDatabase, NewerSchemaIsRefusedAndLeftUnchanged) {
+  TempDir d;
+  const auto path = (d.path / "r.db").string();
+  {
+    bd::Database db(path, bd::OpenMode::kCreate);
+    db.exec("PRAGMA user_version = 99");
+    db.exec("PRAGMA journal_mode = DELETE");
+  }
+  const auto before = file_bytes(path);
+  try {
+    bd::Database db(path, bd::OpenMode::kCreate);
+    FAIL() << "a version-99 database was opened";
+  } catch (const bd::DatabaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("schema version 99"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(file_bytes(path), before);
+}
+
+TEST(StudyDatabase, ConcurrentWritersFromSeveralProcessesLoseNothing) {
+  TempDir d;
+  const auto path = (d.path / "r.db").string();
+  const auto study = bd::expand_study_string(kStudy);
+  {
+    bd::Database db(path, bd::OpenMode::kCreate);
+    bd::register_study(db, study);
+  }
+  constexpr int kProcs = 4, kEach = 40;
+  std::vector<pid_t> kids;
+  for (int p = 0; p < kProcs; ++p) {
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      int rc = 0;
+      try {
+        // Each process opens its own connection, as separate drivers would.
+        bd::Database db(path, bd::OpenMode::kExisting);
+        for (int i = 0; i < kEach; ++i) {
+          const auto& c = study.cases[static_cast<std::size_t>(i) % study.cases.size()];
+          const auto a = bd::begin_attempt(db, c.id + "", 1, "x");
+          bd::finish_attempt(db, a, 75, "interrupted");
+          bd::register_study(db, study);
+        }
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "writer %d: %s\n", p, e.what());
+        rc = 1;
+      }
+      _exit(rc);
+    }
+    kids.push_back(pid);
+  }
+  for (pid_t k : kids) {
+    int st = 0;
+    waitpid(k, &st, 0);
+    EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0);
+  }
+  bd::Database db(path, bd::OpenMode::kExisting);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), kProcs * kEach);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 75 AND ended_at IS NOT NULL"),
+            kProcs * kEach);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM study_cases"), 4);
+}
+
+TEST(StudyDatabase, FailedTransactionLeavesNoTrace) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  bd::register_study(db, bd::expand_study_string(kStudy));
+  EXPECT_THROW(db.transaction([&] {
+    db.exec("DELETE FROM study_cases");
+    throw std::runtime_error("stop");
+  }),
+               std::runtime_error);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM study_cases"), 4);
+}
+
+TEST(StudyDatabase, CurveRatioAndPropagatedErrorFollowTheRecordedResults) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(kStudy);
+  bd::register_study(db, study);
+  for (const auto& c : study.cases) {
+    const double w = -0.01 * (c.params.gravity.angle_deg == 90.0 ? 1.0 : 1.5) * (c.group == "b" ? 0.5 : 1.0);
+    const nlohmann::json summary = {{"scene", "inclined_settling"},
+                                    {"case_id", c.id},
+                                    {"status", "done"},
+                                    {"mean_settling_velocity_m_s", w},
+                                    {"settling_velocity_stderr_m_s", std::abs(w) * 0.02},
+                                    {"simulated_time_s", 2.0},
+                                    {"wall_time_s", 1.0},
+                                    {"particle_steps", 1000},
+                                    {"max_rel_error_vs_analytic", 0.01}};
+    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, summary);
+  }
+  const auto pts = bd::query_curve(db, "s");
+  ASSERT_EQ(pts.size(), 4u);
+  EXPECT_EQ(pts[0].group, "a");
+  EXPECT_EQ(pts[0].angle_deg, 45.0);
+  EXPECT_DOUBLE_EQ(pts[0].w_m_s, -0.015);
+  EXPECT_DOUBLE_EQ(*pts[0].r_acc, 1.5);
+  // |r| sqrt((s/w)^2 + (s90/w90)^2) with 2 % relative errors on both.
+  EXPECT_NEAR(*pts[0].r_acc_err, 1.5 * std::sqrt(2.0) * 0.02, 1e-12);
+  EXPECT_DOUBLE_EQ(*pts[1].r_acc, 1.0);
+  EXPECT_EQ(*pts[1].r_acc_err, 0.0);
+  EXPECT_EQ(pts[2].group, "b");
+  EXPECT_DOUBLE_EQ(pts[2].w_m_s, -0.0075);
+  EXPECT_EQ(bd::query_curve(db, "s", "b").size(), 2u);
+  EXPECT_EQ(
+      count(db,
+            "SELECT COUNT(*) FROM results WHERE validation_errors_json LIKE '%max_rel_error_vs_analytic%' "
+            "AND average_from_s = 1.0 AND average_to_s = 2.0"),
+      4);
+}

@@ -1,0 +1,184 @@
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "core/error.hpp"
+#include "driver/runner.hpp"
+#include "driver/study.hpp"
+
+namespace bd = boycott::driver;
+
+namespace {
+
+const char* kSmall = R"(
+name = "small"
+[base]
+scene = "inclined_settling"
+[base.time]
+end = 2.0
+average_from = 1.0
+[[group]]
+name = "base"
+[[group]]
+name = "visc"
+set = { "fluid.viscosity" = 1.0e-2, "particles.density" = 1500.0 }
+[matrix]
+"gravity.angle_deg" = [30, 60, 90]
+"seed" = [1, 2]
+)";
+
+// The same study: groups, set keys, matrix keys and base sections in another order, a group
+// renamed, nested instead of dotted keys.
+const char* kSmallReordered = R"(
+[[group]]
+name = "viscous"
+set = { particles = { density = 1500.0 }, "fluid.viscosity" = 0.01 }
+[[group]]
+name = "reference"
+[matrix]
+"seed" = [2, 1]
+"gravity.angle_deg" = [90, 60, 30]
+[base.time]
+average_from = 1.0
+end = 2.0
+[base]
+scene = "inclined_settling"
+)";
+
+std::set<std::string> ids_of(const bd::Study& s) {
+  std::set<std::string> ids;
+  for (const auto& c : s.cases) ids.insert(c.id);
+  return ids;
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    bd::expand_study_string(text, "test.toml");
+  } catch (const boycott::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(StudyExpansion, PaperStudyHas64DistinctValidCases) {
+  const auto s = bd::expand_study_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/paper.toml");
+  EXPECT_EQ(s.name, "paper");
+  ASSERT_EQ(s.cases.size(), 64u);
+  EXPECT_EQ(ids_of(s).size(), 64u);
+  EXPECT_EQ(s.groups, (std::vector<std::string>{"base", "Ga145.6", "Sr0.0667", "Sg1.5"}));
+  std::set<double> angles;
+  for (const auto& c : s.cases) {
+    angles.insert(c.params.gravity.angle_deg);
+    if (c.group == "Ga145.6") {
+      EXPECT_DOUBLE_EQ(c.params.fluid.viscosity_pa_s, 1.0e-2);
+    }
+    if (c.group == "Sr0.0667") {
+      EXPECT_DOUBLE_EQ(c.params.particles.diameter_m, 0.4e-3);
+      EXPECT_EQ(c.params.particles.count, 405000);
+    }
+    if (c.group == "Sg1.5") {
+      EXPECT_DOUBLE_EQ(c.params.particles.density_kg_m3, 1500.0);
+    }
+    if (c.group == "base") {
+      EXPECT_EQ(c.params.particles.count, 120000);
+      EXPECT_NEAR(c.params.solid_fraction(), 0.113, 0.001);
+    }
+  }
+  EXPECT_EQ(angles.size(), 16u);
+  EXPECT_EQ(*angles.begin(), 15.0);
+  EXPECT_EQ(*angles.rbegin(), 90.0);
+}
+
+TEST(StudyExpansion, MatrixIsCartesianProductWithinEveryGroup) {
+  const auto s = bd::expand_study_string(kSmall);
+  EXPECT_EQ(s.cases.size(), 2u * 3u * 2u);
+  EXPECT_EQ(ids_of(s).size(), 12u);
+}
+
+TEST(StudyExpansion, IdsAreStableUnderReorderingAndRenaming) {
+  const std::string reordered = std::string("name = \"renamed\"\n") + kSmallReordered;
+  const auto a = bd::expand_study_string(kSmall);
+  const auto b = bd::expand_study_string(reordered);
+  EXPECT_EQ(ids_of(a), ids_of(b));
+}
+
+TEST(StudyExpansion, DistinctParametersGiveDistinctIds) {
+  std::string other = kSmall;
+  other.replace(other.find("end = 2.0"), 9, "end = 2.5");
+  const auto a = ids_of(bd::expand_study_string(kSmall));
+  const auto b = ids_of(bd::expand_study_string(other));
+  for (const auto& id : a) EXPECT_EQ(b.count(id), 0u) << id;
+}
+
+TEST(StudyExpansion, ZipIsZippedAndCombinedWithMatrixAsProduct) {
+  const auto s = bd::expand_study_string(R"(
+name = "z"
+[matrix]
+"gravity.angle_deg" = [45, 90]
+[zip]
+"particles.diameter" = [0.4e-3, 0.6e-3, 0.8e-3]
+"particles.count" = [4000, 1200, 500]
+)");
+  ASSERT_EQ(s.cases.size(), 6u);
+  for (const auto& c : s.cases) {
+    if (c.params.particles.diameter_m == 0.4e-3) {
+      EXPECT_EQ(c.params.particles.count, 4000);
+    }
+    if (c.params.particles.diameter_m == 0.6e-3) {
+      EXPECT_EQ(c.params.particles.count, 1200);
+    }
+    if (c.params.particles.diameter_m == 0.8e-3) {
+      EXPECT_EQ(c.params.particles.count, 500);
+    }
+  }
+  EXPECT_EQ(s.cases[0].group, "base");  // no [[group]]: one group named base
+}
+
+TEST(StudyExpansion, CaseFileWrittenForTheSolverHasTheSameId) {
+  for (const auto& c : bd::expand_study_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/paper.toml").cases) {
+    auto p = boycott::parse_case_string(bd::case_to_toml(c.params));
+    boycott::validate(p);
+    EXPECT_EQ(boycott::case_id(p), c.id);
+  }
+}
+
+TEST(StudyExpansionErrors, NameTheOffendingKey) {
+  EXPECT_NE(error_of("name = \"x\"\n[base\n").find("malformed TOML"), std::string::npos);
+  EXPECT_NE(error_of("name = \"x\"\n[base.fluid]\nviscosityy = 1e-3\n").find("fluid.viscosityy"),
+            std::string::npos);
+  EXPECT_NE(error_of("name = \"x\"\n[[group]]\nname = \"g\"\nset = { \"fluid.viscosity\" = -1e-3 }\n")
+                .find("fluid.viscosity = -0.001 is out of range"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of(
+          "name = \"x\"\n[base.particles]\ncount = 100\n[matrix]\n\"particles.diameter\" = [1e-3, 7e-3]\n")
+          .find("does not fit the channel"),
+      std::string::npos);
+  EXPECT_NE(error_of("name = \"x\"\n[matrix]\n\"gravity.angel_deg\" = [10]\n").find("gravity.angel_deg"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of("name = \"x\"\n[zip]\n\"seed\" = [1, 2]\n\"gravity.angle_deg\" = [10]\n").find("equally long"),
+      std::string::npos);
+  EXPECT_NE(error_of("[base]\nseed = 2\n").find("'name'"), std::string::npos);
+  EXPECT_NE(error_of("name = \"x\"\nmatrx = 1\n").find("'matrx'"), std::string::npos);
+  EXPECT_NE(error_of("name = \"x\"\n[[group]]\nname = \"a\"\n[[group]]\nname = \"b\"\n").find("same case"),
+            std::string::npos);
+  for (const char* bad : {"name = \"x\"\n[base\n", "name = \"x\"\n[base.fluid]\nviscosityy = 1e-3\n"})
+    EXPECT_EQ(error_of(bad).find('\n'), std::string::npos) << "errors are one line";
+}
+
+TEST(StudyLauncher, WrapsTheCaseInMpirunForSeveralRanks) {
+  const auto one = bd::case_command({"boycott"}, 1, "c.toml", "d");
+  EXPECT_EQ(one, (std::vector<std::string>{"boycott", "case", "run", "c.toml", "--out", "d", "--quiet"}));
+  const auto four = bd::case_command({"boycott"}, 4, "c.toml", "d");
+  EXPECT_EQ(four, (std::vector<std::string>{"mpirun", "-n", "4", "--allow-run-as-root", "boycott", "case",
+                                            "run", "c.toml", "--out", "d", "--quiet"}));
+}
+
+TEST(StudyExpansion, DemoStudyIsValidWithThePaperSolidFraction) {
+  const auto s = bd::expand_study_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/demo.toml");
+  ASSERT_EQ(s.cases.size(), 4u);
+  for (const auto& c : s.cases) EXPECT_NEAR(c.params.solid_fraction(), 0.113, 0.002);
+}
