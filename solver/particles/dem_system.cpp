@@ -248,6 +248,56 @@ void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const st
     }
 }
 
+namespace {
+/// Linear spring-dashpot force on the sphere at the `n` side of a contact (n points into it),
+/// overlap delta (m), relative contact velocity vr (m/s), normal damping gn (kg/s); the shear
+/// spring h (m) is advanced by vt dt, turned into the current tangent plane keeping its length,
+/// and capped by Coulomb (Eq. 10). Returns the signed normal force (N) and writes the
+/// tangential force ft (N). A free function without captures keeps the loop's state in registers.
+inline double spring_dashpot(const LinearSpringDashpot& cm, double dt, double nx, double ny, double nz, double delta,
+                             double vrx, double vry, double vrz, double gn, double& hxr, double& hyr, double& hzr,
+                             double& ftx, double& fty, double& ftz) {
+  const double kn = cm.kn_n_m, kt = cm.kt_n_m, mu = cm.friction;
+  const double gt = cm.tangential_ratio * gn;
+  const double vn = vrx * nx + vry * ny + vrz * nz;
+  double fn = kn * delta - gn * vn;
+  if (cm.clip_attractive) fn = std::max(fn, 0.0);
+  const double vtx = vrx - vn * nx, vty = vry - vn * ny, vtz = vrz - vn * nz;
+  double hx = hxr + vtx * dt, hy = hyr + vty * dt, hz = hzr + vtz * dt;
+  const double hn = hx * nx + hy * ny + hz * nz;
+  const double h2 = hx * hx + hy * hy + hz * hz;
+  hx -= hn * nx;
+  hy -= hn * ny;
+  hz -= hn * nz;
+  const double h2p = hx * hx + hy * hy + hz * hz;
+  if (h2p > 0.0 && hn != 0.0) {
+    const double sc = std::sqrt(h2 / h2p);
+    hx *= sc;
+    hy *= sc;
+    hz *= sc;
+  }
+  ftx = -kt * hx - gt * vtx;
+  fty = -kt * hy - gt * vty;
+  ftz = -kt * hz - gt * vtz;
+  const double ft2 = ftx * ftx + fty * fty + ftz * ftz;
+  const double fc = mu * std::abs(fn);
+  if (ft2 > fc * fc) {
+    // Sliding: cap the force and reset the spring to what the capped force implies.
+    const double sc = fc / std::sqrt(ft2);
+    ftx *= sc;
+    fty *= sc;
+    ftz *= sc;
+    hx = -(ftx + gt * vtx) / kt;
+    hy = -(fty + gt * vty) / kt;
+    hz = -(ftz + gt * vtz) / kt;
+  }
+  hxr = hx;
+  hyr = hy;
+  hzr = hz;
+  return fn;
+}
+}  // namespace
+
 template <class Rolling>
 void DemSystem::compute_forces_impl(const Rolling& rolling) {
   const std::size_t n = s_.size();
@@ -258,10 +308,9 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   std::fill(s_.ty.begin(), s_.ty.end(), 0.0);
   std::fill(s_.tz.begin(), s_.tz.end(), 0.0);
   const LinearSpringDashpot& cm = cfg_.contact;
-  const double kn = cm.kn_n_m, kt = cm.kt_n_m, dt = cfg_.dt_s, mu = cm.friction;
+  const double kn = cm.kn_n_m, dt = cfg_.dt_s;
   const double Lx = cfg_.box.len[0], Ly = cfg_.box.len[1], Lz = cfg_.box.len[2];
   const bool px = cfg_.box.periodic[0], py = cfg_.box.periodic[1], pz = cfg_.box.periodic[2];
-  const bool clip = cm.clip_attractive;
   double* __restrict fx = s_.fx.data();
   double* __restrict fy = s_.fy.data();
   double* __restrict fz = s_.fz.data();
@@ -290,52 +339,6 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   const bool uniform = uniform_mass_kg_ > 0.0;
   const double gn_pair = cm.gamma_n(0.5 * uniform_mass_kg_), gn_wall = cm.gamma_n(uniform_mass_kg_);
 
-  // Force on particle a from a contact with normal n (pointing into a), overlap delta, relative
-  // contact velocity (vrx, vry, vrz), effective mass, shear history h (updated in place).
-  // Returns the normal force magnitude (signed) and writes the tangential force.
-  auto contact = [&](double nx, double ny, double nz, double delta, double vrx, double vry, double vrz,
-                     double gn, double& hxr, double& hyr, double& hzr, double& ftx, double& fty,
-                     double& ftz) {
-    const double gt = cm.tangential_ratio * gn;
-    const double vn = vrx * nx + vry * ny + vrz * nz;
-    double fn = kn * delta - gn * vn;
-    if (clip) fn = std::max(fn, 0.0);
-    const double vtx = vrx - vn * nx, vty = vry - vn * ny, vtz = vrz - vn * nz;
-    // Shear spring: accumulate, then rotate back into the current tangent plane keeping its length.
-    double hx = hxr + vtx * dt, hy = hyr + vty * dt, hz = hzr + vtz * dt;
-    const double hn = hx * nx + hy * ny + hz * nz;
-    const double h2 = hx * hx + hy * hy + hz * hz;
-    hx -= hn * nx;
-    hy -= hn * ny;
-    hz -= hn * nz;
-    const double h2p = hx * hx + hy * hy + hz * hz;
-    if (h2p > 0.0) {
-      const double sc = std::sqrt(h2 / h2p);
-      hx *= sc;
-      hy *= sc;
-      hz *= sc;
-    }
-    ftx = -kt * hx - gt * vtx;
-    fty = -kt * hy - gt * vty;
-    ftz = -kt * hz - gt * vtz;
-    const double ft2 = ftx * ftx + fty * fty + ftz * ftz;
-    const double fc = mu * std::abs(fn);
-    if (ft2 > fc * fc) {
-      // Sliding (Eq. 10): cap the force, and reset the spring to what the capped force implies.
-      const double sc = fc / std::sqrt(ft2);
-      ftx *= sc;
-      fty *= sc;
-      ftz *= sc;
-      hx = -(ftx + gt * vtx) / kt;
-      hy = -(fty + gt * vty) / kt;
-      hz = -(ftz + gt * vtz) / kt;
-    }
-    hxr = hx;
-    hyr = hy;
-    hzr = hz;
-    return fn;
-  };
-
   for (std::size_t i = 0; i < n; ++i) {
     double fxi = 0.0, fyi = 0.0, fzi = 0.0, txi = 0.0, tyi = 0.0, tzi = 0.0;
     const double xi = x[i], yi = y[i], zi = z[i], ri = rad[i], mi = mass[i];
@@ -363,7 +366,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       // gamma_n needs sqrt(m_eff k_n): a constant when all masses are equal (the usual case).
       const double gn = uniform ? gn_pair : cm.damping_factor * std::sqrt(mi * mass[j] / (mi + mass[j]) * kn);
       double ftx, fty, ftz;
-      const double fn = contact(nx, ny, nz, rsum - r, vrx, vry, vrz, gn, h_[3 * p], h_[3 * p + 1], h_[3 * p + 2], ftx, fty, ftz);
+      const double fn = spring_dashpot(cm, dt, nx, ny, nz, rsum - r, vrx, vry, vrz, gn, h_[3 * p], h_[3 * p + 1], h_[3 * p + 2], ftx, fty, ftz);
       const double Fx = fn * nx + ftx, Fy = fn * ny + fty, Fz = fn * nz + ftz;
       fxi += Fx;
       fyi += Fy;
@@ -382,10 +385,10 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
         // flipping sign every step (chatter) or creeping at O(g dt).
         const double orx = spx[i] - spx[j], ory = spy[i] - spy[j], orz = spz[i] - spz[j];
         const double on = orx * nx + ory * ny + orz * nz;
-        const double ai = ri / inertia[i], aj = rj / inertia[j], kappa = ai + aj;
-        const double qx = ((orx - on * nx) * inv_dt + (aj - ai) * mx) / kappa;
-        const double qy = ((ory - on * ny) * inv_dt + (aj - ai) * my) / kappa;
-        const double qz = ((orz - on * nz) * inv_dt + (aj - ai) * mz) / kappa;
+        const double ai = ri / inertia[i], aj = rj / inertia[j], ik = 1.0 / (ai + aj);
+        const double qx = ((orx - on * nx) * inv_dt + (aj - ai) * mx) * ik;
+        const double qy = ((ory - on * ny) * inv_dt + (aj - ai) * my) * ik;
+        const double qz = ((orz - on * nz) * inv_dt + (aj - ai) * mz) * ik;
         const double q2 = qx * qx + qy * qy + qz * qz;
         const double qmax = rolling.mu_r * std::abs(fn);
         const double sc = q2 > qmax * qmax ? qmax / std::sqrt(q2) : 1.0;
@@ -428,7 +431,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       const double vry = vy[i] - (cz * nx - cx * nz);
       const double vrz = vz[i] - (cx * ny - cy * nx);
       double ftx, fty, ftz;
-      const double fn = contact(nx, ny, nz, ri - dist, vrx, vry, vrz,
+      const double fn = spring_dashpot(cm, dt, nx, ny, nz, ri - dist, vrx, vry, vrz,
                                 uniform ? gn_wall : cm.damping_factor * std::sqrt(mass[i] * kn), whx[i], why[i], whz[i], ftx, fty, ftz);
       fx[i] += fn * nx + ftx;
       fy[i] += fn * ny + fty;
@@ -438,10 +441,10 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       if constexpr (Rolling::enabled) {
         // As for pairs, with the wall's infinite inertia (a_j = 0).
         const double on = spx[i] * nx + spy[i] * ny + spz[i] * nz;
-        const double ai = ri / inertia[i];
-        const double qx = ((spx[i] - on * nx) * inv_dt - ai * mx) / ai;
-        const double qy = ((spy[i] - on * ny) * inv_dt - ai * my) / ai;
-        const double qz = ((spz[i] - on * nz) * inv_dt - ai * mz) / ai;
+        const double ia = inertia[i] / ri;
+        const double qx = (spx[i] - on * nx) * inv_dt * ia - mx;
+        const double qy = (spy[i] - on * ny) * inv_dt * ia - my;
+        const double qz = (spz[i] - on * nz) * inv_dt * ia - mz;
         const double q2 = qx * qx + qy * qy + qz * qz;
         const double qmax = rolling.mu_r * std::abs(fn);
         const double sc = q2 > qmax * qmax ? qmax / std::sqrt(q2) : 1.0;
