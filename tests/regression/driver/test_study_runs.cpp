@@ -106,6 +106,18 @@ std::vector<std::string> study_run(const fs::path& study, const fs::path& db, in
           kSolver};
 }
 
+/// Waits until some case of the study at db has written a checkpoint (so a stop lands mid-case).
+void wait_for_checkpoint(const fs::path& db) {
+  const fs::path runs = db.string() + ".runs";
+  for (int i = 0; i < 1000; ++i) {
+    std::error_code ec;
+    if (fs::exists(runs, ec))
+      for (const auto& e : fs::directory_iterator(runs, ec))
+        if (fs::exists(e.path() / "checkpoint.json", ec)) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
 std::int64_t count(const fs::path& db, const std::string& sql) {
   bd::Database d(db.string(), bd::OpenMode::kExisting);
   auto st = d.prepare(sql);
@@ -228,7 +240,7 @@ TEST(StudyRun, SigintStopsCasesAtACheckpointAndRerunResumesThem) {
   write(d.path / "s.toml", kStudy);
   const auto db = d.path / "s.db";
   const pid_t pid = spawn(study_run(d.path / "s.toml", db), d.path, {{"FAKE_STEP_WALL_S", "0.1"}});
-  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  wait_for_checkpoint(db);
   ::kill(pid, SIGINT);
   const auto stopped = wait_run(pid, d.path);
   EXPECT_EQ(stopped.rc, 75) << stopped.err;
@@ -334,7 +346,7 @@ TEST(StudyRun, UnusableCheckpointIsSetAsideAndTheCaseRerunFromTheStart) {
 
   const auto db = d.path / "s.db";
   const pid_t pid = spawn(study_run(d.path / "s.toml", db), d.path, {{"FAKE_STEP_WALL_S", "0.1"}});
-  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  wait_for_checkpoint(db);
   ::kill(pid, SIGINT);
   ASSERT_EQ(wait_run(pid, d.path).rc, 75);
   std::string dir;
