@@ -387,3 +387,32 @@ TEST(StudyRun, TwoDriversOnOneDatabaseRunEveryCaseExactlyOnce) {
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 0"), 6);
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status IS NOT 0"), 0);
 }
+
+TEST(StudyRun, RenamedAndReorderedStudyRerunsNothing) {
+  TempDir d;
+  write(d.path / "s.toml", kStudy);
+  const auto db = d.path / "s.db";
+  ASSERT_EQ(run(study_run(d.path / "s.toml", db), d.path).rc, 0);
+  write(d.path / "t.toml", R"(
+name = "renamed"
+[matrix]
+"gravity.angle_deg" = [90.0, 60, 30]
+[[group]]
+name = "viscous"
+set = { fluid = { viscosity = 0.01 } }
+[[group]]
+name = "reference"
+[base.time]
+average_from = 0.4
+end = 0.8
+[base]
+seed = 1
+particles = { count = 1000 }
+)");
+  const auto r = run(study_run(d.path / "t.toml", db), d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_NE(r.out.find("6 of 6 cases done"), std::string::npos) << r.out;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 6);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM study_cases WHERE study = 'renamed' AND group_name = 'viscous'"),
+            3);
+}
