@@ -416,3 +416,35 @@ particles = { count = 1000 }
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM study_cases WHERE study = 'renamed' AND group_name = 'viscous'"),
             3);
 }
+
+TEST(StudyRun, KillNineInsideTheResultTransactionLosesNothingButThatTransaction) {
+  TempDir d;
+  write(d.path / "s.toml", kStudy);
+  const auto db = d.path / "s.db";
+  // One case at a time; the driver sleeps 2 s inside its first result transaction.
+  const pid_t pid = spawn(study_run(d.path / "s.toml", db, 1), d.path,
+                          {{"FAKE_STEP_WALL_S", "0.01"}, {"BOYCOTT_TEST_COMMIT_DELAY_S", "2"}});
+  const fs::path runs = db.string() + ".runs";
+  bool finished = false;
+  for (int i = 0; i < 1000 && !finished; ++i) {
+    std::error_code ec;
+    if (fs::exists(runs, ec))
+      for (const auto& e : fs::directory_iterator(runs, ec))
+        finished |= fs::exists(e.path() / "summary.json", ec);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(finished);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ::kill(pid, SIGKILL);
+  wait_run(pid, d.path);
+  // The transaction never committed: no result, and its attempt is still open.
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 0);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE ended_at IS NULL"), 1);
+
+  const auto r = run(study_run(d.path / "s.toml", db), d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
+  // The finished case was taken from its summary.json, not run again: 6 runs + 1 abandoned.
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 7);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE error_text LIKE 'abandoned%'"), 1);
+}
