@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <ctime>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -37,7 +38,13 @@ Statement& Statement::bind_null(int i) {
   return *this;
 }
 bool Statement::step() {
-  const int rc = sqlite3_step(st_);
+  int rc = sqlite3_step(st_);
+  // Busy without the busy handler (another process switching the new file to WAL): try again.
+  for (int tries = 0; (rc & 0xff) == SQLITE_BUSY && tries < 6000; ++tries) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    sqlite3_reset(st_);
+    rc = sqlite3_step(st_);
+  }
   if (rc == SQLITE_ROW) return true;
   if (rc == SQLITE_DONE) return false;
   throw DatabaseError(fmt::format("database: {}", sqlite3_errmsg(db_)));
@@ -105,7 +112,18 @@ int Database::version() {
 
 void Database::exec(const std::string& sql) {
   char* err = nullptr;
-  if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {
+  int rc = SQLITE_OK;
+  // The busy timeout does not cover every case: switching to WAL while another process opens the
+  // same new file, or WAL recovery, report SQLITE_BUSY at once. Statements run here are safe to
+  // repeat after BUSY (BEGIN IMMEDIATE, COMMIT, pragmas; scripts run inside a write transaction).
+  for (int tries = 0; tries < 6000; ++tries) {
+    sqlite3_free(err);
+    err = nullptr;
+    rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err);
+    if ((rc & 0xff) != SQLITE_BUSY) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (rc != SQLITE_OK) {
     std::string msg = err ? err : sqlite3_errmsg(db_);
     sqlite3_free(err);
     throw DatabaseError(msg);

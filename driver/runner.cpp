@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -337,6 +338,7 @@ int study_run(const StudyRunOptions& opt) {
     std::fflush(stdout);
   };
 
+  std::set<const StudyCase*> told_locked;
   while (!queue.empty() || !running.empty()) {
     bool lock_wait = false;
     if (g_stop_signal.load() && !stopping) {
@@ -350,6 +352,9 @@ int study_run(const StudyRunOptions& opt) {
         // Its folder is locked (an orphaned solver still stopping, or another driver): later.
         queue.push_back(c);
         lock_wait = true;
+        if (told_locked.insert(c).second)
+          std::fprintf(stderr, "case %s: waiting for the process that holds %s to exit\n", c->id.c_str(),
+                       (root / c->id / ".lock").c_str());
         break;
       }
     }

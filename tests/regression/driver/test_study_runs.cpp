@@ -106,6 +106,18 @@ std::vector<std::string> study_run(const fs::path& study, const fs::path& db, in
           kSolver};
 }
 
+/// Waits until some case of the study at db has written a checkpoint (so a stop lands mid-case).
+void wait_for_checkpoint(const fs::path& db) {
+  const fs::path runs = db.string() + ".runs";
+  for (int i = 0; i < 1000; ++i) {
+    std::error_code ec;
+    if (fs::exists(runs, ec))
+      for (const auto& e : fs::directory_iterator(runs, ec))
+        if (fs::exists(e.path() / "checkpoint.json", ec)) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
 std::int64_t count(const fs::path& db, const std::string& sql) {
   bd::Database d(db.string(), bd::OpenMode::kExisting);
   auto st = d.prepare(sql);
@@ -228,7 +240,7 @@ TEST(StudyRun, SigintStopsCasesAtACheckpointAndRerunResumesThem) {
   write(d.path / "s.toml", kStudy);
   const auto db = d.path / "s.db";
   const pid_t pid = spawn(study_run(d.path / "s.toml", db), d.path, {{"FAKE_STEP_WALL_S", "0.1"}});
-  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  wait_for_checkpoint(db);
   ::kill(pid, SIGINT);
   const auto stopped = wait_run(pid, d.path);
   EXPECT_EQ(stopped.rc, 75) << stopped.err;
@@ -334,7 +346,7 @@ TEST(StudyRun, UnusableCheckpointIsSetAsideAndTheCaseRerunFromTheStart) {
 
   const auto db = d.path / "s.db";
   const pid_t pid = spawn(study_run(d.path / "s.toml", db), d.path, {{"FAKE_STEP_WALL_S", "0.1"}});
-  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  wait_for_checkpoint(db);
   ::kill(pid, SIGINT);
   ASSERT_EQ(wait_run(pid, d.path).rc, 75);
   std::string dir;
@@ -374,4 +386,65 @@ TEST(StudyRun, TwoDriversOnOneDatabaseRunEveryCaseExactlyOnce) {
   // The run folder's lock keeps the second driver off a case the first one runs.
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 0"), 6);
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status IS NOT 0"), 0);
+}
+
+TEST(StudyRun, RenamedAndReorderedStudyRerunsNothing) {
+  TempDir d;
+  write(d.path / "s.toml", kStudy);
+  const auto db = d.path / "s.db";
+  ASSERT_EQ(run(study_run(d.path / "s.toml", db), d.path).rc, 0);
+  write(d.path / "t.toml", R"(
+name = "renamed"
+[matrix]
+"gravity.angle_deg" = [90.0, 60, 30]
+[[group]]
+name = "viscous"
+set = { fluid = { viscosity = 0.01 } }
+[[group]]
+name = "reference"
+[base.time]
+average_from = 0.4
+end = 0.8
+[base]
+seed = 1
+particles = { count = 1000 }
+)");
+  const auto r = run(study_run(d.path / "t.toml", db), d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_NE(r.out.find("6 of 6 cases done"), std::string::npos) << r.out;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 6);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM study_cases WHERE study = 'renamed' AND group_name = 'viscous'"),
+            3);
+}
+
+TEST(StudyRun, KillNineInsideTheResultTransactionLosesNothingButThatTransaction) {
+  TempDir d;
+  write(d.path / "s.toml", kStudy);
+  const auto db = d.path / "s.db";
+  // One case at a time; the driver sleeps 2 s inside its first result transaction.
+  const pid_t pid = spawn(study_run(d.path / "s.toml", db, 1), d.path,
+                          {{"FAKE_STEP_WALL_S", "0.01"}, {"BOYCOTT_TEST_COMMIT_DELAY_S", "2"}});
+  const fs::path runs = db.string() + ".runs";
+  bool finished = false;
+  for (int i = 0; i < 1000 && !finished; ++i) {
+    std::error_code ec;
+    if (fs::exists(runs, ec))
+      for (const auto& e : fs::directory_iterator(runs, ec))
+        finished |= fs::exists(e.path() / "summary.json", ec);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(finished);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ::kill(pid, SIGKILL);
+  wait_run(pid, d.path);
+  // The transaction never committed: no result, and its attempt is still open.
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 0);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE ended_at IS NULL"), 1);
+
+  const auto r = run(study_run(d.path / "s.toml", db), d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
+  // The finished case was taken from its summary.json, not run again: 6 runs + 1 abandoned.
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 7);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE error_text LIKE 'abandoned%'"), 1);
 }
