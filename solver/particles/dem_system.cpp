@@ -232,11 +232,7 @@ void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const st
   for (std::size_t i = 0; i < s_.size(); ++i)
     for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
       const std::uint32_t j = nl_.neighbors[p];
-      const double dx = min_image(s_.x[i] - s_.x[j], cfg_.box.len[0], cfg_.box.periodic[0]);
-      const double dy = min_image(s_.y[i] - s_.y[j], cfg_.box.len[1], cfg_.box.periodic[1]);
-      const double dz = min_image(s_.z[i] - s_.z[j], cfg_.box.len[2], cfg_.box.periodic[2]);
-      const double rs = s_.radius[i] + s_.radius[j];
-      if (dx * dx + dy * dy + dz * dz >= rs * rs) continue;
+      if (pair_overlap(i, j) <= 0.0) continue;
       const std::int64_t a = s_.id[i], b = s_.id[j];
       const std::uint64_t key = pair_key(std::min(a, b), std::max(a, b));
       auto it = std::lower_bound(table.begin(), table.end(), std::pair<std::uint64_t, std::uint32_t>{key, 0});
@@ -553,16 +549,19 @@ double DemSystem::kinetic_energy_j() const {
   return e;
 }
 
+double DemSystem::pair_overlap(std::size_t i, std::size_t j) const {
+  const double dx = min_image(s_.x[i] - s_.x[j], cfg_.box.len[0], cfg_.box.periodic[0]);
+  const double dy = min_image(s_.y[i] - s_.y[j], cfg_.box.len[1], cfg_.box.periodic[1]);
+  const double dz = min_image(s_.z[i] - s_.z[j], cfg_.box.len[2], cfg_.box.periodic[2]);
+  return s_.radius[i] + s_.radius[j] - std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
 double DemSystem::spring_energy_j() const {
   const double kn = cfg_.contact.kn_n_m, kt = cfg_.contact.kt_n_m;
   double e = 0.0;
   for (std::size_t i = 0; i < s_.size(); ++i)
     for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
-      const std::uint32_t j = nl_.neighbors[p];
-      const double dx = min_image(s_.x[i] - s_.x[j], cfg_.box.len[0], cfg_.box.periodic[0]);
-      const double dy = min_image(s_.y[i] - s_.y[j], cfg_.box.len[1], cfg_.box.periodic[1]);
-      const double dz = min_image(s_.z[i] - s_.z[j], cfg_.box.len[2], cfg_.box.periodic[2]);
-      const double ov = s_.radius[i] + s_.radius[j] - std::sqrt(dx * dx + dy * dy + dz * dz);
+      const double ov = pair_overlap(i, nl_.neighbors[p]);
       if (ov > 0.0) e += 0.5 * kn * ov * ov + 0.5 * kt * (h_[3 * p] * h_[3 * p] + h_[3 * p + 1] * h_[3 * p + 1] + h_[3 * p + 2] * h_[3 * p + 2]);
     }
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {

@@ -90,6 +90,8 @@ class DemSystem {
   void rebuild();
   void collect_histories();
   void update_uniform_mass();
+  /// r_i + r_j - |x_i - x_j| (minimum image), m; positive when the pair overlaps.
+  double pair_overlap(std::size_t i, std::size_t j) const;
   void predict_velocities(bool from_half_step);
   void restore_histories(const std::vector<std::int64_t>& ida, const std::vector<std::int64_t>& idb,
                          const std::vector<double>& h);
