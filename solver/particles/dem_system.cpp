@@ -292,6 +292,15 @@ inline double spring_dashpot(const LinearSpringDashpot& cm, double dt, double nx
   hzr = hz;
   return fn;
 }
+
+/// Eq. 11's cap: the rolling resistance q (per unit radius, N) is at most mu_r |F_n| in size.
+inline void cap_rolling(double qx, double qy, double qz, double qmax, double& rx, double& ry, double& rz) {
+  const double q2 = qx * qx + qy * qy + qz * qz;
+  const double sc = q2 > qmax * qmax ? qmax / std::sqrt(q2) : 1.0;
+  rx = sc * qx;
+  ry = sc * qy;
+  rz = sc * qz;
+}
 }  // namespace
 
 template <class Rolling>
@@ -385,12 +394,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
         const double qx = ((orx - on * nx) * inv_dt + (aj - ai) * mx) * ik;
         const double qy = ((ory - on * ny) * inv_dt + (aj - ai) * my) * ik;
         const double qz = ((orz - on * nz) * inv_dt + (aj - ai) * mz) * ik;
-        const double q2 = qx * qx + qy * qy + qz * qz;
-        const double qmax = rolling.mu_r * std::abs(fn);
-        const double sc = q2 > qmax * qmax ? qmax / std::sqrt(q2) : 1.0;
-        rtx = sc * qx;
-        rty = sc * qy;
-        rtz = sc * qz;
+        cap_rolling(qx, qy, qz, rolling.mu_r * std::abs(fn), rtx, rty, rtz);
       }
       txi += -ri * mx - ri * rtx;
       tyi += -ri * my - ri * rty;
@@ -441,12 +445,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
         const double qx = (spx[i] - on * nx) * inv_dt * ia - mx;
         const double qy = (spy[i] - on * ny) * inv_dt * ia - my;
         const double qz = (spz[i] - on * nz) * inv_dt * ia - mz;
-        const double q2 = qx * qx + qy * qy + qz * qz;
-        const double qmax = rolling.mu_r * std::abs(fn);
-        const double sc = q2 > qmax * qmax ? qmax / std::sqrt(q2) : 1.0;
-        rtx = sc * qx;
-        rty = sc * qy;
-        rtz = sc * qz;
+        cap_rolling(qx, qy, qz, rolling.mu_r * std::abs(fn), rtx, rty, rtz);
       }
       tx[i] += -ri * (mx + rtx);
       ty[i] += -ri * (my + rty);
