@@ -14,6 +14,9 @@ SceneFn find_scene(const std::string& name) {
   static const std::map<std::string, SceneFn> table = {
       {"dem_only", &run_dem_only},
       {"channel_flow", &run_channel_flow},
+      {"inclined_settling", &run_inclined_settling},
+      {"single_particle", &run_single_particle},
+      {"ergun", &run_ergun},
   };
   auto it = table.find(name);
   if (it == table.end()) throw InputError(fmt::format("scene '{}' is not implemented yet", name));

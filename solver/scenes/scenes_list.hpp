@@ -5,4 +5,7 @@
 namespace boycott::scenes {
 int run_dem_only(const CaseParams& p, RunContext& ctx);
 int run_channel_flow(const CaseParams& p, RunContext& ctx);
+int run_inclined_settling(const CaseParams& p, RunContext& ctx);
+int run_single_particle(const CaseParams& p, RunContext& ctx);
+int run_ergun(const CaseParams& p, RunContext& ctx);
 }  // namespace boycott::scenes

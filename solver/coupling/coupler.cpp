@@ -1,0 +1,246 @@
+#include "coupling/coupler.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/constants.hpp"
+#include "core/error.hpp"
+#include "coupling/drag_laws.hpp"
+#include "fluid/fluid_solver.hpp"
+#include "particles/dem_system.hpp"
+
+namespace boycott::coupling {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+}  // namespace
+
+CouplingSettings CouplingSettings::from_case(const CaseParams& p) {
+  CouplingSettings s;
+  s.drag = p.forces.drag;
+  s.saffman_lift = p.forces.saffman_lift;
+  s.added_mass = p.forces.added_mass;
+  s.pressure_gradient = p.forces.pressure_gradient;
+  s.viscous = p.forces.viscous;
+  s.kernel = kernel_from_name(p.numerics.void_fraction_kernel);
+  s.rho_f_kg_m3 = p.fluid.density_kg_m3;
+  s.mu_pa_s = p.fluid.viscosity_pa_s;
+  s.top_slip = p.domain.top_wall == "slip";
+  return s;
+}
+
+Coupler::Coupler(const CouplingSettings& s, const GridSpec& g) : s_(s), g_(g), fields_(g, s.top_slip) {
+  const bool per[3] = {g.periodic[0], g.periodic[1], g.periodic[2]};
+  const int nx = (int)g.n[0], ny = (int)g.n[1], nz = (int)g.n[2];
+  solid_.resize(nx, ny, nz, per);
+  for (int c = 0; c < 3; ++c) {
+    const int nyc = (c == 1 && !g.periodic[1]) ? ny + 1 : ny;
+    for (GridField* f : {&K_[c], &KU_[c], &S_[c]}) f->resize(nx, nyc, nz, per);
+  }
+}
+
+Coupler::Stencil Coupler::stencil(double x, double y, double z) const {
+  Stencil st;
+  const double pos[3] = {x, y, z};
+  for (int d = 0; d < 3; ++d) {
+    st.cell[d] = cell_weights(s_.kernel, pos[d], g_.dx(d), (int)g_.n[d], !g_.periodic[d]);
+    st.face[d] = face_weights(st.cell[d]);
+  }
+  return st;
+}
+
+std::size_t Coupler::slot(std::int64_t id) {
+  if (id < 0) throw PhysicsError(fmt::format("negative particle id {}", id));
+  const auto k = static_cast<std::size_t>(id);
+  if (k >= x0_[0].size())
+    for (int c = 0; c < 3; ++c) {
+      x0_[c].resize(k + 1, 0.0);
+      v0_[c].resize(k + 1, 0.0);
+      react_[c].resize(k + 1, 0.0);
+    }
+  return k;
+}
+
+namespace {
+
+/// Sum over a separable stencil of w_x(i) w_y(j) w_z(k) f(i,j,k).
+template <class F>
+inline double weighted_sum(const Weights1D& wx, const Weights1D& wy, const Weights1D& wz, F&& f) {
+  double s = 0.0;
+  for (int c = 0; c < wz.n; ++c) {
+    double sy = 0.0;
+    for (int b = 0; b < wy.n; ++b) {
+      double sx = 0.0;
+      for (int a = 0; a < wx.n; ++a) sx += wx.w[a] * f(wx.first + a, wy.first + b, wz.first + c);
+      sy += wy.w[b] * sx;
+    }
+    s += wz.w[c] * sy;
+  }
+  return s;
+}
+
+template <class F>
+inline void weighted_scatter(const Weights1D& wx, const Weights1D& wy, const Weights1D& wz, F&& f) {
+  for (int c = 0; c < wz.n; ++c)
+    for (int b = 0; b < wy.n; ++b)
+      for (int a = 0; a < wx.n; ++a) f(wx.first + a, wy.first + b, wz.first + c, wx.w[a] * wy.w[b] * wz.w[c]);
+}
+
+}  // namespace
+
+template <class Law>
+void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem) {
+  auto& p = dem.particles();
+  const double rho = s_.rho_f_kg_m3, mu = s_.mu_pa_s, nu = mu / rho;
+  const auto& lo = dem.config().box.lo;
+  for (std::size_t i = 0; i < p.n_local; ++i) {
+    const Stencil st = stencil(p.x[i] - lo[0], p.y[i] - lo[1], p.z[i] - lo[2]);
+    const double d = 2.0 * p.radius[i];
+    const double vp = kPi * d * d * d / 6.0;
+    double uf[3], fe[3] = {0.0, 0.0, 0.0}, dudt[3] = {0.0, 0.0, 0.0};
+    for (int c = 0; c < 3; ++c) {
+      const Weights1D& wx = c == 0 ? st.face[0] : st.cell[0];
+      const Weights1D& wy = c == 1 ? st.face[1] : st.cell[1];
+      const Weights1D& wz = c == 2 ? st.face[2] : st.cell[2];
+      const GridField& U = fields_.velocity(c);
+      uf[c] = weighted_sum(wx, wy, wz, [&](int a, int b, int k) { return U.at(a, b, k); });
+      if (s_.pressure_gradient) {
+        const GridField& P = fields_.pressure_gradient(c);
+        fe[c] -= vp * weighted_sum(wx, wy, wz, [&](int a, int b, int k) { return P.at(a, b, k); });
+      }
+      if (s_.viscous) {
+        const GridField& V = fields_.viscous(c);
+        fe[c] += rho * vp * weighted_sum(wx, wy, wz, [&](int a, int b, int k) { return V.at(a, b, k); });
+      }
+      if (s_.added_mass) {
+        const GridField& M = fields_.material_derivative(c);
+        dudt[c] = weighted_sum(wx, wy, wz, [&](int a, int b, int k) { return M.at(a, b, k); });
+      }
+    }
+    const double solid =
+        weighted_sum(st.cell[0], st.cell[1], st.cell[2], [&](int a, int b, int k) { return solid_.at(a, b, k); });
+    const double alpha_f = 1.0 - solid;
+    const double s0 = uf[0] - p.vx[i], s1 = uf[1] - p.vy[i], s2 = uf[2] - p.vz[i];
+    const double slip = std::sqrt(s0 * s0 + s1 * s1 + s2 * s2);
+    p.beta[i] = law.beta(alpha_f, slip, d, rho, mu);
+    p.ufx[i] = uf[0], p.ufy[i] = uf[1], p.ufz[i] = uf[2];
+
+    double react[3] = {0.0, 0.0, 0.0};
+    if (s_.saffman_lift) {
+      double w[3];
+      for (int c = 0; c < 3; ++c) {
+        const GridField& W = fields_.vorticity(c);
+        w[c] = weighted_sum(st.cell[0], st.cell[1], st.cell[2], [&](int a, int b, int k) { return W.at(a, b, k); });
+      }
+      const double wn = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+      if (wn > 0.0) {
+        // Eq. 16: 1.61 rho d^2 sqrt(nu / |w|) (u_f - u_p) x w
+        const double cst = 1.61 * rho * d * d * std::sqrt(nu / wn);
+        const double fl[3] = {cst * (s1 * w[2] - s2 * w[1]), cst * (s2 * w[0] - s0 * w[2]), cst * (s0 * w[1] - s1 * w[0])};
+        for (int c = 0; c < 3; ++c) fe[c] += fl[c], react[c] -= fl[c];
+      }
+    }
+    if (s_.added_mass) {
+      // Eq. 17, with the particle's own acceleration moved into its mass matrix (madd): the
+      // explicit part is (rho V_p / 2) Du_f/Dt.
+      const double ma = 0.5 * rho * vp;
+      p.madd[i] = ma;
+      for (int c = 0; c < 3; ++c) fe[c] += ma * dudt[c], react[c] -= ma * dudt[c];
+    } else {
+      p.madd[i] = 0.0;
+    }
+    p.ext_x[i] = fe[0], p.ext_y[i] = fe[1], p.ext_z[i] = fe[2];
+
+    const std::size_t k = slot(p.id[i]);
+    x0_[0][k] = p.x[i], x0_[1][k] = p.y[i], x0_[2][k] = p.z[i];
+    v0_[0][k] = p.vx[i], v0_[1][k] = p.vy[i], v0_[2][k] = p.vz[i];
+    for (int c = 0; c < 3; ++c) react_[c][k] = react[c];
+  }
+}
+
+void Coupler::prepare(particles::DemSystem& dem, fluid::FluidSolver& fs, double dt_prev_s) {
+  const auto t0 = Clock::now();
+  fields_.update(fs, dt_prev_s, s_.viscous, s_.added_mass, s_.saffman_lift);
+  visit_drag_law(s_.drag, [&](const auto& law) { prepare_impl(law, dem); });
+  seconds_sample += since(t0);
+}
+
+void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double dt_s) {
+  const auto t0 = Clock::now();
+  auto& p = dem.particles();
+  const double vcell = g_.cell_volume_m3();
+  const auto& box = dem.config().box;
+  const auto& lo = box.lo;
+  std::fill(solid_.a.begin(), solid_.a.end(), 0.0);
+  for (int c = 0; c < 3; ++c)
+    for (GridField* f : {&K_[c], &KU_[c], &S_[c]}) std::fill(f->a.begin(), f->a.end(), 0.0);
+  const bool forces = dt_s > 0.0;
+  totals_ = ExchangeTotals{};
+  for (std::size_t i = 0; i < p.n_local; ++i) {
+    const Stencil st = stencil(p.x[i] - lo[0], p.y[i] - lo[1], p.z[i] - lo[2]);
+    const double r = p.radius[i];
+    const double frac = (4.0 / 3.0) * kPi * r * r * r / vcell;
+    weighted_scatter(st.cell[0], st.cell[1], st.cell[2], [&](int a, int b, int k, double w) { solid_.at(a, b, k) += w * frac; });
+    if (!forces) continue;
+    const std::size_t s = slot(p.id[i]);
+    // Mean particle velocity over the sub-cycle from its displacement (minimum image: the DEM
+    // wraps positions at list rebuilds), and its mean acceleration for the added-mass reaction.
+    const double xs[3] = {p.x[i], p.y[i], p.z[i]}, vs[3] = {p.vx[i], p.vy[i], p.vz[i]};
+    double vbar[3], rf[3];
+    for (int c = 0; c < 3; ++c) {
+      double dx = xs[c] - x0_[c][s];
+      if (box.periodic[c]) dx -= box.len[c] * std::round(dx / box.len[c]);
+      vbar[c] = dx / dt_s;
+      rf[c] = react_[c][s];
+      if (s_.added_mass) rf[c] += 0.5 * s_.rho_f_kg_m3 * (4.0 / 3.0) * kPi * r * r * r * (vs[c] - v0_[c][s]) / dt_s;
+      totals_.reaction_n[c] += rf[c];
+    }
+    const double b = p.beta[i];
+    for (int c = 0; c < 3; ++c) {
+      const Weights1D& wx = c == 0 ? st.face[0] : st.cell[0];
+      const Weights1D& wy = c == 1 ? st.face[1] : st.cell[1];
+      const Weights1D& wz = c == 2 ? st.face[2] : st.cell[2];
+      const double kb = b / vcell, kub = b * vbar[c] / vcell, sr = rf[c] / vcell;
+      weighted_scatter(wx, wy, wz, [&](int a, int bb, int k, double w) {
+        const std::size_t idx = K_[c].index(a, bb, k);
+        K_[c].a[idx] += w * kb;
+        KU_[c].a[idx] += w * kub;
+        S_[c].a[idx] += w * sr;
+      });
+    }
+  }
+  for (double v : solid_.a) totals_.solid_volume_m3 += v * vcell;
+
+  // Into the fluid's deposition arrays (one rank: owned = whole grid). The y-wall rows of v are
+  // not fluid unknowns: the share deposited there goes into the wall.
+  const int nx = (int)g_.n[0], ny = (int)g_.n[1], nz = (int)g_.n[2];
+  fs.begin_deposition();
+  PetscScalar*** sol = fs.solid_fraction_local();
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) sol[k][j][i] += solid_.at(i, j, k);
+  if (forces) {
+    for (int c = 0; c < 3; ++c) {
+      PetscScalar*** Ka = fs.drag_coefficient_local(c);
+      PetscScalar*** KUa = fs.drag_momentum_local(c);
+      PetscScalar*** Sa = fs.source_local(c);
+      for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+          for (int i = 0; i < nx; ++i) {
+            Ka[k][j][i] += K_[c].at(i, j, k);
+            KUa[k][j][i] += KU_[c].at(i, j, k);
+            Sa[k][j][i] += S_[c].at(i, j, k);
+          }
+    }
+  }
+  fs.end_deposition();
+  double amin = 1.0;
+  for (double v : solid_.a) amin = std::min(amin, 1.0 - v);
+  totals_.min_alpha_f = amin;
+  seconds_deposit += since(t0);
+}
+
+}  // namespace boycott::coupling

@@ -1,0 +1,93 @@
+#pragma once
+// Two-way fluid-particle coupling of one CFD step (paper section II C, Fig. 2):
+//
+//   prepare():  sample the fluid at every particle with its kernel weights and set the particle
+//               side of the coupling hook: implicit drag (beta, u_f), added mass in the mass
+//               matrix, and the explicit forces -V_p grad P (G included), V_p div tau, Saffman
+//               lift and the fluid half of the added mass. They stay fixed over the DEM sub-steps.
+//   (the caller sub-cycles the DEM over the CFD step)
+//   deposit():  particle volume -> alpha_f; drag onto the fluid momentum matrix (K on the
+//               diagonal, K u_p on the right side, u_p the particle velocity averaged over the
+//               sub-steps); the reactions to Saffman and added mass as an explicit source (Eq. 19).
+//
+// The pressure-gradient and viscous forces are not fed back (equation set II: the fluid feels
+// them through alpha_f). Every exchanged force uses one set of face weights per particle, so what
+// the particles receive the fluid gives back exactly.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/case_params.hpp"
+#include "core/grid_spec.hpp"
+#include "coupling/fluid_fields.hpp"
+#include "coupling/kernels.hpp"
+
+namespace boycott::particles {
+class DemSystem;
+}
+namespace boycott::fluid {
+class FluidSolver;
+}
+
+namespace boycott::coupling {
+
+struct CouplingSettings {
+  std::string drag = "difelice_paper";
+  bool saffman_lift = true, added_mass = true, pressure_gradient = true, viscous = true;
+  KernelKind kernel = KernelKind::trilinear_smoothed;
+  double rho_f_kg_m3 = 1000.0, mu_pa_s = 1.0e-3;
+  bool top_slip = false;
+  /// The case's [forces], [fluid] and numerics.void_fraction_kernel.
+  static CouplingSettings from_case(const CaseParams& p);
+};
+
+/// Totals of the last deposit, for diagnostics and conservation tests.
+struct ExchangeTotals {
+  double solid_volume_m3 = 0.0;        ///< sum over cells of (1 - alpha_f) V_cell
+  std::array<double, 3> reaction_n{};  ///< explicit force given to the fluid (Saffman, added mass), N
+  double min_alpha_f = 1.0;
+};
+
+class Coupler {
+ public:
+  Coupler(const CouplingSettings& s, const GridSpec& g);
+
+  /// Samples the fluid's current level (dt_prev_s: the step that led to it, for Du/Dt) and sets
+  /// beta, u_f, ext and madd on every local particle.
+  void prepare(particles::DemSystem& dem, fluid::FluidSolver& fs, double dt_prev_s);
+  /// Deposits particle volume and the coupling forces of a sub-cycle of length dt_s (0: volume
+  /// only, at start-up) and arms them in the fluid for its next step.
+  void deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double dt_s);
+
+  const ExchangeTotals& totals() const { return totals_; }
+  /// The deposited solid fraction per cell (last deposit), x fastest.
+  const GridField& solid_fraction() const { return solid_; }
+  const FluidFields& fields() const { return fields_; }
+  const CouplingSettings& settings() const { return s_; }
+
+  /// Drag coefficient of the last prepare per particle in storage order is on the particles
+  /// (beta); these are the time spent, s.
+  double seconds_sample = 0.0, seconds_deposit = 0.0;
+
+ private:
+  struct Stencil {
+    Weights1D cell[3], face[3];
+  };
+  Stencil stencil(double x, double y, double z) const;
+  template <class Law>
+  void prepare_impl(const Law& law, particles::DemSystem& dem);
+  std::size_t slot(std::int64_t id);
+
+  CouplingSettings s_;
+  GridSpec g_;
+  FluidFields fields_;
+  GridField solid_, K_[3], KU_[3], S_[3];
+  // Per particle, indexed by slot (from the global id, so the DEM's re-sorting does not matter):
+  // position and velocity at the start of the sub-cycle, the explicit reaction owed to the fluid.
+  std::vector<std::int64_t> slot_of_id_;
+  std::vector<double> x0_[3], v0_[3], react_[3];
+  ExchangeTotals totals_;
+};
+
+}  // namespace boycott::coupling

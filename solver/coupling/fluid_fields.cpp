@@ -1,0 +1,182 @@
+#include "coupling/fluid_fields.hpp"
+
+#include <mpi.h>
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "fluid/fluid_solver.hpp"
+
+namespace boycott::coupling {
+
+namespace {
+constexpr int kE[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+}
+
+FluidFields::FluidFields(const GridSpec& g, bool top_slip) : g_(g), walls_(!g.periodic[1]), top_slip_(top_slip) {
+  const bool per[3] = {g.periodic[0], g.periodic[1], g.periodic[2]};
+  const int nx = (int)g.n[0], ny = (int)g.n[1], nz = (int)g.n[2];
+  for (int c = 0; c < 3; ++c) {
+    const int nyc = (c == 1 && walls_) ? ny + 1 : ny;
+    for (GridField* f : {&u_[c], &uprev_[c], &gradp_[c], &visc_[c], &dudt_[c]}) f->resize(nx, nyc, nz, per);
+    vort_[c].resize(nx, ny, nz, per);
+  }
+  p_.resize(nx, ny, nz, per);
+  nut_.resize(nx, ny, nz, per);
+}
+
+double FluidFields::uval(int c, int i, int j, int k) const {
+  if (walls_) {
+    const int ny = (int)g_.n[1];
+    if (c == 1) {
+      if (j < 0) return -u_[1].at(i, -j, k);
+      if (j > ny) return -u_[1].at(i, 2 * ny - j, k);
+    } else {
+      if (j < 0) return -u_[c].at(i, -1 - j, k);
+      if (j >= ny) return (top_slip_ ? 1.0 : -1.0) * u_[c].at(i, 2 * ny - 1 - j, k);
+    }
+  }
+  return u_[c].at(i, j, k);
+}
+
+double FluidFields::nu_cell(int i, int j, int k) const { return nu_ + nut_.at(i, j, k); }
+
+void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous, bool need_material,
+                         bool need_vorticity) {
+  int size = 1;
+  MPI_Comm_size(fs.comm(), &size);
+  if (size != 1)
+    throw InputError(fmt::format("coupled scenes run on one MPI rank (this run has {}): particles are not "
+                                 "decomposed over ranks yet",
+                                 size));
+  rho_ = fs.settings().density_kg_m3;
+  nu_ = fs.settings().viscosity_pa_s / rho_;
+  const int n[3] = {(int)g_.n[0], (int)g_.n[1], (int)g_.n[2]};
+  const double h[3] = {g_.dx(0), g_.dx(1), g_.dx(2)};
+
+  for (int c = 0; c < 3; ++c) std::swap(u_[c].a, uprev_[c].a);
+  // Copy the solver's owned values (one rank: the whole grid).
+  for (int c = 0; c < 5; ++c) {
+    const PetscScalar* const* const* a = fs.read_local(c);
+    GridField& dst = c < 3 ? u_[c] : (c == 3 ? p_ : nut_);
+    for (int k = 0; k < n[2]; ++k)
+      for (int j = 0; j < n[1]; ++j)
+        for (int i = 0; i < n[0]; ++i) dst.at(i, j, k) = a[k][j][i];
+    fs.restore_read(c);
+  }
+  if (walls_) {
+    for (int k = 0; k < n[2]; ++k)
+      for (int i = 0; i < n[0]; ++i) u_[1].at(i, 0, k) = u_[1].at(i, n[1], k) = 0.0;
+  }
+  const bool first = !have_prev_ || dt_s <= 0.0;
+  have_prev_ = true;
+  const double G = fs.mean_pressure_gradient_pa_m();
+
+  for (int c = 0; c < 3; ++c) {
+    const int ec[3] = {kE[c][0], kE[c][1], kE[c][2]};
+    const int nyc = u_[c].ny;
+    for (int k = 0; k < n[2]; ++k)
+      for (int j = 0; j < nyc; ++j)
+        for (int i = 0; i < n[0]; ++i) {
+          const bool wall_row = walls_ && c == 1 && (j == 0 || j == n[1]);
+          if (wall_row) continue;  // filled from the nearest interior row below
+          const int im = i - ec[0], jm = j - ec[1], km = k - ec[2];
+          gradp_[c].at(i, j, k) = (p_.at(i, j, k) - p_.at(im, jm, km)) / h[c] + (c == 2 ? G : 0.0);
+
+          if (need_viscous) {
+            // The fluid momentum equation's viscous operator (fluid_solver.cpp), per unit mass.
+            const double uP = u_[c].at(i, j, k);
+            double lap = 0.0, tstress = 0.0;
+            for (int d = 0; d < 3; ++d)
+              for (int s = -1; s <= 1; s += 2) {
+                const int N[3] = {i + s * kE[d][0], j + s * kE[d][1], k + s * kE[d][2]};
+                double nuf = 0.0, tT = 0.0;
+                if (d == c) {
+                  const int Q[3] = {s > 0 ? i : im, s > 0 ? j : jm, s > 0 ? k : km};
+                  nuf = nu_cell(Q[0], Q[1], Q[2]);
+                  tT = nuf * (uval(c, Q[0] + ec[0], Q[1] + ec[1], Q[2] + ec[2]) - uval(c, Q[0], Q[1], Q[2])) / h[c];
+                  lap += nuf * (uval(c, N[0], N[1], N[2]) - uP) / (h[d] * h[d]);
+                } else {
+                  const int E[3] = {s > 0 ? N[0] : i, s > 0 ? N[1] : j, s > 0 ? N[2] : k};
+                  if (d == 1 && walls_ && (E[1] <= 0 || E[1] >= n[1])) {
+                    nuf = 0.5 * (nu_cell(i, j, k) + nu_cell(im, jm, km));
+                    const bool slip = s > 0 && top_slip_;
+                    if (!slip) lap += -2.0 * nuf * uP / (h[d] * h[d]);
+                    tT = 0.0;  // v = 0 along the wall
+                  } else {
+                    const int O[3] = {E[0] - kE[d][0], E[1] - kE[d][1], E[2] - kE[d][2]};
+                    nuf = 0.25 * (nu_cell(E[0], E[1], E[2]) + nu_cell(E[0] - ec[0], E[1] - ec[1], E[2] - ec[2]) +
+                                  nu_cell(O[0], O[1], O[2]) + nu_cell(O[0] - ec[0], O[1] - ec[1], O[2] - ec[2]));
+                    tT = nuf * (uval(d, E[0], E[1], E[2]) - uval(d, E[0] - ec[0], E[1] - ec[1], E[2] - ec[2])) / h[c];
+                    lap += nuf * (uval(c, N[0], N[1], N[2]) - uP) / (h[d] * h[d]);
+                  }
+                }
+                tstress += s * tT / h[d];
+              }
+            visc_[c].at(i, j, k) = lap + tstress;
+          }
+
+          if (need_material) {
+            double conv = 0.0;
+            for (int d = 0; d < 3; ++d) {
+              double ud;
+              if (d == c) {
+                ud = u_[c].at(i, j, k);
+              } else {
+                const int e[3] = {kE[d][0], kE[d][1], kE[d][2]};
+                ud = 0.25 * (uval(d, i, j, k) + uval(d, i + e[0], j + e[1], k + e[2]) + uval(d, im, jm, km) +
+                             uval(d, im + e[0], jm + e[1], km + e[2]));
+              }
+              const double dudx = (uval(c, i + kE[d][0], j + kE[d][1], k + kE[d][2]) -
+                                   uval(c, i - kE[d][0], j - kE[d][1], k - kE[d][2])) /
+                                  (2.0 * h[d]);
+              conv += ud * dudx;
+            }
+            const double dudt_local = first ? 0.0 : (u_[c].at(i, j, k) - uprev_[c].at(i, j, k)) / dt_s;
+            dudt_[c].at(i, j, k) = dudt_local + conv;
+          }
+        }
+    if (walls_ && c == 1) {
+      // Wall rows are not fluid unknowns; a particle near the wall still feels the hydrostatic
+      // gradient there, so they take the nearest interior face's value.
+      for (int k = 0; k < n[2]; ++k)
+        for (int i = 0; i < n[0]; ++i) {
+          const int lo = std::min(1, n[1] - 1), hi = std::max(n[1] - 1, 0);
+          for (GridField* f : {&gradp_[1], &visc_[1], &dudt_[1]}) {
+            f->at(i, 0, k) = f->at(i, lo, k);
+            f->at(i, n[1], k) = f->at(i, hi, k);
+          }
+        }
+    }
+  }
+
+  if (need_vorticity) {
+    // Cell-centred velocity with the wall mirror rule, then central differences.
+    auto uc = [&](int e, int i, int j, int k) {
+      return 0.5 * (uval(e, i, j, k) + uval(e, i + kE[e][0], j + kE[e][1], k + kE[e][2]));
+    };
+    auto ucell = [&](int e, int i, int j, int k) {
+      if (walls_ && e != 1) {
+        if (j < 0) return -uc(e, i, -1 - j, k);
+        if (j >= n[1]) return (top_slip_ ? 1.0 : -1.0) * uc(e, i, 2 * n[1] - 1 - j, k);
+      }
+      if (walls_ && e == 1 && (j < 0 || j >= n[1])) return -uc(e, i, j < 0 ? -1 - j : 2 * n[1] - 1 - j, k);
+      return uc(e, i, j, k);
+    };
+    auto dd = [&](int e, int d, int i, int j, int k) {
+      return (ucell(e, i + kE[d][0], j + kE[d][1], k + kE[d][2]) - ucell(e, i - kE[d][0], j - kE[d][1], k - kE[d][2])) /
+             (2.0 * h[d]);
+    };
+    for (int k = 0; k < n[2]; ++k)
+      for (int j = 0; j < n[1]; ++j)
+        for (int i = 0; i < n[0]; ++i) {
+          vort_[0].at(i, j, k) = dd(2, 1, i, j, k) - dd(1, 2, i, j, k);
+          vort_[1].at(i, j, k) = dd(0, 2, i, j, k) - dd(2, 0, i, j, k);
+          vort_[2].at(i, j, k) = dd(1, 0, i, j, k) - dd(0, 1, i, j, k);
+        }
+  }
+}
+
+}  // namespace boycott::coupling

@@ -1,0 +1,78 @@
+#pragma once
+// The fluid quantities the particles need, on the grid, each at its own staggered location:
+// velocity u_c on c-faces (levels n and n-1), pressure gradient (plus the mean driving gradient G
+// in z) on c-faces, the viscous stress divergence on c-faces (the same discrete operator the
+// fluid momentum equation uses, so particle and fluid forces cancel), the material derivative
+// Du/Dt on c-faces and the vorticity at cell centres. Read from the fluid solver once per CFD
+// step; particles then sample them with their kernel weights (coupler.hpp).
+//
+// One MPI rank: the fields are dense copies of the whole grid with periodic wrap. (Particles are
+// not decomposed over ranks yet; coupled scenes refuse more than one rank.)
+#include <array>
+#include <vector>
+
+#include "core/grid_spec.hpp"
+
+namespace boycott::fluid {
+class FluidSolver;
+}
+
+namespace boycott::coupling {
+
+/// A dense grid array of nx x ny x nz values (x fastest) with periodic wrap where asked.
+struct GridField {
+  int nx = 0, ny = 0, nz = 0;
+  bool periodic[3] = {true, true, true};
+  std::vector<double> a;
+
+  void resize(int x, int y, int z, const bool per[3]) {
+    nx = x, ny = y, nz = z;
+    for (int d = 0; d < 3; ++d) periodic[d] = per[d];
+    a.assign(static_cast<std::size_t>(nx) * ny * nz, 0.0);
+  }
+  static int wrap(int i, int n) {
+    i %= n;
+    return i < 0 ? i + n : i;
+  }
+  std::size_t index(int i, int j, int k) const {
+    if (periodic[0]) i = wrap(i, nx);
+    if (periodic[1]) j = wrap(j, ny);
+    if (periodic[2]) k = wrap(k, nz);
+    return (static_cast<std::size_t>(k) * ny + j) * nx + i;
+  }
+  double& at(int i, int j, int k) { return a[index(i, j, k)]; }
+  double at(int i, int j, int k) const { return a[index(i, j, k)]; }
+};
+
+class FluidFields {
+ public:
+  explicit FluidFields(const GridSpec& g, bool top_slip);
+
+  /// Reads velocity, pressure and nu_t from the solver at its current level and derives the
+  /// fields above. `dt_s` is the step that led to this level (for Du/Dt; 0 = first call, then
+  /// the time derivative is taken as zero).
+  void update(fluid::FluidSolver& fs, double dt_s, bool need_viscous, bool need_material, bool need_vorticity);
+
+  const GridSpec& grid() const { return g_; }
+  /// Face fields per component c (0 u on x-faces, 1 v on y-faces, 2 w on z-faces). With y walls
+  /// the v field has ny + 1 rows; rows 0 and ny are the walls (v = 0).
+  const GridField& velocity(int c) const { return u_[c]; }
+  const GridField& pressure_gradient(int c) const { return gradp_[c]; }  ///< Pa/m, includes G e_z
+  const GridField& viscous(int c) const { return visc_[c]; }             ///< div tau / rho, m/s^2
+  const GridField& material_derivative(int c) const { return dudt_[c]; }  ///< m/s^2
+  const GridField& vorticity(int c) const { return vort_[c]; }            ///< 1/s, cell centres
+
+ private:
+  /// u_c at face node (i,j,k) with the wall rule in y: beyond a wall the tangential velocity is
+  /// mirrored (-u no-slip, +u slip top) and v is zero on the wall rows.
+  double uval(int c, int i, int j, int k) const;
+  double nu_cell(int i, int j, int k) const;
+
+  GridSpec g_;
+  bool walls_, top_slip_;
+  double rho_ = 1000.0, nu_ = 1e-6;
+  GridField u_[3], uprev_[3], gradp_[3], visc_[3], dudt_[3], vort_[3], p_, nut_;
+  bool have_prev_ = false;
+};
+
+}  // namespace boycott::coupling

@@ -1,0 +1,127 @@
+#include "scenes/coupled_run.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/constants.hpp"
+#include "core/error.hpp"
+
+namespace boycott::scenes {
+
+CoupledRun::CoupledRun(const CaseParams& p, const CoupledOptions& opt) : p_(p), opt_(opt) {
+  dem_ = std::make_unique<particles::DemSystem>(particles::DemConfig::from_case(p));
+  auto fs = fluid::FluidSettings::from_case(p);
+  // The fluid feels gravity (alpha_f rho_f g in set II) and, in z, the driving gradient G.
+  fs.body_acceleration_m_s2 = p.gravity_vector();
+  fluid_ = std::make_unique<fluid::FluidSolver>(fs);
+  coupler_ = std::make_unique<coupling::Coupler>(coupling::CouplingSettings::from_case(p), fs.grid);
+}
+
+double CoupledRun::particle_volume_m3() const {
+  const auto& s = dem_->particles();
+  double v = 0.0;
+  for (std::size_t i = 0; i < s.n_local; ++i) v += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i];
+  return v;
+}
+
+void CoupledRun::start() {
+  dem_->initialize();
+  coupler_->deposit(*dem_, *fluid_, 0.0);
+  if (opt_.zero_slurry_flux) {
+    // Weight of the suspended mixture per unit volume along z: the hydrostatic gradient.
+    const double vbox = p_.box_volume_m3();
+    const double ap = particle_volume_m3() / vbox;
+    const double rho_mix = (1.0 - ap) * p_.fluid.density_kg_m3 + ap * p_.particles.density_kg_m3;
+    fluid_->set_mean_pressure_gradient_pa_m(rho_mix * p_.gravity_vector()[2]);
+  }
+}
+
+CoupledStep CoupledRun::step() {
+  CoupledStep st;
+  const double dt_dem = p_.time.dt_dem_s;
+  double dt = std::min(p_.time.dt_cfd_s, fluid_->stable_dt());
+  if (opt_.move_particles) {
+    st.dem_substeps = std::max(1, static_cast<int>(std::floor(dt / dt_dem + 1e-9)));
+    dt = st.dem_substeps * dt_dem;
+  }
+  st.dt_s = dt;
+  coupler_->prepare(*dem_, *fluid_, dt_prev_);
+  if (opt_.move_particles)
+    for (int k = 0; k < st.dem_substeps; ++k) dem_->step();
+  coupler_->deposit(*dem_, *fluid_, dt);
+  if (opt_.zero_slurry_flux) {
+    // Eq. 25: the fluid's flux controller finds the G that makes alpha_f <w_f> cancel the
+    // particles' volume flux at the new level.
+    const auto& s = dem_->particles();
+    double q = 0.0;
+    for (std::size_t i = 0; i < s.n_local; ++i) q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
+    fluid_->set_target_mean_flux_z(-q / p_.box_volume_m3());
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  st.fluid = fluid_->step(dt);
+  seconds_fluid_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  dt_prev_ = dt;
+  time_ += dt;
+  ++steps_;
+  const double ke = dem_->kinetic_energy_j();
+  if (!std::isfinite(ke))
+    throw PhysicsError(fmt::format("particle velocities became NaN at t = {:.6g} s (CFD step {})", time_, steps_));
+  return st;
+}
+
+double CoupledRun::mean_particle_velocity(int c) const {
+  const auto& s = dem_->particles();
+  const auto& v = c == 0 ? s.vx : c == 1 ? s.vy : s.vz;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < s.n_local; ++i) sum += v[i];
+  return s.n_local ? sum / static_cast<double>(s.n_local) : 0.0;
+}
+
+double CoupledRun::mean_fluid_velocity_z() const {
+  const double af = 1.0 - particle_volume_m3() / p_.box_volume_m3();
+  return fluid_->mean_flux_z() / af;
+}
+
+double CoupledRun::slurry_velocity_z() const {
+  const auto& s = dem_->particles();
+  double q = 0.0;
+  for (std::size_t i = 0; i < s.n_local; ++i) q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
+  return fluid_->mean_flux_z() + q / p_.box_volume_m3();
+}
+
+void CoupledRun::activate_models(ModelTimers& t) const {
+  const auto& f = p_.forces;
+  t.activate("fluid", fmt::format("set II, SIMPLEC, QUICK{}", p_.fluid.subgrid_model == "vreman" ? ", Vreman" : ""));
+  t.activate("coupling_sample", fmt::format("kernel {}", p_.numerics.void_fraction_kernel));
+  t.activate("coupling_deposit", fmt::format("kernel {}", p_.numerics.void_fraction_kernel));
+  if (f.drag != "none") t.activate("drag", fmt::format("{}, implicit on both sides (timed with coupling_sample)", f.drag));
+  if (f.pressure_gradient) t.activate("pressure_gradient_force", "-V_p grad P incl. G (timed with coupling_sample)");
+  if (f.viscous) t.activate("viscous_force", "V_p div tau (timed with coupling_sample)");
+  if (f.saffman_lift) t.activate("saffman_lift", "Eq. 16 (timed with coupling_sample)");
+  if (f.added_mass) t.activate("added_mass", "Eq. 17, particle side in the mass matrix (timed with coupling_sample)");
+  if (opt_.zero_slurry_flux) t.activate("slurry_flux_control", "Eq. 25 through the mean gradient G");
+  if (opt_.move_particles) {
+    t.activate("dem_contacts", fmt::format("{}, k_n = {} N/m, e = {}, mu = {}", p_.contact.model,
+                                           p_.contact.stiffness_n_m, p_.contact.restitution, p_.contact.friction));
+    if (p_.contact.rolling_model != "none" && p_.contact.rolling_friction > 0.0)
+      t.activate("rolling_friction", fmt::format("{}, mu_r = {} (timed with dem_contacts)", p_.contact.rolling_model,
+                                                 p_.contact.rolling_friction));
+    t.activate("neighbor_search", fmt::format("linked cells + Verlet skin {} m", p_.numerics.neighbor_skin_m));
+    t.activate("integration", "velocity Verlet, drag and added mass implicit");
+  }
+}
+
+void CoupledRun::report_timers(ModelTimers& t) const {
+  t.add("fluid", seconds_fluid_);
+  t.add("coupling_sample", coupler_->seconds_sample);
+  t.add("coupling_deposit", coupler_->seconds_deposit);
+  if (opt_.move_particles) {
+    t.add("dem_contacts", dem_->seconds_force);
+    t.add("neighbor_search", dem_->seconds_neighbor);
+    t.add("integration", dem_->seconds_integrate);
+  }
+}
+
+}  // namespace boycott::scenes

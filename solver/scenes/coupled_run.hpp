@@ -1,0 +1,65 @@
+#pragma once
+// The coupled CFD-DEM time loop shared by the fluid-particle scenes (paper Fig. 2): per CFD step
+// sample the fluid at the particles, sub-cycle the DEM, deposit volume and forces, set the
+// driving force, solve the fluid. Scenes choose what runs: frozen particles (no DEM), the
+// zero-slurry-velocity forcing of Eq. 25, which forces are on.
+#include <memory>
+
+#include "core/case_params.hpp"
+#include "core/timers.hpp"
+#include "coupling/coupler.hpp"
+#include "fluid/fluid_solver.hpp"
+#include "particles/dem_system.hpp"
+
+namespace boycott::scenes {
+
+struct CoupledOptions {
+  bool move_particles = true;   ///< false: frozen bed (ergun), no DEM steps
+  bool zero_slurry_flux = true; ///< Eq. 25: hold alpha_f <w_f> + alpha_p <w_p> = 0 through G(t)
+};
+
+struct CoupledStep {
+  double dt_s = 0.0;
+  int dem_substeps = 0;
+  fluid::StepReport fluid;
+};
+
+class CoupledRun {
+ public:
+  CoupledRun(const CaseParams& p, const CoupledOptions& opt);
+
+  particles::DemSystem& dem() { return *dem_; }
+  fluid::FluidSolver& fluid() { return *fluid_; }
+  coupling::Coupler& coupler() { return *coupler_; }
+
+  /// After the particles are placed: builds DEM forces, deposits alpha_f, sets the initial G to
+  /// the weight of the suspended mixture (so the first step does not start from free fall).
+  void start();
+  /// One CFD step of at most time.dt_cfd (CFL-limited), a whole number of DEM sub-steps.
+  CoupledStep step();
+  double time_s() const { return time_; }
+  std::int64_t steps() const { return steps_; }
+
+  // Measurements (Eqs. 28, 25).
+  double mean_particle_velocity(int c) const;   ///< <u_p,c>, m/s
+  double mean_fluid_velocity_z() const;         ///< <w_f> = mean(alpha_f w) / mean(alpha_f), m/s
+  double slurry_velocity_z() const;             ///< alpha_f <w_f> + alpha_p <w_p> over the box, m/s
+  double particle_volume_m3() const;
+
+  /// Adds the wall time of each part to the timers (call once at the end).
+  void report_timers(ModelTimers& t) const;
+  /// Registers the active models in the timers (what this run switches on).
+  void activate_models(ModelTimers& t) const;
+
+ private:
+  CaseParams p_;
+  CoupledOptions opt_;
+  std::unique_ptr<particles::DemSystem> dem_;
+  std::unique_ptr<fluid::FluidSolver> fluid_;
+  std::unique_ptr<coupling::Coupler> coupler_;
+  double time_ = 0.0, dt_prev_ = 0.0;
+  std::int64_t steps_ = 0;
+  double seconds_fluid_ = 0.0;
+};
+
+}  // namespace boycott::scenes
