@@ -55,11 +55,12 @@ Coupler::Stencil Coupler::stencil(double x, double y, double z) const {
 std::size_t Coupler::slot(std::int64_t id) {
   if (id < 0) throw PhysicsError(fmt::format("negative particle id {}", id));
   const auto k = static_cast<std::size_t>(id);
-  if (k >= x0_[0].size())
+  if (k >= v0_[0].size())
     for (int c = 0; c < 3; ++c) {
-      x0_[c].resize(k + 1, 0.0);
       v0_[c].resize(k + 1, 0.0);
       react_[c].resize(k + 1, 0.0);
+      fpv_[c].resize(k + 1, 0.0);
+      owed_[c].resize(k + 1, 0.0);
     }
   return k;
 }
@@ -92,7 +93,7 @@ inline void weighted_scatter(const Weights1D& wx, const Weights1D& wy, const Wei
 }  // namespace
 
 template <class Law>
-void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem) {
+void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_prev) {
   auto& p = dem.particles();
   const double rho = s_.rho_f_kg_m3, mu = s_.mu_pa_s, nu = mu / rho;
   const auto& lo = dem.config().box.lo;
@@ -119,6 +120,18 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem) {
         const GridField& M = fields_.material_derivative(c);
         dudt[c] = weighted_sum(wx, wy, wz, [&](int a, int b, int k) { return M.at(a, b, k); });
       }
+    }
+    // Lag reconciliation (see coupler.hpp): what the fluid gave at level n+1 minus what the
+    // particle received at level n over the last sub-cycle, both with these weights.
+    const std::size_t k = slot(p.id[i]);
+    {
+      const double ufo[3] = {p.ufx[i], p.ufy[i], p.ufz[i]};
+      for (int c = 0; c < 3; ++c) {
+        owed_[c][k] = dt_prev * (p.beta[i] * (uf[c] - ufo[c]) + (fe[c] - fpv_[c][k]));
+        totals_.owed_impulse_ns[c] += owed_[c][k];
+        fpv_[c][k] = fe[c];
+      }
+      p.drag_jx[i] = p.drag_jy[i] = p.drag_jz[i] = 0.0;
     }
     const double solid =
         weighted_sum(st.cell[0], st.cell[1], st.cell[2], [&](int a, int b, int k) { return solid_.at(a, b, k); });
@@ -154,8 +167,6 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem) {
     }
     p.ext_x[i] = fe[0], p.ext_y[i] = fe[1], p.ext_z[i] = fe[2];
 
-    const std::size_t k = slot(p.id[i]);
-    x0_[0][k] = p.x[i], x0_[1][k] = p.y[i], x0_[2][k] = p.z[i];
     v0_[0][k] = p.vx[i], v0_[1][k] = p.vy[i], v0_[2][k] = p.vz[i];
     for (int c = 0; c < 3; ++c) react_[c][k] = react[c];
   }
@@ -164,7 +175,8 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem) {
 void Coupler::prepare(particles::DemSystem& dem, fluid::FluidSolver& fs, double dt_prev_s) {
   const auto t0 = Clock::now();
   fields_.update(fs, dt_prev_s, s_.viscous, s_.added_mass, s_.saffman_lift);
-  visit_drag_law(s_.drag, [&](const auto& law) { prepare_impl(law, dem); });
+  totals_.owed_impulse_ns = {0.0, 0.0, 0.0};
+  visit_drag_law(s_.drag, [&](const auto& law) { prepare_impl(law, dem, dt_prev_s); });
   seconds_sample += since(t0);
 }
 
@@ -172,13 +184,14 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
   const auto t0 = Clock::now();
   auto& p = dem.particles();
   const double vcell = g_.cell_volume_m3();
-  const auto& box = dem.config().box;
-  const auto& lo = box.lo;
+  const auto& lo = dem.config().box.lo;
   std::fill(solid_.a.begin(), solid_.a.end(), 0.0);
   for (int c = 0; c < 3; ++c)
     for (GridField* f : {&K_[c], &KU_[c], &S_[c]}) std::fill(f->a.begin(), f->a.end(), 0.0);
   const bool forces = dt_s > 0.0;
+  const auto owed = totals_.owed_impulse_ns;
   totals_ = ExchangeTotals{};
+  totals_.owed_impulse_ns = owed;
   for (std::size_t i = 0; i < p.n_local; ++i) {
     const Stencil st = stencil(p.x[i] - lo[0], p.y[i] - lo[1], p.z[i] - lo[2]);
     const double r = p.radius[i];
@@ -186,15 +199,15 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
     weighted_scatter(st.cell[0], st.cell[1], st.cell[2], [&](int a, int b, int k, double w) { solid_.at(a, b, k) += w * frac; });
     if (!forces) continue;
     const std::size_t s = slot(p.id[i]);
-    // Mean particle velocity over the sub-cycle from its displacement (minimum image: the DEM
-    // wraps positions at list rebuilds), and its mean acceleration for the added-mass reaction.
-    const double xs[3] = {p.x[i], p.y[i], p.z[i]}, vs[3] = {p.vx[i], p.vy[i], p.vz[i]};
-    double vbar[3], rf[3];
+    // The fluid's drag is K (u_p - u) with K u_p = beta u_f(n) - J / dt: with u at level n it
+    // returns exactly the impulse J the kicks applied. The reaction to the explicit forces uses
+    // the particle's actual velocity change (added mass) and the lag owed from the last step.
+    const double vs[3] = {p.vx[i], p.vy[i], p.vz[i]};
+    const double J[3] = {p.drag_jx[i], p.drag_jy[i], p.drag_jz[i]};
+    const double uf[3] = {p.ufx[i], p.ufy[i], p.ufz[i]};
+    double rf[3];
     for (int c = 0; c < 3; ++c) {
-      double dx = xs[c] - x0_[c][s];
-      if (box.periodic[c]) dx -= box.len[c] * std::round(dx / box.len[c]);
-      vbar[c] = dx / dt_s;
-      rf[c] = react_[c][s];
+      rf[c] = react_[c][s] + owed_[c][s] / dt_s;
       if (s_.added_mass) rf[c] += 0.5 * s_.rho_f_kg_m3 * (4.0 / 3.0) * kPi * r * r * r * (vs[c] - v0_[c][s]) / dt_s;
       totals_.reaction_n[c] += rf[c];
     }
@@ -203,7 +216,7 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
       const Weights1D& wx = c == 0 ? st.face[0] : st.cell[0];
       const Weights1D& wy = c == 1 ? st.face[1] : st.cell[1];
       const Weights1D& wz = c == 2 ? st.face[2] : st.cell[2];
-      const double kb = b / vcell, kub = b * vbar[c] / vcell, sr = rf[c] / vcell;
+      const double kb = b / vcell, kub = (b * uf[c] - J[c] / dt_s) / vcell, sr = rf[c] / vcell;
       weighted_scatter(wx, wy, wz, [&](int a, int bb, int k, double w) {
         const std::size_t idx = K_[c].index(a, bb, k);
         K_[c].a[idx] += w * kb;

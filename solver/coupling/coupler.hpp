@@ -12,7 +12,12 @@
 //
 // The pressure-gradient and viscous forces are not fed back (equation set II: the fluid feels
 // them through alpha_f). Every exchanged force uses one set of face weights per particle, so what
-// the particles receive the fluid gives back exactly.
+// the particles receive the fluid gives back exactly, up to one time-level lag: over a sub-cycle
+// the particles see the fluid at level n while the fluid's implicit drag and its alpha-weighted
+// pressure and viscous terms act at level n+1. The next prepare() measures that difference per
+// particle (both levels sampled with the same weights) and the next deposit() hands it to the
+// fluid as an explicit source, so momentum is conserved to the solver tolerance with only the
+// last step's difference pending (totals().owed_impulse_ns).
 #include <array>
 #include <cstdint>
 #include <string>
@@ -46,6 +51,8 @@ struct CouplingSettings {
 struct ExchangeTotals {
   double solid_volume_m3 = 0.0;        ///< sum over cells of (1 - alpha_f) V_cell
   std::array<double, 3> reaction_n{};  ///< explicit force given to the fluid (Saffman, added mass), N
+  /// Impulse owed to the fluid from the previous step's time-level lag (set by prepare), N s.
+  std::array<double, 3> owed_impulse_ns{};
   double min_alpha_f = 1.0;
 };
 
@@ -76,7 +83,7 @@ class Coupler {
   };
   Stencil stencil(double x, double y, double z) const;
   template <class Law>
-  void prepare_impl(const Law& law, particles::DemSystem& dem);
+  void prepare_impl(const Law& law, particles::DemSystem& dem, double dt_prev_s);
   std::size_t slot(std::int64_t id);
 
   CouplingSettings s_;
@@ -84,9 +91,10 @@ class Coupler {
   FluidFields fields_;
   GridField solid_, K_[3], KU_[3], S_[3];
   // Per particle, indexed by slot (from the global id, so the DEM's re-sorting does not matter):
-  // position and velocity at the start of the sub-cycle, the explicit reaction owed to the fluid.
-  std::vector<std::int64_t> slot_of_id_;
-  std::vector<double> x0_[3], v0_[3], react_[3];
+  // velocity at the start of the sub-cycle, the explicit reaction owed to the fluid.
+  std::vector<double> v0_[3], react_[3];
+  std::vector<double> fpv_[3];   ///< pressure-gradient + viscous force of the last prepare, N
+  std::vector<double> owed_[3];  ///< impulse owed to the fluid (lag reconciliation), N s
   ExchangeTotals totals_;
 };
 

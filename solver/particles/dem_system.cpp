@@ -479,9 +479,18 @@ void DemSystem::kick(double h) {
     const double* __restrict e = (c == 0 ? s_.ext_x : c == 1 ? s_.ext_y : s_.ext_z).data();
     const double* __restrict u = (c == 0 ? s_.ufx : c == 1 ? s_.ufy : s_.ufz).data();
     const double g = c == 0 ? gx : c == 1 ? gy : gz;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double M = m[i] + ma[i];
-      v[i] = (M * v[i] + h * (f[i] + e[i] + m[i] * g + b[i] * u[i])) / (M + h * b[i]);
+    if (cfg_.track_drag_impulse) {
+      double* __restrict J = (c == 0 ? s_.drag_jx : c == 1 ? s_.drag_jy : s_.drag_jz).data();
+      for (std::size_t i = 0; i < n; ++i) {
+        const double M = m[i] + ma[i];
+        v[i] = (M * v[i] + h * (f[i] + e[i] + m[i] * g + b[i] * u[i])) / (M + h * b[i]);
+        J[i] += h * b[i] * (u[i] - v[i]);
+      }
+    } else {
+      for (std::size_t i = 0; i < n; ++i) {
+        const double M = m[i] + ma[i];
+        v[i] = (M * v[i] + h * (f[i] + e[i] + m[i] * g + b[i] * u[i])) / (M + h * b[i]);
+      }
     }
     double* __restrict w = (c == 0 ? s_.wx : c == 1 ? s_.wy : s_.wz).data();
     const double* __restrict t = (c == 0 ? s_.tx : c == 1 ? s_.ty : s_.tz).data();

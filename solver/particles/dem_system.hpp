@@ -24,6 +24,8 @@ struct DemConfig {
   LinearSpringDashpot contact;
   std::string rolling_model = "constant_directional";  ///< or "none"
   double rolling_friction = 0.1;
+  /// Accumulate the applied drag impulse per particle (ParticleStore::drag_j*), for coupling.
+  bool track_drag_impulse = false;
 
   /// Channel of the case: periodic x and z, walls at y = 0 and y = W unless periodic_y.
   static DemConfig from_case(const CaseParams& p);

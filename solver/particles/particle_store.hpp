@@ -24,6 +24,9 @@ struct ParticleStore {
   std::vector<double> beta;                 ///< implicit linear drag coefficient, kg/s
   std::vector<double> ufx, ufy, ufz;        ///< fluid velocity the drag pulls toward, m/s
   std::vector<double> madd;                 ///< added mass, kg
+  /// Drag impulse beta (u_f - v) dt actually applied by the kicks since the coupling last reset
+  /// it, N s: what the fluid must receive back so that momentum is exchanged exactly.
+  std::vector<double> drag_jx, drag_jy, drag_jz;
 
   std::size_t size() const { return id.size(); }
 
@@ -36,7 +39,7 @@ struct ParticleStore {
   template <class F>
   void for_each_array(F&& f) {
     for (auto* a : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &mass,
-                    &inertia, &ext_x, &ext_y, &ext_z, &beta, &ufx, &ufy, &ufz, &madd})
+                    &inertia, &ext_x, &ext_y, &ext_z, &beta, &ufx, &ufy, &ufz, &madd, &drag_jx, &drag_jy, &drag_jz})
       f(*a);
   }
 };

@@ -11,7 +11,9 @@
 namespace boycott::scenes {
 
 CoupledRun::CoupledRun(const CaseParams& p, const CoupledOptions& opt) : p_(p), opt_(opt) {
-  dem_ = std::make_unique<particles::DemSystem>(particles::DemConfig::from_case(p));
+  auto dc = particles::DemConfig::from_case(p);
+  dc.track_drag_impulse = true;
+  dem_ = std::make_unique<particles::DemSystem>(dc);
   auto fs = fluid::FluidSettings::from_case(p);
   // The fluid feels gravity (alpha_f rho_f g in set II) and, in z, the driving gradient G.
   fs.body_acceleration_m_s2 = p.gravity_vector();

@@ -9,7 +9,7 @@ namespace boycott::scenes {
 
 namespace {
 /// Random sequential insertion stops converging near this solid fraction.
-constexpr double kInsertFraction = 0.40;
+constexpr double kInsertFraction = 0.30;
 }  // namespace
 
 void grow_packing(particles::DemSystem& dem, double r0, double r1, double rho, int steps) {
