@@ -121,14 +121,16 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
         dudt[c] = weighted_sum(wx, wy, wz, [&](int a, int b, int k) { return M.at(a, b, k); });
       }
     }
-    // Lag reconciliation (see coupler.hpp): what the fluid gave at level n+1 minus what the
-    // particle received at level n over the last sub-cycle, both with these weights.
+    // Time-level lag (see coupler.hpp): what the fluid gave at level n+1 minus what the particle
+    // received at level n over the last sub-cycle, both with these weights. Measured, not fed
+    // back: handing it to the fluid as an explicit source undoes the implicit drag (a frozen
+    // dense bed diverges) and feeds pressure jumps back in dense beds.
     const std::size_t k = slot(p.id[i]);
     {
       const double ufo[3] = {p.ufx[i], p.ufy[i], p.ufz[i]};
       for (int c = 0; c < 3; ++c) {
         owed_[c][k] = dt_prev * (p.beta[i] * (uf[c] - ufo[c]) + (fe[c] - fpv_[c][k]));
-        totals_.owed_impulse_ns[c] += owed_[c][k];
+        totals_.lag_impulse_ns[c] += owed_[c][k];
         fpv_[c][k] = fe[c];
       }
       p.drag_jx[i] = p.drag_jy[i] = p.drag_jz[i] = 0.0;
@@ -175,7 +177,7 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
 void Coupler::prepare(particles::DemSystem& dem, fluid::FluidSolver& fs, double dt_prev_s) {
   const auto t0 = Clock::now();
   fields_.update(fs, dt_prev_s, s_.viscous, s_.added_mass, s_.saffman_lift);
-  totals_.owed_impulse_ns = {0.0, 0.0, 0.0};
+  totals_.lag_impulse_ns = {0.0, 0.0, 0.0};
   visit_drag_law(s_.drag, [&](const auto& law) { prepare_impl(law, dem, dt_prev_s); });
   seconds_sample += since(t0);
 }
@@ -189,9 +191,9 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
   for (int c = 0; c < 3; ++c)
     for (GridField* f : {&K_[c], &KU_[c], &S_[c]}) std::fill(f->a.begin(), f->a.end(), 0.0);
   const bool forces = dt_s > 0.0;
-  const auto owed = totals_.owed_impulse_ns;
+  const auto lag = totals_.lag_impulse_ns;
   totals_ = ExchangeTotals{};
-  totals_.owed_impulse_ns = owed;
+  totals_.lag_impulse_ns = lag;
   for (std::size_t i = 0; i < p.n_local; ++i) {
     const Stencil st = stencil(p.x[i] - lo[0], p.y[i] - lo[1], p.z[i] - lo[2]);
     const double r = p.radius[i];
@@ -201,13 +203,13 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
     const std::size_t s = slot(p.id[i]);
     // The fluid's drag is K (u_p - u) with K u_p = beta u_f(n) - J / dt: with u at level n it
     // returns exactly the impulse J the kicks applied. The reaction to the explicit forces uses
-    // the particle's actual velocity change (added mass) and the lag owed from the last step.
+    // the particle's actual velocity change (added mass).
     const double vs[3] = {p.vx[i], p.vy[i], p.vz[i]};
     const double J[3] = {p.drag_jx[i], p.drag_jy[i], p.drag_jz[i]};
     const double uf[3] = {p.ufx[i], p.ufy[i], p.ufz[i]};
     double rf[3];
     for (int c = 0; c < 3; ++c) {
-      rf[c] = react_[c][s] + owed_[c][s] / dt_s;
+      rf[c] = react_[c][s];
       if (s_.added_mass) rf[c] += 0.5 * s_.rho_f_kg_m3 * (4.0 / 3.0) * kPi * r * r * r * (vs[c] - v0_[c][s]) / dt_s;
       totals_.reaction_n[c] += rf[c];
     }

@@ -14,10 +14,10 @@
 // them through alpha_f). Every exchanged force uses one set of face weights per particle, so what
 // the particles receive the fluid gives back exactly, up to one time-level lag: over a sub-cycle
 // the particles see the fluid at level n while the fluid's implicit drag and its alpha-weighted
-// pressure and viscous terms act at level n+1. The next prepare() measures that difference per
-// particle (both levels sampled with the same weights) and the next deposit() hands it to the
-// fluid as an explicit source, so momentum is conserved to the solver tolerance with only the
-// last step's difference pending (totals().owed_impulse_ns).
+// pressure and viscous terms act at level n+1. The next prepare() measures that difference
+// (totals().lag_impulse_ns, both levels sampled with the same weights), so a momentum budget
+// closes to round-off with it; it is not fed back (see coupler.cpp). It is bounded: for a
+// steady state it vanishes, and over a run it sums to roughly the difference of its end values.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -51,8 +51,9 @@ struct CouplingSettings {
 struct ExchangeTotals {
   double solid_volume_m3 = 0.0;        ///< sum over cells of (1 - alpha_f) V_cell
   std::array<double, 3> reaction_n{};  ///< explicit force given to the fluid (Saffman, added mass), N
-  /// Impulse owed to the fluid from the previous step's time-level lag (set by prepare), N s.
-  std::array<double, 3> owed_impulse_ns{};
+  /// Momentum the last step's time-level lag created (fluid at n+1 against particles at n),
+  /// measured by prepare, N s.
+  std::array<double, 3> lag_impulse_ns{};
   double min_alpha_f = 1.0;
 };
 
@@ -94,7 +95,7 @@ class Coupler {
   // velocity at the start of the sub-cycle, the explicit reaction owed to the fluid.
   std::vector<double> v0_[3], react_[3];
   std::vector<double> fpv_[3];   ///< pressure-gradient + viscous force of the last prepare, N
-  std::vector<double> owed_[3];  ///< impulse owed to the fluid (lag reconciliation), N s
+  std::vector<double> owed_[3];  ///< lag impulse per particle of the last step, N s
   ExchangeTotals totals_;
 };
 

@@ -50,8 +50,17 @@ CoupledStep CoupledRun::step() {
   }
   st.dt_s = dt;
   coupler_->prepare(*dem_, *fluid_, dt_prev_);
-  if (opt_.move_particles)
+  if (opt_.move_particles) {
     for (int k = 0; k < st.dem_substeps; ++k) dem_->step();
+  } else {
+    // A frozen bed takes the whole drag impulse beta (u_f - v) dt (it is held in place).
+    auto& s = dem_->particles();
+    for (std::size_t i = 0; i < s.n_local; ++i) {
+      s.drag_jx[i] = dt * s.beta[i] * (s.ufx[i] - s.vx[i]);
+      s.drag_jy[i] = dt * s.beta[i] * (s.ufy[i] - s.vy[i]);
+      s.drag_jz[i] = dt * s.beta[i] * (s.ufz[i] - s.vz[i]);
+    }
+  }
   coupler_->deposit(*dem_, *fluid_, dt);
   if (opt_.zero_slurry_flux) {
     // Eq. 25: the fluid's flux controller finds the G that makes alpha_f <w_f> cancel the
