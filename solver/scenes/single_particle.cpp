@@ -34,13 +34,14 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   run.start();
   run.activate_models(timers);
 
-  const double vt = coupling::visit_drag_law(p.forces.drag, [&](const auto& law) {
+  // Without drag there is no terminal velocity (the reference is then left unset).
+  const double vt = p.forces.drag == "none" ? kUnset : coupling::visit_drag_law(p.forces.drag, [&](const auto& law) {
     return coupling::terminal_slip_speed(law, 1.0, p.particles.diameter_m, p.particles.density_kg_m3,
                                          p.fluid.density_kg_m3, p.fluid.viscosity_pa_s, p.gravity.magnitude_m_s2);
   });
   const auto g = p.gravity_vector();
   const double gmag = p.gravity.magnitude_m_s2;
-  const double ref_wz = gmag > 0 ? vt * g[2] / gmag : 0.0;  // settles along g in an unbounded fluid
+  const double ref_wz = gmag > 0 ? vt * g[2] / gmag : kUnset;  // settles along g in an unbounded fluid
   const double rp = p.particles.density_kg_m3, rf = p.fluid.density_kg_m3;
   const double cam = p.forces.added_mass ? 0.5 : 0.0;
   const double acc_ref = (p.forces.pressure_gradient ? (rp - rf) : rp) * g[2] / (rp + cam * rf);
@@ -85,7 +86,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   auto j = make_summary(p, sb, timers);
   j["terminal_velocity_m_s"] = wt;
   j["terminal_velocity_reference_m_s"] = ref_wz;
-  j["rel_error"] = ref_wz != 0.0 ? (wt - ref_wz) / ref_wz : kUnset;
+  j["rel_error"] = is_set(ref_wz) && ref_wz != 0.0 ? (wt - ref_wz) / ref_wz : kUnset;
   j["reynolds_number_reference"] = vt * d / nu;
   j["cell_size_over_diameter"] = p.domain.length_x_m / static_cast<double>(p.domain.cells[0]) / d;
   j["initial_acceleration_z_m_s2"] = acc0;

@@ -87,10 +87,13 @@ TEST(SingleParticle, AddedMassSetsTheStartAcceleration) {
 TEST(StiffDrag, TinyParticleInViscousFluidSettlesStablyToItsTerminalVelocity) {
   // d = 0.1 mm, rho_p 2650, mu = 1 Pa s: response time 1.5 us, dt_DEM = 10 us (spring limit
   // 12.5 us). Explicit drag would blow up; the implicit update must land on Stokes' velocity.
+  // In creeping flow the particle's own momentum source raises the fluid velocity at its centre
+  // by about 0.37 d/dx of its slip (measured: +7.3 % at dx/d = 5, +3.7 % at 10, +1.8 % at 20):
+  // cells 20 diameters wide here.
   const auto j = run_case_file("single_particle.toml", "stiff",
-                               {"particles.diameter=1.0e-4", "fluid.viscosity=1.0", "time.dt_dem=1.0e-5",
-                                "domain.length_x=0.005", "domain.width_y=0.005", "domain.height_z=0.01",
-                                "time.end=0.02", "time.average_from=0.01"});
+                               {"particles.diameter=1.0e-4", "numerics.neighbor_skin=3.0e-5", "fluid.viscosity=1.0",
+                                "time.dt_dem=1.0e-5", "domain.length_x=0.02", "domain.width_y=0.02",
+                                "domain.height_z=0.04", "time.end=0.02", "time.average_from=0.01"});
   EXPECT_GT(j["dt_dem_over_response_time"].get<double>(), 5.0);
   EXPECT_LE(std::abs(j["rel_error"].get<double>()), 0.02);
   std::printf("[ report ] stiff drag: w_t %.5g m/s vs %.5g (%+.2f %%)\n", j["terminal_velocity_m_s"].get<double>(),
