@@ -174,6 +174,27 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
   }
 }
 
+std::vector<std::vector<double>> Coupler::export_state() const {
+  auto st = fields_.export_state();
+  for (int c = 0; c < 3; ++c) st.push_back(fpv_[c]);
+  st.push_back(solid_.a);
+  return st;
+}
+
+void Coupler::import_state(const std::vector<std::vector<double>>& st) {
+  if (st.size() != 8) throw CheckpointError("coupling state: expected 8 arrays");
+  if (st[7].size() != solid_.a.size()) throw CheckpointError("coupling state: solid fraction of another grid");
+  solid_.a = st[7];
+  fields_.import_state({st.begin(), st.begin() + 4});
+  for (int c = 0; c < 3; ++c) {
+    fpv_[c] = st[4 + c];
+    const std::size_t n = fpv_[c].size();
+    v0_[c].resize(n, 0.0);
+    react_[c].resize(n, 0.0);
+    owed_[c].resize(n, 0.0);
+  }
+}
+
 void Coupler::prepare(particles::DemSystem& dem, fluid::FluidSolver& fs, double dt_prev_s) {
   const auto t0 = Clock::now();
   fields_.update(fs, dt_prev_s, s_.viscous, s_.added_mass, s_.saffman_lift);

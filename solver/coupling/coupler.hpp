@@ -74,6 +74,12 @@ class Coupler {
   const FluidFields& fields() const { return fields_; }
   const CouplingSettings& settings() const { return s_; }
 
+  /// What the next step depends on (checkpoints): the fluid velocity read at the last prepare
+  /// (previous level for Du/Dt), the per-particle force of that prepare (lag measurement) and
+  /// the deposited solid fraction (alpha_f at the particles).
+  std::vector<std::vector<double>> export_state() const;
+  void import_state(const std::vector<std::vector<double>>& st);
+
   /// Drag coefficient of the last prepare per particle in storage order is on the particles
   /// (beta); these are the time spent, s.
   double seconds_sample = 0.0, seconds_deposit = 0.0;

@@ -41,6 +41,18 @@ double FluidFields::uval(int c, int i, int j, int k) const {
   return u_[c].at(i, j, k);
 }
 
+void FluidFields::import_state(const std::vector<std::vector<double>>& st) {
+  if (st.size() != 4 || st[3].size() != 1)
+    throw CheckpointError("coupling state: expected 3 velocity arrays and a flag");
+  for (int c = 0; c < 3; ++c) {
+    if (st[c].size() != u_[c].a.size())
+      throw CheckpointError(fmt::format("coupling state: velocity {} has {} values, the grid {}", c, st[c].size(),
+                                        u_[c].a.size()));
+    u_[c].a = st[c];
+  }
+  have_prev_ = st[3][0] != 0.0;
+}
+
 double FluidFields::nu_cell(int i, int j, int k) const { return nu_ + nut_.at(i, j, k); }
 
 void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous, bool need_material,

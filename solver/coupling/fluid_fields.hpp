@@ -62,6 +62,11 @@ class FluidFields {
   const GridField& material_derivative(int c) const { return dudt_[c]; }  ///< m/s^2
   const GridField& vorticity(int c) const { return vort_[c]; }            ///< 1/s, cell centres
 
+  /// The velocity read at the last update (the next update's previous level, for Du/Dt), for
+  /// checkpoints: u, v, w arrays and whether a previous level exists.
+  std::vector<std::vector<double>> export_state() const { return {u_[0].a, u_[1].a, u_[2].a, {have_prev_ ? 1.0 : 0.0}}; }
+  void import_state(const std::vector<std::vector<double>>& st);
+
  private:
   /// u_c at face node (i,j,k) with the wall rule in y: beyond a wall the tangential velocity is
   /// mirrored (-u no-slip, +u slip top) and v is zero on the wall rows.

@@ -825,7 +825,9 @@ FluidState FluidSolver::export_state() const {
   st.dt_prev_s = dt_prev_;
   st.steps = steps_;
   st.mean_pressure_gradient_pa_m = G_;
-  const Vec vs[10] = {U_[0], U_[1], U_[2], Unm1_[0], Unm1_[1], Unm1_[2], P_, alpha_[1], alpha_[2], alpha_[0]};
+  // nu_t too: it was computed from the previous level at the start of the last step, and the
+  // coupling reads it before the next step recomputes it.
+  const Vec vs[11] = {U_[0], U_[1], U_[2], Unm1_[0], Unm1_[1], Unm1_[2], P_, alpha_[1], alpha_[2], alpha_[0], nut_};
   for (Vec v : vs) {
     PetscInt nloc;
     VecGetLocalSize(v, &nloc);
@@ -839,10 +841,10 @@ FluidState FluidSolver::export_state() const {
 
 void FluidSolver::import_state(const FluidState& st) {
   const OwnedBox b = owned_box();
-  if (st.box.lo != b.lo || st.box.size != b.size || st.fields.size() != 10)
+  if (st.box.lo != b.lo || st.box.size != b.size || st.fields.size() != 11)
     throw std::invalid_argument("fluid state from another layout");
-  Vec vs[10] = {U_[0], U_[1], U_[2], Unm1_[0], Unm1_[1], Unm1_[2], P_, alpha_[1], alpha_[2], alpha_[0]};
-  for (int f = 0; f < 10; ++f) {
+  Vec vs[11] = {U_[0], U_[1], U_[2], Unm1_[0], Unm1_[1], Unm1_[2], P_, alpha_[1], alpha_[2], alpha_[0], nut_};
+  for (int f = 0; f < 11; ++f) {
     PetscScalar* a;
     BC_PETSC(VecGetArray(vs[f], &a));
     std::copy(st.fields[f].begin(), st.fields[f].end(), a);
@@ -855,6 +857,7 @@ void FluidSolver::import_state(const FluidState& st) {
   G_ = st.mean_pressure_gradient_pa_m;
   alpha_initialised_ = true;
   for (int l = 0; l < 3; ++l) BC_PETSC(DMGlobalToLocal(da_, alpha_[l], INSERT_VALUES, alphal_[l]));
+  BC_PETSC(DMGlobalToLocal(da_, nut_, INSERT_VALUES, nutl_));
   update_ghosts();
 }
 

@@ -89,7 +89,7 @@ struct FluidState {
   double time_s = 0.0, dt_prev_s = 0.0;
   int steps = 0;
   double mean_pressure_gradient_pa_m = 0.0;
-  /// u, v, w at levels n and n-1, p, alpha_f at n, n-1 and n+1: 10 owned arrays.
+  /// u, v, w at levels n and n-1, p, alpha_f at n, n-1 and n+1, nu_t: 11 owned arrays.
   std::vector<std::vector<double>> fields;
 };
 

@@ -7,6 +7,7 @@
 
 #include "core/constants.hpp"
 #include "core/error.hpp"
+#include "io/state_io.hpp"
 
 namespace boycott::scenes {
 
@@ -80,6 +81,31 @@ CoupledStep CoupledRun::step() {
   if (!std::isfinite(ke))
     throw PhysicsError(fmt::format("particle velocities became NaN at t = {:.6g} s (CFD step {})", time_, steps_));
   return st;
+}
+
+void CoupledRun::save(io::CheckpointWriter& w) const {
+  w.put("run.time_s", time_);
+  w.put("run.dt_prev_s", dt_prev_);
+  w.put_int("run.steps", steps_);
+  io::save(w, "dem.", dem_->export_state());
+  io::save(w, "fluid.", fluid_->export_state());
+  io::save(w, "coupler.", coupler_->export_state());
+}
+
+void CoupledRun::load(const io::CheckpointReader& r) {
+  time_ = r.scalar("run.time_s");
+  dt_prev_ = r.scalar("run.dt_prev_s");
+  steps_ = r.integer("run.steps");
+  particles::DemState ds;
+  io::load(r, "dem.", ds);
+  dem_->import_state(ds);
+  fluid::FluidState fs;
+  io::load(r, "fluid.", fs);
+  const auto box = fluid_->owned_box();
+  if (fs.box.lo != box.lo || fs.box.size != box.size)
+    throw CheckpointError(fmt::format("{}: the fluid grid was decomposed differently (other rank count?)", r.path().string()));
+  fluid_->import_state(fs);
+  coupler_->import_state(io::load_arrays(r, "coupler."));
 }
 
 double CoupledRun::mean_particle_velocity(int c) const {

@@ -9,6 +9,7 @@
 #include "core/timers.hpp"
 #include "coupling/coupler.hpp"
 #include "fluid/fluid_solver.hpp"
+#include "io/checkpoint_file.hpp"
 #include "particles/dem_system.hpp"
 
 namespace boycott::scenes {
@@ -45,6 +46,11 @@ class CoupledRun {
   double mean_fluid_velocity_z() const;         ///< <w_f> = mean(alpha_f w) / mean(alpha_f), m/s
   double slurry_velocity_z() const;             ///< alpha_f <w_f> + alpha_p <w_p> over the box, m/s
   double particle_volume_m3() const;
+
+  /// Everything the next step depends on, under prefixes run., dem., fluid., coupler. (start()
+  /// is not called again on a resumed run).
+  void save(io::CheckpointWriter& w) const;
+  void load(const io::CheckpointReader& r);
 
   /// Adds the wall time of each part to the timers (call once at the end).
   void report_timers(ModelTimers& t) const;

@@ -10,6 +10,9 @@
 
 #include "core/error.hpp"
 #include "core/statistics.hpp"
+#include "core/version.hpp"
+#include "io/checkpoint_file.hpp"
+#include "io/state_io.hpp"
 #include "coupling/drag_laws.hpp"
 #include "scenes/coupled_run.hpp"
 #include "scenes/particle_setup.hpp"
@@ -40,10 +43,6 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   WallClock clock;
   ModelTimers timers;
   CoupledRun run(p, CoupledOptions{true, true});
-  insert_case_particles(run.dem(), p);
-  run.start();
-  run.activate_models(timers);
-
   const auto& s = run.dem().particles();
   const double vt = isolated_terminal_speed(p);
   const double W = p.domain.width_y_m;
@@ -53,14 +52,61 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   const double wrange = std::max(8.0 * vt, 0.05);
   Histogram pdf_w(-wrange, 0.5 * wrange, bins);
   BatchMeans wp_avg, wf_avg, slurry_avg;
-  double slurry_max = 0.0;
+  double slurry_max = 0.0, next_out = 0.0, wall_before = 0.0;
+  const std::string id = case_id(p);
+
+  // Resume from the newest checkpoint, or start.
+  const auto ck = io::latest_checkpoint(ctx.out_dir);
+  if (ck) {
+    io::CheckpointReader r(*ck);
+    if (r.string("case_id") != id)
+      throw CheckpointError(fmt::format("{} belongs to case {}, not {}; it is left in place", ck->string(),
+                                        r.string("case_id"), id));
+    run.load(r);
+    io::load(r, "stats.wp.", wp_avg);
+    io::load(r, "stats.wf.", wf_avg);
+    io::load(r, "stats.slurry.", slurry_avg);
+    io::load(r, "stats.pdf_y.", pdf_y);
+    io::load(r, "stats.pdf_w.", pdf_w);
+    slurry_max = r.scalar("stats.slurry_max");
+    next_out = r.scalar("stats.next_out");
+    wall_before = r.scalar("run.wall_time_s");
+    truncate_csv_after(ctx.out_dir / "timeseries.csv", run.time_s());
+    if (!ctx.quiet) std::fprintf(stderr, "resuming from %s at t = %g s\n", ck->c_str(), run.time_s());
+  } else {
+    insert_case_particles(run.dem(), p);
+    run.start();
+  }
+  run.activate_models(timers);
+  timers.activate("checkpoints", fmt::format("HDF5 every {} s, newest {} kept", p.time.checkpoint_every_s,
+                                             p.output.keep_checkpoints));
+
+  auto write_checkpoint = [&] {
+    ModelTimers::Scope sc(timers, "checkpoints");
+    io::CheckpointWriter w(io::checkpoint_path(ctx.out_dir, run.steps()));
+    w.put_string("case_id", id);
+    w.put_string("case_json", to_json(p).dump());
+    w.put_string("program_version", std::string(kVersion));
+    run.save(w);
+    io::save(w, "stats.wp.", wp_avg);
+    io::save(w, "stats.wf.", wf_avg);
+    io::save(w, "stats.slurry.", slurry_avg);
+    io::save(w, "stats.pdf_y.", pdf_y);
+    io::save(w, "stats.pdf_w.", pdf_w);
+    w.put("stats.slurry_max", slurry_max);
+    w.put("stats.next_out", next_out);
+    w.put("run.wall_time_s", wall_before + clock.seconds());
+    w.commit();
+    io::prune_checkpoints(ctx.out_dir, static_cast<int>(p.output.keep_checkpoints));
+  };
 
   CsvWriter csv(ctx.out_dir / "timeseries.csv",
                 {"time_s", "mean_wp_m_s", "mean_wf_m_s", "slurry_velocity_m_s", "mean_up_m_s", "mean_vp_m_s",
                  "driving_gradient_pa_m", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
-                false);
+                ck.has_value());
   const double out_every = is_set(p.output.timeseries_every_s) ? p.output.timeseries_every_s : 0.0;
-  double next_out = 0.0;
+  const double ck_every = p.time.checkpoint_every_s;
+  double next_ck = (std::floor(run.time_s() / ck_every + 1e-9) + 1.0) * ck_every;
   int exit_code = kExitOk;
   SummaryBase sb;
   const double end = p.time.end_s;
@@ -87,10 +133,17 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       next_out = t + out_every;
       if (ctx.progress) ctx.progress(t);
     }
-    if (ctx.should_stop()) {
+    const bool stop = ctx.should_stop();
+    // Also at the end: the final state stays inspectable (and comparable across restarts).
+    if (t >= next_ck - 1e-12 || t >= end - 1e-12 || stop) {
+      csv.flush();
+      write_checkpoint();
+      next_ck = (std::floor(t / ck_every + 1e-9) + 1.0) * ck_every;
+    }
+    if (stop) {
       sb.status = "interrupted";
-      exit_code = kExitFailure;
-      std::fprintf(stderr, "interrupted at t = %g s; inclined_settling writes no checkpoint yet, a rerun starts over\n", t);
+      exit_code = kExitInterrupted;
+      if (!ctx.quiet) std::fprintf(stderr, "stopped at t = %g s after writing a checkpoint; run again to resume\n", t);
       break;
     }
   }
@@ -102,7 +155,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   }
 
   sb.simulated_time_s = run.time_s();
-  sb.wall_time_s = clock.seconds();
+  sb.wall_time_s = wall_before + clock.seconds();
   sb.particle_steps = static_cast<double>(s.n_local) * static_cast<double>(run.dem().steps());
   sb.mean_settling_velocity_m_s = wp_avg.count() ? wp_avg.mean() : kUnset;
   sb.settling_velocity_stderr_m_s = wp_avg.stderr_of_mean();
@@ -116,6 +169,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   j["cfd_steps"] = run.steps();
   j["dem_steps"] = run.dem().steps();
   j["samples_averaged"] = wp_avg.count();
+  j["resumed_from_checkpoint"] = ck.has_value();
   j["pdf_outside_fraction"] = {{"y", pdf_y.total_ > 0 ? pdf_y.outside_ / pdf_y.total_ : 0.0},
                                {"wp", pdf_w.total_ > 0 ? pdf_w.outside_ / pdf_w.total_ : 0.0}};
   j["wall_time_per_simulated_second_s"] = run.time_s() > 0 ? sb.wall_time_s / run.time_s() : kUnset;

@@ -71,4 +71,21 @@ void CsvWriter::row(const std::vector<double>& values) {
 
 void CsvWriter::flush() { std::fflush(f_); }
 
+void truncate_csv_after(const std::filesystem::path& path, double t_max) {
+  std::ifstream in(path);
+  if (!in) return;
+  std::string line, out;
+  bool header = true;
+  while (std::getline(in, line)) {
+    if (!header) {
+      const double t = std::strtod(line.c_str(), nullptr);
+      if (t > t_max * (1.0 + 1e-12) + 1e-15) break;
+    }
+    header = false;
+    out += line + "\n";
+  }
+  in.close();
+  write_file_atomic(path, out);
+}
+
 }  // namespace boycott::scenes

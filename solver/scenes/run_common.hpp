@@ -44,6 +44,10 @@ class CsvWriter {
   std::size_t ncol_;
 };
 
+/// Drops the rows of a CSV file whose first column exceeds t_max (a resumed run repeats nothing
+/// and loses nothing: rows written after its checkpoint are computed again).
+void truncate_csv_after(const std::filesystem::path& path, double t_max);
+
 /// Wall clock since construction, seconds.
 class WallClock {
  public:

@@ -1,0 +1,129 @@
+// Restart checkpoints (issue 5): a run stopped halfway and resumed ends bitwise where the
+// uninterrupted run ends; bad checkpoints are refused with a message and left untouched.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "core/case_params.hpp"
+#include "core/error.hpp"
+#include "io/checkpoint_file.hpp"
+#include "scenes/scene.hpp"
+
+namespace boycott {
+namespace {
+
+namespace fs = std::filesystem;
+
+CaseParams small_case() {
+  CaseParams p = parse_case_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/cases/inclined_settling_smoke.toml");
+  apply_override(p, "time.end=0.06");
+  apply_override(p, "time.average_from=0.02");
+  apply_override(p, "time.checkpoint_every=0.025");
+  return p;
+}
+
+/// Runs the case in `dir`; with stop_at > 0 a stop is requested once simulated time reaches it.
+int run_in(const CaseParams& p, const fs::path& dir, double stop_at = -1.0) {
+  std::atomic<bool> stop{false};
+  scenes::RunContext ctx;
+  ctx.quiet = true;
+  ctx.out_dir = dir;
+  ctx.stop_requested = &stop;
+  ctx.progress = [&](double t) {
+    if (stop_at > 0 && t >= stop_at) stop = true;
+  };
+  return scenes::run_case(p, ctx);
+}
+
+nlohmann::json summary(const fs::path& dir) {
+  std::ifstream in(dir / "summary.json");
+  return nlohmann::json::parse(in);
+}
+
+std::string slurp(const fs::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+TEST(RestartIdentity, StoppedHalfwayAndResumedEqualsTheUninterruptedRunBitwise) {
+  const CaseParams p = small_case();
+  const fs::path a = fs::temp_directory_path() / "boycott_restart_a", b = fs::temp_directory_path() / "boycott_restart_b";
+  fs::remove_all(a);
+  fs::remove_all(b);
+  ASSERT_EQ(run_in(p, a), kExitOk);
+  ASSERT_EQ(run_in(p, b, 0.03), kExitInterrupted);
+  EXPECT_EQ(summary(b)["status"], "interrupted");
+  ASSERT_EQ(run_in(p, b), kExitOk);
+  const auto sa = summary(a), sb = summary(b);
+  EXPECT_EQ(sb["resumed_from_checkpoint"], true);
+  EXPECT_EQ(sa["mean_settling_velocity_m_s"].get<double>(), sb["mean_settling_velocity_m_s"].get<double>());
+  EXPECT_EQ(sa["settling_velocity_stderr_m_s"].get<double>(), sb["settling_velocity_stderr_m_s"].get<double>());
+  EXPECT_EQ(sa["cfd_steps"], sb["cfd_steps"]);
+  // The final states: every particle array, every fluid field, the statistics.
+  const auto fa = io::latest_checkpoint(a), fb = io::latest_checkpoint(b);
+  ASSERT_TRUE(fa && fb);
+  EXPECT_EQ(fa->filename(), fb->filename());
+  io::CheckpointReader ra(*fa), rb(*fb);
+  for (int k = 0; k < 29; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "dem.array%02d", k);
+    if (!ra.has(name)) break;
+    EXPECT_EQ(ra.doubles(name), rb.doubles(name)) << name;
+  }
+  EXPECT_EQ(ra.int64s("dem.id"), rb.int64s("dem.id"));
+  for (int f = 0; f < 11; ++f) {
+    char name[32];
+    std::snprintf(name, sizeof name, "fluid.field.%02d", f);
+    EXPECT_EQ(ra.doubles(name), rb.doubles(name)) << name;
+  }
+  EXPECT_EQ(ra.doubles("stats.wp.sums"), rb.doubles("stats.wp.sums"));
+  EXPECT_EQ(ra.doubles("stats.pdf_w.counts"), rb.doubles("stats.pdf_w.counts"));
+  // The time series has each row once, equal to the uninterrupted one.
+  EXPECT_EQ(slurp(a / "timeseries.csv"), slurp(b / "timeseries.csv"));
+}
+
+TEST(BadCheckpoint, TruncatedFileIsRefusedAndLeftInPlace) {
+  const CaseParams p = small_case();
+  const fs::path d = fs::temp_directory_path() / "boycott_restart_trunc";
+  fs::remove_all(d);
+  ASSERT_EQ(run_in(p, d, 0.03), kExitInterrupted);
+  const auto ck = io::latest_checkpoint(d);
+  ASSERT_TRUE(ck);
+  const auto size = fs::file_size(*ck);
+  fs::resize_file(*ck, size / 2);
+  try {
+    run_in(p, d);
+    FAIL() << "a truncated checkpoint was accepted";
+  } catch (const CheckpointError& e) {
+    EXPECT_NE(std::string(e.what()).find(ck->filename().string()), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(fs::file_size(*ck), size / 2);  // not overwritten, not deleted
+  EXPECT_FALSE(fs::exists(d / "summary.json") && summary(d)["status"] == "completed");
+}
+
+TEST(BadCheckpoint, CheckpointOfOtherParametersIsRefused) {
+  CaseParams p = small_case();
+  const fs::path d = fs::temp_directory_path() / "boycott_restart_other";
+  fs::remove_all(d);
+  ASSERT_EQ(run_in(p, d, 0.03), kExitInterrupted);
+  const auto ck = io::latest_checkpoint(d);
+  // Another case in the same folder: refused by params.json already; without it, by the
+  // checkpoint's own case hash.
+  apply_override(p, "gravity.angle_deg=70");
+  EXPECT_THROW(run_in(p, d), CheckpointError);
+  fs::remove(d / "params.json");
+  try {
+    run_in(p, d);
+    FAIL() << "a checkpoint of another case was accepted";
+  } catch (const CheckpointError& e) {
+    EXPECT_NE(std::string(e.what()).find("belongs to case"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::exists(*ck));
+}
+
+}  // namespace
+}  // namespace boycott
