@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -76,8 +77,14 @@ void truncate_csv_after(const std::filesystem::path& path, double t_max) {
   if (!in) return;
   std::string line, out;
   bool header = true;
+  std::size_t ncomma = 0;
   while (std::getline(in, line)) {
-    if (!header) {
+    const auto commas = static_cast<std::size_t>(std::count(line.begin(), line.end(), ','));
+    if (header) {
+      ncomma = commas;
+    } else {
+      // A row cut short by a kill has fewer fields: it and everything after it go.
+      if (commas != ncomma || in.eof()) break;
       const double t = std::strtod(line.c_str(), nullptr);
       if (t > t_max * (1.0 + 1e-12) + 1e-15) break;
     }
