@@ -48,8 +48,9 @@ std::vector<T> read_dataset(hid_t file, const fs::path& path, const std::string&
   const hid_t ds = H5Dopen2(file, name.c_str(), H5P_DEFAULT);
   if (ds < 0) throw CheckpointError(fmt::format("{}: dataset '{}' is missing", path.string(), name));
   const hid_t space = H5Dget_space(ds);
-  hsize_t n = 0;
-  H5Sget_simple_extent_dims(space, &n, nullptr);
+  // Any rank: all points, slowest dimension first.
+  const hssize_t npts = H5Sget_simple_extent_npoints(space);
+  const auto n = static_cast<std::size_t>(npts < 0 ? 0 : npts);
   std::vector<T> v(n);
   herr_t e = n > 0 ? H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) : 0;
   H5Sclose(space);
@@ -85,6 +86,27 @@ void CheckpointWriter::put(const std::string& name, const std::vector<std::int64
 void CheckpointWriter::put_string(const std::string& name, const std::string& s) {
   std::vector<std::int64_t> bytes(s.begin(), s.end());
   put(name, bytes);
+}
+
+void CheckpointWriter::put_3d(const std::string& name, const std::array<std::size_t, 3>& dims,
+                              const std::vector<double>& v) {
+  const hsize_t d[3] = {dims[0], dims[1], dims[2]};
+  if (d[0] * d[1] * d[2] != v.size()) throw CheckpointError(fmt::format("dataset '{}': size mismatch", name));
+  const hid_t space = H5Screate_simple(3, d, nullptr);
+  const hid_t ds = H5Dcreate2(file_, name.c_str(), H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  if (ds < 0) {
+    H5Sclose(space);
+    throw CheckpointError(fmt::format("cannot create dataset '{}'", name));
+  }
+  check(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), "write " + name);
+  H5Dclose(ds);
+  H5Sclose(space);
+}
+
+void CheckpointWriter::put_group(const std::string& name) {
+  const hid_t g = H5Gcreate2(file_, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  if (g < 0) throw CheckpointError(fmt::format("cannot create group '{}'", name));
+  H5Gclose(g);
 }
 
 void CheckpointWriter::commit() {

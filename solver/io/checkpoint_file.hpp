@@ -6,6 +6,7 @@
 // only a stray .tmp and the previous checkpoint intact. A reader refuses a file without the
 // marker (truncated or half written) and one whose case hash differs, with a CheckpointError
 // naming the file; nothing is ever deleted or overwritten on such an error.
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -27,6 +28,10 @@ class CheckpointWriter {
   void put(const std::string& name, double v) { put(name, std::vector<double>{v}); }
   void put_int(const std::string& name, std::int64_t v) { put(name, std::vector<std::int64_t>{v}); }
   void put_string(const std::string& name, const std::string& s);
+  /// A 3-D array stored slowest-first with dimensions {n0, n1, n2} (z, y, x for grid fields).
+  void put_3d(const std::string& name, const std::array<std::size_t, 3>& dims, const std::vector<double>& v);
+  /// Creates a group (for names "group/dataset").
+  void put_group(const std::string& name);
   /// Marks the file complete, flushes, renames it into place.
   void commit();
 

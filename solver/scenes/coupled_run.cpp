@@ -108,6 +108,40 @@ void CoupledRun::load(const io::CheckpointReader& r) {
   coupler_->import_state(io::load_arrays(r, "coupler."));
 }
 
+io::SnapshotData CoupledRun::snapshot() const {
+  io::SnapshotData d;
+  d.time_s = time_;
+  const auto& s = dem_->particles();
+  const std::size_t n = s.n_local;
+  for (auto [dst, src] : {std::pair{&d.x, &s.x}, {&d.y, &s.y}, {&d.z, &s.z}, {&d.vx, &s.vx}, {&d.vy, &s.vy},
+                          {&d.vz, &s.vz}, {&d.radius, &s.radius}})
+    dst->assign(src->begin(), src->begin() + static_cast<std::ptrdiff_t>(n));
+  const auto& g = fluid_->settings().grid;
+  const int nx = (int)g.n[0], ny = (int)g.n[1], nz = (int)g.n[2];
+  const bool walls = !g.periodic[1];
+  d.cell_fields.emplace_back("alpha_f", fluid_->gather(5));
+  d.cell_fields.emplace_back("pressure", fluid_->gather(3));
+  const char* names[3] = {"u", "v", "w"};
+  for (int c = 0; c < 3; ++c) {
+    const auto f = fluid_->gather(c);  // lower faces
+    std::vector<double> cc(f.size());
+    for (int k = 0; k < nz; ++k)
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+          const int i1 = c == 0 ? (i + 1) % nx : i, j1 = c == 1 ? j + 1 : j, k1 = c == 2 ? (k + 1) % nz : k;
+          const double lo = f[i + nx * (j + ny * k)];
+          double hi = 0.0;
+          if (c == 1 && j1 == ny)
+            hi = walls ? 0.0 : f[i + nx * (0 + ny * k)];
+          else
+            hi = f[i1 + nx * (j1 + ny * k1)];
+          cc[i + nx * (j + ny * k)] = 0.5 * (lo + hi);
+        }
+    d.cell_fields.emplace_back(names[c], std::move(cc));
+  }
+  return d;
+}
+
 double CoupledRun::mean_particle_velocity(int c) const {
   const auto& s = dem_->particles();
   const auto& v = c == 0 ? s.vx : c == 1 ? s.vy : s.vz;

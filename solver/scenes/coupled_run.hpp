@@ -10,6 +10,7 @@
 #include "coupling/coupler.hpp"
 #include "fluid/fluid_solver.hpp"
 #include "io/checkpoint_file.hpp"
+#include "io/snapshot.hpp"
 #include "particles/dem_system.hpp"
 
 namespace boycott::scenes {
@@ -51,6 +52,9 @@ class CoupledRun {
   /// is not called again on a resumed run).
   void save(io::CheckpointWriter& w) const;
   void load(const io::CheckpointReader& r);
+
+  /// Particles and cell-centred fluid fields (alpha_f, p, u, v, w) now, for io::write_snapshot.
+  io::SnapshotData snapshot() const;
 
   /// Adds the wall time of each part to the timers (call once at the end).
   void report_timers(ModelTimers& t) const;

@@ -5,6 +5,8 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <regex>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -123,6 +125,60 @@ TEST(BadCheckpoint, CheckpointOfOtherParametersIsRefused) {
     EXPECT_NE(std::string(e.what()).find("belongs to case"), std::string::npos) << e.what();
   }
   EXPECT_TRUE(fs::exists(*ck));
+}
+
+}  // namespace
+}  // namespace boycott
+
+namespace boycott {
+namespace {
+
+TEST(Snapshots, XdmfIsWellFormedAndNamesDatasetsThatExistWithTheRightShapes) {
+  CaseParams p = small_case();
+  apply_override(p, "time.end=0.02");
+  apply_override(p, "time.average_from=0.01");
+  apply_override(p, "output.snapshot_times=[0.005, 0.015]");
+  const fs::path d = fs::temp_directory_path() / "boycott_snapshots";
+  fs::remove_all(d);
+  ASSERT_EQ(run_in(p, d), kExitOk);
+  const fs::path xmf = d / "snapshots" / "fields.xmf";
+  ASSERT_TRUE(fs::exists(xmf));
+  const std::string text = slurp(xmf);
+  // Well-formed: every element closed in order (no system() to an XML parser: forking after
+  // MPI_Init hangs Open MPI).
+  {
+    static const std::regex tag(R"(<(/?)([A-Za-z?][^ >/]*)[^>]*?(/?)>)");
+    std::vector<std::string> stack;
+    for (std::sregex_iterator it(text.begin(), text.end(), tag), end; it != end; ++it) {
+      const std::string name = (*it)[2].str();
+      if (name[0] == '?' || (*it)[3].str() == "/") continue;
+      if ((*it)[1].str() == "/") {
+        ASSERT_FALSE(stack.empty()) << "unexpected </" << name << ">";
+        ASSERT_EQ(stack.back(), name);
+        stack.pop_back();
+      } else {
+        stack.push_back(name);
+      }
+    }
+    EXPECT_TRUE(stack.empty());
+    EXPECT_NE(text.find("<Xdmf"), std::string::npos);
+  }
+  static const std::regex item(R"(Dimensions=\"([0-9 ]+)\">([^:<]+):/([^<]+)</DataItem>)");
+  int checked = 0;
+  for (std::sregex_iterator it(text.begin(), text.end(), item), end; it != end; ++it) {
+    std::istringstream dims((*it)[1].str());
+    std::size_t n = 1, v;
+    while (dims >> v) n *= v;
+    io::CheckpointReader r(d / "snapshots" / (*it)[2].str());
+    ASSERT_TRUE(r.has((*it)[3].str())) << (*it)[3].str();
+    EXPECT_EQ(r.doubles((*it)[3].str()).size(), n) << (*it)[3].str();
+    ++checked;
+  }
+  // 2 times x (3 coordinates + 4 particle attributes + 5 fluid fields)
+  EXPECT_EQ(checked, 24);
+  io::CheckpointReader r(d / "snapshots" / "snap_00000.h5");
+  EXPECT_EQ(r.doubles("particles/x").size(), summary(d)["particle_count"].get<std::size_t>());
+  EXPECT_NEAR(r.scalar("time"), 0.005, 1e-12);
 }
 
 }  // namespace
