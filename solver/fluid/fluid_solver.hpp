@@ -16,7 +16,7 @@
 // Discretisation: finite volume, BDF2 (variable step) in time, QUICK convection by deferred
 // correction on implicit upwind, central diffusion and pressure gradient, SIMPLE with
 // under-relaxation; linear systems by PETSc KSP with prefixes "momentum_" and "pressure_"
-// (defaults: BiCGStab + block Jacobi/ILU; CG + hypre BoomerAMG, constant null space removed).
+// (defaults: BiCGStab + block Jacobi/ILU; GMRES + hypre BoomerAMG, constant null space removed).
 #include <mpi.h>
 #include <petscdmda.h>
 #include <petscksp.h>
