@@ -13,6 +13,7 @@
 #include "core/statistics.hpp"
 #include "core/version.hpp"
 #include "io/checkpoint_file.hpp"
+#include "io/png_image.hpp"
 #include "io/snapshot.hpp"
 #include "io/state_io.hpp"
 #include "coupling/drag_laws.hpp"
@@ -115,6 +116,11 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   std::size_t next_snap = 0;
   while (next_snap < snaps.size() && snaps[next_snap] <= run.time_s() + 1e-12) ++next_snap;
   if (!snaps.empty()) timers.activate("snapshots", fmt::format("HDF5 + XDMF at {} times", snaps.size()));
+  std::vector<double> images = p.output.image_times_s;
+  std::sort(images.begin(), images.end());
+  std::size_t next_image = 0;
+  while (next_image < images.size() && images[next_image] <= run.time_s() + 1e-12) ++next_image;
+  if (!images.empty()) timers.activate("images", fmt::format("PNG of the x-z plane at {} times", images.size()));
   int exit_code = kExitOk;
   SummaryBase sb;
   const double end = p.time.end_s;
@@ -145,6 +151,13 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       ModelTimers::Scope sc(timers, "snapshots");
       io::write_snapshot(ctx.out_dir, static_cast<int>(next_snap), run.snapshot(), run.fluid().settings().grid);
       ++next_snap;
+    }
+    while (next_image < images.size() && t >= images[next_image] - 1e-12) {
+      ModelTimers::Scope sc(timers, "images");
+      const io::ParticleView view{&s.x, &s.y, &s.z, &s.radius, s.n_local, p.domain.length_x_m, p.domain.width_y_m,
+                                  p.domain.height_z_m};
+      io::write_particle_png(ctx.out_dir / fmt::format("particles_t{:.3f}.png", images[next_image]), view);
+      ++next_image;
     }
     const bool stop = ctx.should_stop();
     // Also at the end: the final state stays inspectable (and comparable across restarts).
