@@ -10,28 +10,12 @@
 #include "core/error.hpp"
 #include "core/statistics.hpp"
 #include "particles/dem_system.hpp"
+#include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scenes_list.hpp"
 
 namespace boycott::scenes {
 
-namespace {
-
-/// Inserts the case's particles: uniformly in the box ("random") or into the lower part of the
-/// channel at a loose solid fraction of 0.3 ("bed"), from which gravity settles them.
-void insert_particles(particles::DemSystem& dem, const CaseParams& p) {
-  const double r = 0.5 * p.particles.diameter_m;
-  const auto& b = dem.config().box;
-  std::array<double, 3> lo = b.lo, hi = {b.lo[0] + b.len[0], b.lo[1] + b.len[1], b.lo[2] + b.len[2]};
-  if (p.particles.insertion == "bed") {
-    constexpr double kLooseFraction = 0.3;
-    const double h = p.particles.count * p.particle_volume_m3() / (kLooseFraction * b.len[0] * b.len[2]);
-    hi[1] = std::min(hi[1], b.lo[1] + h + 2.0 * r);
-  }
-  dem.insert_random(p.particles.count, r, p.particles.density_kg_m3, lo, hi, static_cast<std::uint64_t>(p.seed));
-}
-
-}  // namespace
 
 int run_dem_only(const CaseParams& p, RunContext& ctx) {
   WallClock clock;
@@ -41,7 +25,7 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
                                  p.forces.drag));
   ModelTimers timers;
   particles::DemSystem dem(particles::DemConfig::from_case(p));
-  insert_particles(dem, p);
+  insert_case_particles(dem, p);
   auto& s = dem.particles();
   const bool stokes = p.forces.drag == "stokes";
   if (stokes) {
