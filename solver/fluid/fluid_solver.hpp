@@ -16,7 +16,9 @@
 // Discretisation: finite volume, BDF2 (variable step) in time, QUICK convection by deferred
 // correction on implicit upwind, central diffusion and pressure gradient, SIMPLE with
 // under-relaxation; linear systems by PETSc KSP with prefixes "momentum_" and "pressure_"
-// (defaults: BiCGStab + block Jacobi/ILU; GMRES + hypre BoomerAMG, constant null space removed).
+// (defaults: BiCGStab + block Jacobi/ILU; GMRES + BoomerAMG on one rank, GMRES + GAMG on
+// several, constant null space removed; the other AMG, prefix "pressure_fallback_", redoes a
+// failed pressure solve).
 #include <mpi.h>
 #include <petscdmda.h>
 #include <petscksp.h>
@@ -148,6 +150,8 @@ class FluidSolver {
   StepReport step(double dt_s);
   double time_s() const { return time_; }
   int steps_done() const { return steps_; }
+  /// Pressure solves that failed with the default solver and were redone with GAMG.
+  int pressure_fallbacks() const { return pressure_fallbacks_; }
 
   // ---- diagnostics ----
   /// Volume mean of alpha_f w over the domain (m/s).
@@ -184,6 +188,8 @@ class FluidSolver {
   Mat A_ = nullptr;    // momentum matrix (one component at a time)
   Mat Ap_ = nullptr;   // pressure-correction matrix
   KSP ksp_m_ = nullptr, ksp_p_ = nullptr;
+  KSP ksp_p_fallback_ = nullptr;  // GAMG, created on the first failed pressure solve
+  int pressure_fallbacks_ = 0;
   MatNullSpace null_ = nullptr;
 
   // global vectors

@@ -193,6 +193,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   j["particle_count"] = s.n_local;
   j["solid_fraction"] = p.solid_fraction();
   j["cfd_steps"] = run.steps();
+  j["pressure_solver_fallbacks"] = run.fluid().pressure_fallbacks();
   j["dem_steps"] = run.dem().steps();
   j["samples_averaged"] = wp_avg.count();
   j["resumed_from_checkpoint"] = ck.has_value();

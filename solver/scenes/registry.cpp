@@ -1,3 +1,5 @@
+#include <mpi.h>
+
 #include <fstream>
 #include <map>
 
@@ -42,7 +44,12 @@ int run_case(CaseParams params, RunContext& ctx) {
       throw CheckpointError(fmt::format("{} holds case {} but this is case {}; use another --out folder",
                                         ctx.out_dir.string(), case_id(case_from_json(stored)), case_id(params)));
   } else {
-    write_file_atomic(params_path, canonical.dump(2) + "\n");
+    // One writer: under mpirun every rank runs this, and they would race on the temporary file.
+    int rank = 0, initialized = 0;
+    MPI_Initialized(&initialized);
+    if (initialized) MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    if (rank == 0) write_file_atomic(params_path, canonical.dump(2) + "\n");
+    if (initialized) MPI_Barrier(MPI_COMM_WORLD);
   }
   return fn(params, ctx);
 }
