@@ -8,6 +8,7 @@
 #include "core/case_params.hpp"
 #include "core/error.hpp"
 #include "fluid/petsc_session.hpp"
+#include "scenes/preflight.hpp"
 #include "scenes/scene.hpp"
 
 namespace boycott::driver {
@@ -49,10 +50,17 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv) {
 
 int case_check(const std::string& file, const std::vector<std::string>& sets) {
   CaseParams p = load(file, sets);
-  std::printf("case %s (scene %s): valid\n", case_id(p).c_str(), p.scene.c_str());
-  std::printf("  particles %lld, solid fraction %.4f\n", static_cast<long long>(p.particles.count), p.solid_fraction());
-  std::printf("  dt_dem %.4g us, spring limit %.4g us (%.1f %%)\n", p.time.dt_dem_s * 1e6, p.dem_spring_limit_s() * 1e6,
-              100.0 * p.time.dt_dem_s / p.dem_spring_limit_s());
+  const scenes::Preflight pre = scenes::preflight(p);
+  std::printf("case %s (scene %s): %s\n", case_id(p).c_str(), p.scene.c_str(),
+              pre.errors.empty() ? (pre.warnings.empty() ? "valid" : "valid, with warnings") : "REFUSED");
+  std::printf("  particles %lld, solid fraction %.4f, dt_dem %.4g us, dt_cfd %.4g ms\n",
+              static_cast<long long>(p.particles.count), p.solid_fraction(), p.time.dt_dem_s * 1e6,
+              p.time.dt_cfd_s * 1e3);
+  std::fputs(pre.text().c_str(), stdout);
+  if (!pre.errors.empty()) {
+    std::fprintf(stderr, "error: %s\n", pre.errors.front().c_str());
+    return kExitInputError;
+  }
   return 0;
 }
 

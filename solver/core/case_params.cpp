@@ -365,6 +365,9 @@ void apply_override(CaseParams& p, const std::string& assignment) {
     }
   });
   if (!found) throw InputError(fmt::format("--set: unknown key '{}'", key));
+  // The particle load is given one way or the other; the later assignment wins (otherwise a
+  // count set over a case file's volume_fraction would be silently ignored).
+  if (key == "particles.count") p.particles.volume_fraction = kUnset;
 }
 
 void validate(CaseParams& p) {

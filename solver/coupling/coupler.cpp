@@ -273,9 +273,13 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
     }
   }
   fs.end_deposition();
-  double amin = 1.0;
-  for (double v : solid_.a) amin = std::min(amin, 1.0 - v);
+  double amin = 1.0, amax = 0.0;
+  for (double v : solid_.a) {
+    amin = std::min(amin, 1.0 - v);
+    amax = std::max(amax, 1.0 - v);
+  }
   totals_.min_alpha_f = amin;
+  totals_.max_alpha_f = amax;
   seconds_deposit += since(t0);
 }
 

@@ -54,7 +54,8 @@ struct ExchangeTotals {
   /// Momentum the last step's time-level lag created (fluid at n+1 against particles at n),
   /// measured by prepare, N s.
   std::array<double, 3> lag_impulse_ns{};
-  double min_alpha_f = 1.0;
+  double min_alpha_f = 1.0;  ///< smallest and largest cell fluid fraction after the last deposit
+  double max_alpha_f = 1.0;
 };
 
 class Coupler {

@@ -62,6 +62,18 @@ CoupledStep CoupledRun::step() {
       s.drag_jz[i] = dt * s.beta[i] * (s.ufz[i] - s.vz[i]);
     }
   }
+  // NaN or Inf stops the run here, before the kernels turn a position into a cell index and
+  // before anything is checkpointed (the scene's last good checkpoint stays the newest).
+  {
+    const auto& s = dem_->particles();
+    double sum = 0.0;
+    for (std::size_t i = 0; i < s.n_local; ++i)
+      sum += s.x[i] + s.y[i] + s.z[i] + s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i];
+    if (!std::isfinite(sum))
+      throw PhysicsError(fmt::format("particle state became NaN or Inf at t = {:.6g} s (CFD step {}); nothing was "
+                                     "checkpointed after the last good state",
+                                     time_ + dt, steps_ + 1));
+  }
   coupler_->deposit(*dem_, *fluid_, dt);
   if (opt_.zero_slurry_flux) {
     // Eq. 25: the fluid's flux controller finds the G that makes alpha_f <w_f> cancel the

@@ -56,6 +56,8 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   Histogram pdf_w(-wrange, 0.5 * wrange, bins);
   BatchMeans wp_avg, wf_avg, slurry_avg;
   double slurry_max = 0.0, next_out = 0.0, wall_before = 0.0;
+  // Stability record over the whole run (issue 7): alpha_f range and the largest kinetic energy.
+  double alpha_min_seen = 1.0, alpha_max_seen = 0.0, ke_max_seen = 0.0;
   const std::string id = case_id(p);
 
   // Resume from the newest checkpoint, or start.
@@ -73,6 +75,11 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     io::load(r, "stats.pdf_w.", pdf_w);
     slurry_max = r.scalar("stats.slurry_max");
     next_out = r.scalar("stats.next_out");
+    if (r.has("stats.alpha_min_seen")) {  // absent in checkpoints of earlier builds
+      alpha_min_seen = r.scalar("stats.alpha_min_seen");
+      alpha_max_seen = r.scalar("stats.alpha_max_seen");
+      ke_max_seen = r.scalar("stats.ke_max_seen");
+    }
     wall_before = r.scalar("run.wall_time_s");
     truncate_csv_after(ctx.out_dir / "timeseries.csv", run.time_s());
     if (!ctx.quiet) std::fprintf(stderr, "resuming from %s at t = %g s\n", ck->c_str(), run.time_s());
@@ -98,6 +105,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     io::save(w, "stats.pdf_w.", pdf_w);
     w.put("stats.slurry_max", slurry_max);
     w.put("stats.next_out", next_out);
+    w.put("stats.alpha_min_seen", alpha_min_seen);
+    w.put("stats.alpha_max_seen", alpha_max_seen);
+    w.put("stats.ke_max_seen", ke_max_seen);
     w.put("run.wall_time_s", wall_before + clock.seconds());
     w.commit();
     io::prune_checkpoints(ctx.out_dir, static_cast<int>(p.output.keep_checkpoints));
@@ -130,6 +140,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     const double wp = run.mean_particle_velocity(2);
     const double wf = run.mean_fluid_velocity_z();
     const double slurry = run.slurry_velocity_z();
+    alpha_min_seen = std::min(alpha_min_seen, run.coupler().totals().min_alpha_f);
+    alpha_max_seen = std::max(alpha_max_seen, run.coupler().totals().max_alpha_f);
+    ke_max_seen = std::max(ke_max_seen, run.dem().kinetic_energy_j());
     if (t > p.time.average_from_s + 1e-12) {
       wp_avg.add(wp);
       wf_avg.add(wf);
@@ -193,6 +206,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   j["particle_count"] = s.n_local;
   j["solid_fraction"] = p.solid_fraction();
   j["cfd_steps"] = run.steps();
+  j["min_fluid_fraction"] = alpha_min_seen;
+  j["max_fluid_fraction"] = alpha_max_seen;
+  j["max_kinetic_energy_j"] = ke_max_seen;
   j["pressure_solver_fallbacks"] = run.fluid().pressure_fallbacks();
   j["dem_steps"] = run.dem().steps();
   j["samples_averaged"] = wp_avg.count();

@@ -1,11 +1,13 @@
 #include <mpi.h>
 
+#include <cstdio>
 #include <fstream>
 #include <map>
 
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "scenes/preflight.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scene.hpp"
 #include "scenes/scenes_list.hpp"
@@ -28,6 +30,9 @@ SceneFn find_scene(const std::string& name) {
 int run_case(CaseParams params, RunContext& ctx) {
   validate(params);
   const SceneFn fn = find_scene(params.scene);
+  // Refused before anything is written: a case that cannot work leaves the folder as it was.
+  const Preflight pre = preflight(params);
+  if (!pre.errors.empty()) throw InputError(pre.errors.front());
   std::filesystem::create_directories(ctx.out_dir);
   const auto params_path = ctx.out_dir / "params.json";
   const auto canonical = to_json(params);
@@ -50,6 +55,16 @@ int run_case(CaseParams params, RunContext& ctx) {
     if (initialized) MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     if (rank == 0) write_file_atomic(params_path, canonical.dump(2) + "\n");
     if (initialized) MPI_Barrier(MPI_COMM_WORLD);
+  }
+  {
+    int rank = 0, initialized = 0;
+    MPI_Initialized(&initialized);
+    if (initialized) MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    if (rank == 0) {
+      write_file_atomic(ctx.out_dir / "preflight.json", pre.to_json().dump(2) + "\n");
+      if (!ctx.quiet)
+        for (const auto& w : pre.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    }
   }
   return fn(params, ctx);
 }

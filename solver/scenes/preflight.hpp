@@ -1,0 +1,40 @@
+#pragma once
+// Pre-flight report of a case (issue 7): the dimensionless groups and time-step ratios that
+// decide whether a run can work, computed before anything is allocated. `validate()` in
+// core/case_params refuses what cannot work at all (spring limit, overfilled box, d >= W, ...);
+// this report adds warnings for what is doubtful and errors for what the coupled solver cannot
+// represent, and is printed by `boycott case check` and before every `case run`.
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/case_params.hpp"
+
+namespace boycott::scenes {
+
+struct PreflightItem {
+  std::string name;   ///< e.g. "Re_p"
+  double value = 0.0;
+  std::string unit;   ///< "" for dimensionless
+  std::string meaning;
+};
+
+struct Preflight {
+  std::vector<PreflightItem> items;
+  std::vector<std::string> warnings;  ///< doubtful: the run goes ahead
+  std::vector<std::string> errors;    ///< cannot work: the run is refused
+
+  nlohmann::json to_json() const;
+  /// Human-readable table, one item per line, then warnings and errors.
+  std::string text() const;
+};
+
+/// Computes the report for a validated case. Never throws for physics reasons: it collects.
+Preflight preflight(const CaseParams& p);
+
+/// Binary collision time of the linear spring-dashpot for two equal spheres with restitution e
+/// (s): pi / (omega_0 sqrt(1 - zeta^2)), omega_0 = sqrt(k / m_eff), m_eff = m / 2.
+double collision_time_s(double mass_kg, double stiffness_n_m, double restitution);
+
+}  // namespace boycott::scenes
