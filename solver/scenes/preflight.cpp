@@ -49,6 +49,10 @@ Preflight preflight(const CaseParams& p) {
     add("Ga", std::sqrt(g * W * W * W) / nu, "", "Galileo number sqrt(g W^3)/nu (Eq. 26)");
   }
   if (!parts) return r;
+  if (p.scene == "inclined_settling" && p.domain.periodic_y && std::abs(std::cos(p.gravity.angle_deg * kPi / 180.0)) > 1e-9)
+    r.errors.push_back(fmt::format("domain.periodic_y = true needs gravity.angle_deg = 90, not {}: in a fully periodic "
+                                   "box only the z driving gradient holds the weight (homogeneous suspension)",
+                                   p.gravity.angle_deg));
 
   const double m = p.particle_mass_kg();
   add("Sg", rho_p / rho_f, "", "density ratio rho_p/rho_f (Eq. 26)");
