@@ -7,8 +7,13 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "driver/report_util.hpp"
 
 namespace boycott::driver {
+
+using report::marker;
+using report::ticks;
+using report::xml_escape;
 
 CurveFormat parse_curve_format(const std::string& s) {
   if (s == "table") return CurveFormat::kTable;
@@ -60,57 +65,6 @@ struct Panel {
   double py(double v) const { return y0 + h - (v - vmin) / (vmax - vmin) * h; }
 };
 
-/// Round numbers for ticks over [lo, hi].
-std::vector<double> ticks(double lo, double hi) {
-  const double span = hi - lo;
-  const double raw = span / 5.0;
-  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
-  double step = mag;
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * mag >= raw) {
-      step = m * mag;
-      break;
-    }
-  std::vector<double> t;
-  for (double v = std::ceil(lo / step) * step; v <= hi + 1e-9 * span; v += step)
-    t.push_back(std::abs(v) < 1e-12 * step ? 0.0 : v);
-  return t;
-}
-
-const char* kColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd",
-                         "#ff7f0e", "#8c564b", "#e377c2", "#17becf"};
-const char* kMarks[] = {"circle", "square", "diamond", "triangle"};
-
-std::string marker(const char* kind, double x, double y, const char* color) {
-  const std::string k = kind;
-  if (k == "circle") return fmt::format("<circle cx='{:.1f}' cy='{:.1f}' r='4' fill='{}'/>", x, y, color);
-  if (k == "square")
-    return fmt::format("<rect x='{:.1f}' y='{:.1f}' width='8' height='8' fill='{}'/>", x - 4, y - 4, color);
-  if (k == "diamond")
-    return fmt::format(
-        "<polygon points='{:.1f},{:.1f} {:.1f},{:.1f} {:.1f},{:.1f} {:.1f},{:.1f}' fill='{}'/>", x, y - 5,
-        x + 5, y, x, y + 5, x - 5, y, color);
-  return fmt::format("<polygon points='{:.1f},{:.1f} {:.1f},{:.1f} {:.1f},{:.1f}' fill='{}'/>", x, y - 5,
-                     x + 5, y + 4, x - 5, y + 4, color);
-}
-
-std::string xml_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '<')
-      o += "&lt;";
-    else if (c == '>')
-      o += "&gt;";
-    else if (c == '&')
-      o += "&amp;";
-    else if (c == '\'')
-      o += "&apos;";
-    else
-      o += c;
-  }
-  return o;
-}
-
 }  // namespace
 
 std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& title) {
@@ -158,7 +112,7 @@ std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& tit
         "<text transform='translate({:.1f},{:.1f}) rotate(-90)' text-anchor='middle'>{}</text>\n", pn.x0 - 55,
         pn.y0 + pn.h / 2, panel == 0 ? "⟨⟨w_p⟩⟩ (mm/s)" : "r_acc = ⟨⟨w_p⟩⟩ / ⟨⟨w_p⟩⟩(90°)");
     for (std::size_t g = 0; g < groups.size(); ++g) {
-      const char* color = kColors[g % 8];
+      const char* color = report::color(g);
       std::string line;
       std::string marks;
       for (const auto& p : pts) {
@@ -173,7 +127,7 @@ std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& tit
               "<line x1='{4:.1f}' y1='{1:.1f}' x2='{5:.1f}' y2='{1:.1f}' stroke='{3}'/>"
               "<line x1='{4:.1f}' y1='{2:.1f}' x2='{5:.1f}' y2='{2:.1f}' stroke='{3}'/>\n",
               x, pn.py(v->first - v->second), pn.py(v->first + v->second), color, x - 3, x + 3);
-        marks += marker(kMarks[g % 4], x, y, color) + "\n";
+        marks += marker(report::marker_kind(g), x, y, color) + "\n";
       }
       if (!line.empty())
         s += fmt::format(
@@ -183,7 +137,7 @@ std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& tit
       s += marks;
       if (panel == 1)
         s += fmt::format("{}<text x='{:.1f}' y='{:.1f}'>{}</text>\n",
-                         marker(kMarks[g % 4], pn.x0 + 18, pn.y0 + 18 + 18.0 * g, color), pn.x0 + 28,
+                         marker(report::marker_kind(g), pn.x0 + 18, pn.y0 + 18 + 18.0 * g, color), pn.x0 + 28,
                          pn.y0 + 22 + 18.0 * g, xml_escape(groups[g]));
     }
   }

@@ -16,6 +16,8 @@
 #include "driver/database.hpp"
 #include "driver/runner.hpp"
 #include "driver/store.hpp"
+#include "driver/validation_query.hpp"
+#include "driver/work_precision.hpp"
 
 namespace {
 
@@ -98,6 +100,21 @@ int main(int argc, char** argv) {
   qcurve->add_option("--group", q_group, "only this group");
   qcurve->add_option("--format", q_format, "table, csv or json")->capture_default_str();
   qcurve->add_option("--plot", q_plot, "also draw the curves (SVG, like Fig. 14 of the paper)");
+  auto* qvalid = query_cmd->add_subcommand(
+      "validation",
+      "per finished case: the scene's measured errors against its reference, and the wall time");
+  qvalid->add_option("--db", q_db, "results database")->required();
+  qvalid->add_option("--study", q_study, "only this study");
+  qvalid->add_option("--format", q_format, "table, csv or json")->capture_default_str();
+  std::string q_reference = "reference";
+  auto* qwork = query_cmd->add_subcommand(
+      "work-precision", "error of <<w_p>> and r_acc against the reference group, and the run time it cost");
+  qwork->add_option("--db", q_db, "results database")->required();
+  qwork->add_option("--study", q_study, "study name")->required();
+  qwork->add_option("--reference", q_reference, "group holding the reference runs, one per angle")
+      ->capture_default_str();
+  qwork->add_option("--format", q_format, "table, csv or json")->capture_default_str();
+  qwork->add_option("--plot", q_plot, "also draw |error| against wall time (SVG, log-log)");
   auto* qcases = query_cmd->add_subcommand("cases", "list cases and their status");
   qcases->add_option("--db", q_db, "results database")->required();
   qcases->add_option("--study", q_study, "only this study");
@@ -122,6 +139,32 @@ int main(int argc, char** argv) {
       if (!q_plot.empty()) {
         std::ofstream out(q_plot);
         out << boycott::driver::curve_svg(pts, fmt::format("study {}", q_study));
+        if (!out) throw std::runtime_error(fmt::format("cannot write '{}'", q_plot));
+      }
+      return 0;
+    });
+  if (qvalid->parsed())
+    return run_guarded([&] {
+      const auto fmt_kind = boycott::driver::parse_curve_format(q_format);
+      boycott::driver::Database db(q_db, boycott::driver::OpenMode::kExisting);
+      const auto rows = boycott::driver::query_validation(db, q_study);
+      std::fputs(boycott::driver::format_validation(rows, fmt_kind).c_str(), stdout);
+      return 0;
+    });
+  if (qwork->parsed())
+    return run_guarded([&] {
+      const auto fmt_kind = boycott::driver::parse_curve_format(q_format);
+      boycott::driver::Database db(q_db, boycott::driver::OpenMode::kExisting);
+      const auto wp = boycott::driver::query_work_precision(db, q_study, q_reference);
+      if (wp.rows.empty())
+        throw boycott::InputError(
+            fmt::format("no finished cases of study '{}' outside the reference group '{}' in '{}'", q_study,
+                        q_reference, q_db));
+      std::fputs(boycott::driver::format_work_precision(wp, fmt_kind).c_str(), stdout);
+      if (!q_plot.empty()) {
+        std::ofstream out(q_plot);
+        out << boycott::driver::work_precision_svg(
+            wp, fmt::format("study {}: error against run time (reference group '{}')", q_study, q_reference));
         if (!out) throw std::runtime_error(fmt::format("cannot write '{}'", q_plot));
       }
       return 0;

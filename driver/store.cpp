@@ -228,6 +228,22 @@ std::vector<CaseState> case_states(Database& db, const std::string& study, int r
   return out;
 }
 
+std::string SweptValue::display() const {
+  return value_num ? fmt::format("{:.6g}", *value_num) : value;
+}
+
+std::vector<SweptValue> case_swept_values(Database& db, const std::string& case_id) {
+  auto st = db.prepare("SELECT key, value, value_num FROM case_values WHERE case_id = ?1 ORDER BY key");
+  st.bind(1, case_id);
+  std::vector<SweptValue> out;
+  while (st.step()) {
+    SweptValue v{st.text(0), st.text(1), std::nullopt};
+    if (!st.is_null(2)) v.value_num = st.real(2);
+    out.push_back(std::move(v));
+  }
+  return out;
+}
+
 std::vector<CurvePoint> query_curve(Database& db, const std::string& study, const std::string& group) {
   auto st = db.prepare(
       "SELECT sc.group_name, c.id, c.angle_deg, r.mean_settling_velocity_m_s, "

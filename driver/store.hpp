@@ -48,6 +48,19 @@ struct CurvePoint {
   std::optional<double> r_acc, r_acc_err;  ///< <<w_p>>/<<w_p>>(90 deg); unset without a 90 deg case
 };
 
+/// A key a study sets on a case (group `set`, matrix, zip), as stored in case_values.
+struct SweptValue {
+  std::string key;
+  std::string value;                ///< TOML text, e.g. 2.0000000000000002e-05 or [200, 6, 100]
+  std::optional<double> value_num;  ///< when the value is a number
+  bool operator==(const SweptValue& o) const { return key == o.key && value == o.value; }
+  /// The value for people: numbers in 6 significant digits (the TOML text keeps all 17).
+  std::string display() const;
+};
+
+/// The swept values of one case, by key.
+std::vector<SweptValue> case_swept_values(Database& db, const std::string& case_id);
+
 /// The correlation curve of finished cases, per group in study order, by angle.
 std::vector<CurvePoint> query_curve(Database& db, const std::string& study, const std::string& group = "");
 

@@ -162,6 +162,7 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
   struct Group {
     std::string name;
     std::vector<std::pair<std::string, std::string>> sets;
+    std::vector<Axis> axes;  ///< the group's own [group.matrix] / [group.zip], before the study's
   };
   std::vector<Group> groups;
   if (const auto* ga = root["group"].as_array()) {
@@ -174,8 +175,16 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
         throw InputError("[[group]]: every group needs a non-empty string 'name'");
       g.name = *gname;
       for (const auto& [k, node] : *gt) {
-        if (k.str() != "name" && k.str() != "set")
-          throw InputError(fmt::format("group '{}': unknown key '{}' (expected name, set)", g.name, k.str()));
+        if (k.str() != "name" && k.str() != "set" && k.str() != "matrix" && k.str() != "zip")
+          throw InputError(
+              fmt::format("group '{}': unknown key '{}' (expected name, set, matrix, zip)", g.name, k.str()));
+      }
+      // A group may sweep its own keys (one setting varied at a time, as a work-precision study
+      // does); they combine with the study's [matrix] as a product.
+      try {
+        g.axes = read_axes(*gt);
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("group '{}': {}", g.name, e.what()));
       }
       if (const auto* set = (*gt)["set"].as_table()) {
         std::vector<std::pair<std::string, const toml::node*>> entries;
@@ -200,7 +209,9 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
   std::map<std::string, std::string> seen;  // id -> "group (values)"
   for (const auto& g : groups) {
     s.groups.push_back(g.name);
-    std::vector<std::size_t> idx(axes.size(), 0);
+    std::vector<Axis> all = g.axes;
+    all.insert(all.end(), axes.begin(), axes.end());
+    std::vector<std::size_t> idx(all.size(), 0);
     while (true) {
       StudyCase c;
       c.group = g.name;
@@ -210,10 +221,10 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
         apply_named(c.params, k, v, where);
         c.swept.emplace_back(k, v);
       }
-      for (std::size_t a = 0; a < axes.size(); ++a)
-        for (std::size_t k = 0; k < axes[a].keys.size(); ++k) {
-          apply_named(c.params, axes[a].keys[k], axes[a].points[idx[a]][k], where);
-          c.swept.emplace_back(axes[a].keys[k], axes[a].points[idx[a]][k]);
+      for (std::size_t a = 0; a < all.size(); ++a)
+        for (std::size_t k = 0; k < all[a].keys.size(); ++k) {
+          apply_named(c.params, all[a].keys[k], all[a].points[idx[a]][k], where);
+          c.swept.emplace_back(all[a].keys[k], all[a].points[idx[a]][k]);
         }
       std::string label = where;
       for (const auto& [k, v] : c.swept) label += fmt::format(" {}={}", k, v);
@@ -228,7 +239,7 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
       seen.emplace(c.id, label);
       s.cases.push_back(std::move(c));
       // Odometer over the axes, last axis fastest.
-      if (!advance(idx, axes)) break;
+      if (!advance(idx, all)) break;
     }
   }
   return s;

@@ -18,6 +18,7 @@ CoupledRun::CoupledRun(const CaseParams& p, const CoupledOptions& opt) : p_(p), 
   auto fs = fluid::FluidSettings::from_case(p);
   // The fluid feels gravity (alpha_f rho_f g in set II) and, in z, the driving gradient G.
   fs.body_acceleration_m_s2 = p.gravity_vector();
+  if (std::isfinite(opt.target_mean_flux_z_m_s)) fs.target_mean_flux_z_m_s = opt.target_mean_flux_z_m_s;
   fluid_ = std::make_unique<fluid::FluidSolver>(fs);
   coupler_ = std::make_unique<coupling::Coupler>(coupling::CouplingSettings::from_case(p), fs.grid);
 }

@@ -3,6 +3,7 @@
 // sample the fluid at the particles, sub-cycle the DEM, deposit volume and forces, set the
 // driving force, solve the fluid. Scenes choose what runs: frozen particles (no DEM), the
 // zero-slurry-velocity forcing of Eq. 25, which forces are on.
+#include <limits>
 #include <memory>
 
 #include "core/case_params.hpp"
@@ -18,6 +19,9 @@ namespace boycott::scenes {
 struct CoupledOptions {
   bool move_particles = true;   ///< false: frozen bed (ergun), no DEM steps
   bool zero_slurry_flux = true; ///< Eq. 25: hold alpha_f <w_f> + alpha_p <w_p> = 0 through G(t)
+  /// Instead of Eq. 25: hold the box mean of alpha_f w at this value (m/s) through G(t), e.g. the
+  /// bulk velocity of sediment transport; NaN = off.
+  double target_mean_flux_z_m_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct CoupledStep {

@@ -48,6 +48,17 @@ Preflight preflight(const CaseParams& p) {
   if (fluid) {
     add("Ga", std::sqrt(g * W * W * W) / nu, "", "Galileo number sqrt(g W^3)/nu (Eq. 26)");
   }
+  if (p.scene == "sediment_transport") {
+    if (std::abs(std::cos(p.gravity.angle_deg * kPi / 180.0) - 1.0) > 1e-9)
+      r.errors.push_back(fmt::format("gravity.angle_deg = {} for sediment_transport: must be 0 (gravity along -y)",
+                                     p.gravity.angle_deg));
+    if (p.domain.periodic_y)
+      r.errors.push_back("domain.periodic_y = true for sediment_transport: must be false (a bed on the wall y = 0)");
+    if (p.domain.top_wall != "slip")
+      r.warnings.push_back(fmt::format("domain.top_wall = \"{}\" for sediment_transport: the paper's top is a slip "
+                                       "(mirror) wall; the Shields stress assumes it",
+                                       p.domain.top_wall));
+  }
   if (!parts) return r;
   if (p.scene == "inclined_settling" && p.domain.periodic_y && std::abs(std::cos(p.gravity.angle_deg * kPi / 180.0)) > 1e-9)
     r.errors.push_back(fmt::format("domain.periodic_y = true needs gravity.angle_deg = 90, not {}: in a fully periodic "

@@ -21,6 +21,7 @@ SceneFn find_scene(const std::string& name) {
       {"inclined_settling", &run_inclined_settling},
       {"single_particle", &run_single_particle},
       {"ergun", &run_ergun},
+      {"sediment_transport", &run_sediment_transport},
   };
   auto it = table.find(name);
   if (it == table.end()) throw InputError(fmt::format("scene '{}' is not implemented yet", name));

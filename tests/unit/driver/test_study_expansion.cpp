@@ -136,6 +136,40 @@ name = "z"
   EXPECT_EQ(s.cases[0].group, "base");  // no [[group]]: one group named base
 }
 
+TEST(StudyExpansion, GroupMatrixVariesOneSettingAndCombinesWithTheStudyMatrix) {
+  const auto s = bd::expand_study_string(R"(
+name = "wp"
+[[group]]
+name = "reference"
+set = { "time.dt_dem" = 1.0e-5 }
+[[group]]
+name = "dt_cfd"
+[group.matrix]
+"time.dt_cfd" = [5.0e-4, 2.0e-3]
+[matrix]
+"gravity.angle_deg" = [65, 90]
+)");
+  ASSERT_EQ(s.cases.size(), 6u);  // 1 x 2 angles + 2 x 2 angles
+  int n_dt_cfd = 0;
+  for (const auto& c : s.cases) {
+    if (c.group != "dt_cfd") continue;
+    ++n_dt_cfd;
+    ASSERT_EQ(c.swept.size(), 2u);
+    EXPECT_EQ(c.swept[0].first, "time.dt_cfd");  // the group's own axis first, then the study's
+    EXPECT_EQ(c.swept[1].first, "gravity.angle_deg");
+    EXPECT_TRUE(c.params.time.dt_cfd_s == 5.0e-4 || c.params.time.dt_cfd_s == 2.0e-3);
+  }
+  EXPECT_EQ(n_dt_cfd, 4);
+  EXPECT_THROW(bd::expand_study_string(R"(
+name = "bad"
+[[group]]
+name = "g"
+[group.matrix]
+"time.no_such_key" = [1, 2]
+)"),
+               boycott::InputError);
+}
+
 TEST(StudyExpansion, CaseFileWrittenForTheSolverHasTheSameId) {
   for (const auto& c : bd::expand_study_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/paper.toml").cases) {
     auto p = boycott::parse_case_string(bd::case_to_toml(c.params));

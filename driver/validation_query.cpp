@@ -1,0 +1,146 @@
+#include "driver/validation_query.hpp"
+
+#include <set>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "driver/report_util.hpp"
+
+namespace boycott::driver {
+
+namespace {
+
+void require_study(Database& db, const std::string& study) {
+  if (study.empty()) return;
+  auto st = db.prepare("SELECT COUNT(*) FROM studies WHERE name = ?1");
+  st.bind(1, study);
+  st.step();
+  if (st.integer(0) == 0) throw InputError(fmt::format("no study '{}' in '{}'", study, db.path()));
+}
+
+/// A stored error for people. The scenes' "error" keys are relative errors ("rel" in the name);
+/// anything else (a count, an absolute error with a unit) is shown as it is.
+std::string table_text(const nlohmann::json& v, bool relative) {
+  if (v.is_null()) return "-";
+  if (v.is_number())
+    return relative ? report::percent(v.get<double>()) : fmt::format("{:.4g}", v.get<double>());
+  if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
+  if (v.is_string()) return v.get<std::string>();
+  std::string s;
+  if (v.is_array()) {
+    for (const auto& e : v) s += (s.empty() ? "" : ", ") + table_text(e, relative);
+    return "[" + s + "]";
+  }
+  for (const auto& [k, e] : v.items())
+    s += fmt::format("{}{}: {}", s.empty() ? "" : ", ", k, table_text(e, relative));
+  return "{" + s + "}";
+}
+
+std::string csv_text(const nlohmann::json& v) {
+  if (v.is_null()) return "";
+  if (v.is_number()) return fmt::format("{:.9g}", v.get<double>());
+  if (v.is_string()) return v.get<std::string>();
+  return v.dump();
+}
+
+std::string opt_csv(const std::optional<double>& v) {
+  return v ? fmt::format("{:.9g}", *v) : std::string();
+}
+nlohmann::json opt_json(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+}  // namespace
+
+std::vector<ValidationRow> query_validation(Database& db, const std::string& study) {
+  require_study(db, study);
+  // LEFT JOIN: without a study filter, a result whose case left every study still shows.
+  auto st = db.prepare(
+      "SELECT sc.study, sc.group_name, c.id, c.scene, r.mean_settling_velocity_m_s, r.wall_time_s, "
+      "r.validation_errors_json FROM results r JOIN cases c ON c.id = r.case_id "
+      "LEFT JOIN study_cases sc ON sc.case_id = c.id WHERE (?1 = '' OR sc.study = ?1) "
+      "ORDER BY sc.study IS NULL, sc.study, sc.position, c.id");
+  st.bind(1, study);
+  std::vector<ValidationRow> rows;
+  while (st.step()) {
+    ValidationRow r;
+    r.study = st.is_null(0) ? "-" : st.text(0);
+    r.group = st.is_null(1) ? "-" : st.text(1);
+    r.case_id = st.text(2);
+    r.scene = st.text(3);
+    if (!st.is_null(4)) r.w_m_s = st.real(4);
+    if (!st.is_null(5)) r.wall_time_s = st.real(5);
+    // Written by record_result as an object; anything else (hand-edited, older drivers) is shown
+    // as one entry rather than refused, so one odd row does not hide the others.
+    if (!st.is_null(6)) {
+      const auto j = nlohmann::json::parse(st.text(6), nullptr, /*allow_exceptions=*/false);
+      if (j.is_object())
+        for (const auto& [k, v] : j.items()) r.errors.emplace_back(k, v);
+      else if (!j.is_null())
+        r.errors.emplace_back("validation_errors_json", j.is_discarded() ? nlohmann::json(st.text(6)) : j);
+    }
+    rows.push_back(std::move(r));
+  }
+  for (auto& r : rows) r.values = case_swept_values(db, r.case_id);
+  return rows;
+}
+
+std::string format_validation(const std::vector<ValidationRow>& rows, CurveFormat f) {
+  if (f == CurveFormat::kJson) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto& r : rows) {
+      nlohmann::json values = nlohmann::json::object(), errors = nlohmann::json::object();
+      for (const auto& v : r.values) values[v.key] = report::value_json(v);
+      for (const auto& [k, v] : r.errors) errors[k] = v;
+      j.push_back({{"study", r.study},
+                   {"group", r.group},
+                   {"case_id", r.case_id},
+                   {"scene", r.scene},
+                   {"values", values},
+                   {"errors", errors},
+                   {"mean_settling_velocity_m_s", opt_json(r.w_m_s)},
+                   {"wall_time_s", opt_json(r.wall_time_s)}});
+    }
+    return j.dump(2) + "\n";
+  }
+  if (f == CurveFormat::kCsv) {
+    // Scenes report different keys: one column per key seen in any row, empty where absent.
+    std::set<std::string> keys;
+    for (const auto& r : rows)
+      for (const auto& e : r.errors) keys.insert(e.first);
+    std::string s = "study,group,case_id,scene,values,mean_settling_velocity_m_s,wall_time_s";
+    // Appended in two steps: GCC 12 warns (-Wrestrict, a false positive) on "," + std::string.
+    for (const auto& k : keys) s.append(",").append(report::csv_field(k));
+    s += "\n";
+    for (const auto& r : rows) {
+      s += fmt::format("{},{},{},{},{},{},{}", report::csv_field(r.study), report::csv_field(r.group),
+                       r.case_id, report::csv_field(r.scene),
+                       report::csv_field(r.values.empty() ? "" : report::join_values(r.values)),
+                       opt_csv(r.w_m_s), opt_csv(r.wall_time_s));
+      for (const auto& k : keys) {
+        std::string cell;
+        for (const auto& [ek, v] : r.errors)
+          if (ek == k) cell = csv_text(v);
+        s.append(",").append(report::csv_field(cell));
+      }
+      s += "\n";
+    }
+    return s;
+  }
+  if (rows.empty()) return "(no finished cases)\n";
+  report::TextTable t({"study", "group", "case", "scene", "<<w_p>> (mm/s)", "wall (s)", "values", "errors"},
+                      {false, false, false, false, true, true, false, false});
+  for (const auto& r : rows) {
+    std::string errs;
+    for (const auto& [k, v] : r.errors)
+      errs += fmt::format("{}{}={}", errs.empty() ? "" : "  ", k,
+                          table_text(v, k.find("rel") != std::string::npos));
+    t.add({r.study, r.group, r.case_id, r.scene, r.w_m_s ? fmt::format("{:.4f}", *r.w_m_s * 1e3) : "-",
+           r.wall_time_s ? report::seconds(*r.wall_time_s) : "-", report::join_values(r.values),
+           errs.empty() ? "-" : errs});
+  }
+  return t.str();
+}
+
+}  // namespace boycott::driver

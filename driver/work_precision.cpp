@@ -1,0 +1,369 @@
+#include "driver/work_precision.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "driver/report_util.hpp"
+
+namespace boycott::driver {
+
+namespace {
+
+constexpr const char* kAngleKey = "gravity.angle_deg";
+
+struct FinishedRun {
+  std::string group, case_id;
+  double angle_deg = 0;
+  double w = 0, w_err = 0;
+  std::optional<double> wall_time_s;
+  std::optional<std::int64_t> particle_steps;
+};
+
+std::vector<SweptValue> setting_of(Database& db, const std::string& case_id) {
+  auto v = case_swept_values(db, case_id);
+  std::erase_if(v, [](const SweptValue& x) { return x.key == kAngleKey; });
+  return v;
+}
+
+const FinishedRun& reference_at(const std::vector<FinishedRun>& refs, const std::string& ref_group,
+                                Database& db, const FinishedRun& run) {
+  std::vector<const FinishedRun*> found;
+  for (const auto& r : refs)
+    if (r.angle_deg == run.angle_deg) found.push_back(&r);
+  if (found.empty())
+    throw InputError(fmt::format(
+        "no finished case of reference group '{}' at {} = {:g} (needed by group '{}' case {}): run the "
+        "reference at that angle, or name another reference group with --reference",
+        ref_group, kAngleKey, run.angle_deg, run.group, run.case_id));
+  if (found.size() > 1) {
+    std::string names;
+    for (const auto* r : found)
+      names += fmt::format("{}{} ({})", names.empty() ? "" : ", ", r->case_id,
+                           report::join_values(setting_of(db, r->case_id)));
+    throw InputError(
+        fmt::format("reference group '{}' has {} finished cases at {} = {:g}: {}; a work-precision reference "
+                    "needs exactly "
+                    "one case per angle",
+                    ref_group, found.size(), kAngleKey, run.angle_deg, names));
+  }
+  if (found[0]->w == 0.0)
+    throw InputError(
+        fmt::format("reference case {} at {} = {:g} has <<w_p>> = 0: the relative error is undefined",
+                    found[0]->case_id, kAngleKey, run.angle_deg));
+  return *found[0];
+}
+
+std::string percent_pm(double e, double u) {
+  const double up = u * 100.0;
+  return fmt::format("{} +- {}", report::percent(e),
+                     up >= 0.01 || up == 0.0 ? fmt::format("{:.2f} %", up) : fmt::format("{:.2g} %", up));
+}
+
+std::string opt_csv(const std::optional<double>& v) {
+  return v ? fmt::format("{:.9g}", *v) : std::string();
+}
+nlohmann::json opt_json(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+}  // namespace
+
+WorkPrecision query_work_precision(Database& db, const std::string& study,
+                                   const std::string& reference_group) {
+  {
+    auto st = db.prepare("SELECT COUNT(*) FROM studies WHERE name = ?1");
+    st.bind(1, study);
+    st.step();
+    if (st.integer(0) == 0) throw InputError(fmt::format("no study '{}' in '{}'", study, db.path()));
+  }
+  std::vector<std::string> groups;  // study order
+  {
+    auto st = db.prepare(
+        "SELECT group_name FROM study_cases WHERE study = ?1 GROUP BY group_name ORDER BY MIN(position)");
+    st.bind(1, study);
+    while (st.step()) groups.push_back(st.text(0));
+  }
+  if (std::find(groups.begin(), groups.end(), reference_group) == groups.end()) {
+    std::string names;
+    for (const auto& g : groups) names += (names.empty() ? "" : ", ") + g;
+    throw InputError(
+        fmt::format("study '{}' has no group '{}' (its groups: {}): name the reference group with "
+                    "--reference",
+                    study, reference_group, names.empty() ? "none" : names));
+  }
+
+  std::vector<FinishedRun> refs, runs;
+  {
+    auto st = db.prepare(
+        "SELECT sc.group_name, c.id, c.angle_deg, r.mean_settling_velocity_m_s, "
+        "r.settling_velocity_stderr_m_s, "
+        "r.wall_time_s, r.particle_steps FROM study_cases sc JOIN cases c ON c.id = sc.case_id "
+        "JOIN results r ON r.case_id = c.id WHERE sc.study = ?1 AND r.mean_settling_velocity_m_s IS NOT NULL "
+        "ORDER BY sc.position");
+    st.bind(1, study);
+    while (st.step()) {
+      FinishedRun r{st.text(0),   st.text(1),  st.real(2), st.real(3), st.is_null(4) ? 0.0 : st.real(4),
+                    std::nullopt, std::nullopt};
+      if (!st.is_null(5)) r.wall_time_s = st.real(5);
+      if (!st.is_null(6)) r.particle_steps = st.integer(6);
+      (r.group == reference_group ? refs : runs).push_back(std::move(r));
+    }
+  }
+
+  WorkPrecision wp{study, reference_group, {}, {}};
+  for (const auto& run : runs) {
+    const auto& ref = reference_at(refs, reference_group, db, run);
+    WorkPrecisionRow row;
+    row.group = run.group;
+    row.case_id = run.case_id;
+    row.setting = setting_of(db, run.case_id);
+    row.angle_deg = run.angle_deg;
+    row.wall_time_s = run.wall_time_s;
+    row.particle_steps = run.particle_steps;
+    row.w_m_s = run.w;
+    row.w_err_m_s = run.w_err;
+    row.ref_case_id = ref.case_id;
+    row.w_ref_m_s = ref.w;
+    row.w_ref_err_m_s = ref.w_err;
+    // e = w/w_ref - 1; de/dw = 1/w_ref, de/dw_ref = -w/w_ref^2 (independent standard errors).
+    row.rel_error_w = run.w / ref.w - 1.0;
+    row.rel_error_w_unc = std::hypot(run.w_err / ref.w, run.w * ref.w_err / (ref.w * ref.w));
+    wp.rows.push_back(std::move(row));
+    if (std::none_of(wp.references.begin(), wp.references.end(),
+                     [&](const ReferenceRun& r) { return r.case_id == ref.case_id; }))
+      wp.references.push_back({ref.case_id, ref.angle_deg, ref.w, ref.w_err, ref.wall_time_s});
+  }
+
+  // r_acc against the reference's r_acc: the quantity the paper reports, whose error can be far
+  // smaller than that of <<w_p>> when a setting shifts all angles alike.
+  for (auto& row : wp.rows) {
+    if (row.angle_deg == 90.0) continue;
+    const WorkPrecisionRow* v90 = nullptr;
+    for (const auto& q : wp.rows)
+      if (q.group == row.group && q.angle_deg == 90.0 && q.setting == row.setting) v90 = &q;
+    if (!v90 || v90->w_m_s == 0.0) continue;
+    // R = (w / w90) / (wr / wr90); every reference w is non-zero (checked above).
+    const double w = row.w_m_s, w90 = v90->w_m_s, wr = row.w_ref_m_s, wr90 = v90->w_ref_m_s;
+    const double R = (w / w90) * (wr90 / wr);
+    row.rel_error_r_acc = R - 1.0;
+    const double dw = row.w_err_m_s * wr90 / (w90 * wr);
+    const double dw90 = R * v90->w_err_m_s / w90, dwr = R * row.w_ref_err_m_s / wr,
+                 dwr90 = R * v90->w_ref_err_m_s / wr90;
+    row.rel_error_r_acc_unc = std::sqrt(dw * dw + dw90 * dw90 + dwr * dwr + dwr90 * dwr90);
+  }
+
+  std::map<std::string, std::size_t> order;
+  for (std::size_t i = 0; i < groups.size(); ++i) order[groups[i]] = i;
+  std::stable_sort(wp.rows.begin(), wp.rows.end(), [&](const WorkPrecisionRow& a, const WorkPrecisionRow& b) {
+    if (a.group != b.group) return order[a.group] < order[b.group];
+    // Cases without a recorded wall time last.
+    if (a.wall_time_s.has_value() != b.wall_time_s.has_value()) return a.wall_time_s.has_value();
+    if (a.wall_time_s && *a.wall_time_s != *b.wall_time_s) return *a.wall_time_s < *b.wall_time_s;
+    return a.angle_deg < b.angle_deg;
+  });
+  std::sort(wp.references.begin(), wp.references.end(),
+            [](const ReferenceRun& a, const ReferenceRun& b) { return a.angle_deg < b.angle_deg; });
+  return wp;
+}
+
+std::string format_work_precision(const WorkPrecision& wp, CurveFormat f) {
+  if (f == CurveFormat::kJson) {
+    nlohmann::json refs = nlohmann::json::array(), rows = nlohmann::json::array();
+    for (const auto& r : wp.references)
+      refs.push_back({{"case_id", r.case_id},
+                      {"angle_deg", r.angle_deg},
+                      {"mean_settling_velocity_m_s", r.w_m_s},
+                      {"stderr_m_s", r.w_err_m_s},
+                      {"wall_time_s", opt_json(r.wall_time_s)}});
+    for (const auto& r : wp.rows) {
+      nlohmann::json setting = nlohmann::json::object();
+      for (const auto& v : r.setting) setting[v.key] = report::value_json(v);
+      rows.push_back(
+          {{"group", r.group},
+           {"setting", setting},
+           {"angle_deg", r.angle_deg},
+           {"wall_time_s", opt_json(r.wall_time_s)},
+           {"particle_steps", r.particle_steps ? nlohmann::json(*r.particle_steps) : nlohmann::json(nullptr)},
+           {"mean_settling_velocity_m_s", r.w_m_s},
+           {"stderr_m_s", r.w_err_m_s},
+           {"reference_m_s", r.w_ref_m_s},
+           {"reference_stderr_m_s", r.w_ref_err_m_s},
+           {"rel_error_w", r.rel_error_w},
+           {"rel_error_w_uncertainty", r.rel_error_w_unc},
+           {"rel_error_r_acc", opt_json(r.rel_error_r_acc)},
+           {"rel_error_r_acc_uncertainty", opt_json(r.rel_error_r_acc_unc)},
+           {"case_id", r.case_id},
+           {"reference_case_id", r.ref_case_id}});
+    }
+    const nlohmann::json j = {
+        {"study", wp.study}, {"reference_group", wp.reference_group}, {"references", refs}, {"rows", rows}};
+    return j.dump(2) + "\n";
+  }
+  if (f == CurveFormat::kCsv) {
+    std::string s =
+        "group,setting,angle_deg,wall_time_s,particle_steps,mean_settling_velocity_m_s,stderr_m_s,reference_"
+        "m_s,"
+        "reference_stderr_m_s,rel_error_w,rel_error_w_uncertainty,rel_error_r_acc,rel_error_r_acc_"
+        "uncertainty,"
+        "case_id,reference_case_id\n";
+    for (const auto& r : wp.rows)
+      s += fmt::format("{},{},{:g},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{},{}\n",
+                       report::csv_field(r.group), report::csv_field(report::join_values(r.setting)),
+                       r.angle_deg, opt_csv(r.wall_time_s),
+                       r.particle_steps ? std::to_string(*r.particle_steps) : "", r.w_m_s, r.w_err_m_s,
+                       r.w_ref_m_s, r.w_ref_err_m_s, r.rel_error_w, r.rel_error_w_unc,
+                       opt_csv(r.rel_error_r_acc), opt_csv(r.rel_error_r_acc_unc), r.case_id, r.ref_case_id);
+    return s;
+  }
+  if (wp.rows.empty())
+    return fmt::format("(no finished cases outside the reference group '{}')\n", wp.reference_group);
+  report::TextTable t({"group", "setting", "angle", "wall (s)", "particle steps", "<<w_p>> (mm/s)",
+                       "ref (mm/s)", "error <<w_p>>", "error r_acc"},
+                      {false, false, true, true, true, true, true, true, true});
+  for (const auto& r : wp.rows)
+    t.add({r.group, report::join_values(r.setting), fmt::format("{:g}", r.angle_deg),
+           r.wall_time_s ? report::seconds(*r.wall_time_s) : "-",
+           r.particle_steps ? std::to_string(*r.particle_steps) : "-", fmt::format("{:.4f}", r.w_m_s * 1e3),
+           fmt::format("{:.4f}", r.w_ref_m_s * 1e3), percent_pm(r.rel_error_w, r.rel_error_w_unc),
+           r.rel_error_r_acc ? percent_pm(*r.rel_error_r_acc, *r.rel_error_r_acc_unc) : "-"});
+  std::string s = t.str();
+  for (const auto& r : wp.references)
+    s += fmt::format("reference '{}' at {:g} deg: <<w_p>> {:.4f} +- {:.4f} mm/s, wall {} s, case {}\n",
+                     wp.reference_group, r.angle_deg, r.w_m_s * 1e3, r.w_err_m_s * 1e3,
+                     r.wall_time_s ? report::seconds(*r.wall_time_s) : "-", r.case_id);
+  return s;
+}
+
+std::string work_precision_svg(const WorkPrecision& wp, const std::string& title) {
+  using report::xml_escape;
+  constexpr double kFloor = kWorkPrecisionErrorFloor;
+  std::vector<std::string> groups;
+  for (const auto& r : wp.rows)
+    if (std::find(groups.begin(), groups.end(), r.group) == groups.end()) groups.push_back(r.group);
+
+  // Only positive wall times have a place on a log axis.
+  auto plotted = [](const WorkPrecisionRow& r) { return r.wall_time_s && *r.wall_time_s > 0; };
+  double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
+  bool any_floor = false;
+  for (const auto& r : wp.rows) {
+    if (!plotted(r)) continue;
+    xlo = std::min(xlo, *r.wall_time_s), xhi = std::max(xhi, *r.wall_time_s);
+    const double e = std::abs(r.rel_error_w);
+    any_floor = any_floor || e < kFloor;
+    ylo = std::min(ylo, std::max(e, kFloor));
+    yhi = std::max(yhi, std::max(e + r.rel_error_w_unc, kFloor));
+  }
+  for (const auto& r : wp.references)
+    if (r.wall_time_s && *r.wall_time_s > 0)
+      xlo = std::min(xlo, *r.wall_time_s), xhi = std::max(xhi, *r.wall_time_s);
+  if (!std::isfinite(xlo)) xlo = 1, xhi = 10;
+  if (!std::isfinite(ylo)) ylo = 1e-3, yhi = 1e-1;
+  // A margin of a fifth of a decade (at least one decade in view) keeps markers off the frame.
+  if (xhi / xlo < 10) {
+    const double m = std::sqrt(10 * xlo / xhi);
+    xlo /= m, xhi *= m;
+  }
+  if (yhi / ylo < 10) {
+    const double m = std::sqrt(10 * ylo / yhi);
+    ylo /= m, yhi *= m;
+  }
+  xlo /= 1.6, xhi *= 1.6, ylo /= 1.6, yhi *= 1.6;
+
+  const double x0 = 90, y0 = 50, w = 520, h = 380;
+  auto px = [&](double t) {
+    return x0 + (std::log10(t) - std::log10(xlo)) / (std::log10(xhi) - std::log10(xlo)) * w;
+  };
+  auto py = [&](double e) {
+    return y0 + h - (std::log10(e) - std::log10(ylo)) / (std::log10(yhi) - std::log10(ylo)) * h;
+  };
+
+  std::string s =
+      "<svg xmlns='http://www.w3.org/2000/svg' width='900' height='500' font-family='sans-serif' "
+      "font-size='13'>\n<rect width='900' height='500' fill='white'/>\n";
+  s += fmt::format("<text x='{:.1f}' y='26' text-anchor='middle' font-size='15'>{}</text>\n", x0 + w / 2,
+                   xml_escape(title));
+  s += fmt::format("<rect x='{}' y='{}' width='{}' height='{}' fill='none' stroke='black'/>\n", x0, y0, w, h);
+  for (double t : report::log_ticks(xlo, xhi))
+    s += fmt::format(
+        "<line x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' stroke='#ddd'/><text x='{0:.1f}' "
+        "y='{3:.1f}' "
+        "text-anchor='middle'>{4:g}</text>\n",
+        px(t), y0, y0 + h, y0 + h + 18, t);
+  for (double e : report::log_ticks(ylo, yhi))
+    s += fmt::format(
+        "<line x1='{0:.1f}' y1='{1:.1f}' x2='{2:.1f}' y2='{1:.1f}' stroke='#ddd'/><text x='{3:.1f}' "
+        "y='{4:.1f}' "
+        "text-anchor='end'>{5:g}</text>\n",
+        x0, py(e), x0 + w, x0 - 6, py(e) + 4, e);
+  s += fmt::format("<text x='{:.1f}' y='{:.1f}' text-anchor='middle'>wall time (s)</text>\n", x0 + w / 2,
+                   y0 + h + 40);
+  s += fmt::format(
+      "<text transform='translate({:.1f},{:.1f}) rotate(-90)' text-anchor='middle'>|⟨⟨w_p⟩⟩ / ⟨⟨w_p⟩⟩_ref − "
+      "1| "
+      "(dimensionless)</text>\n",
+      x0 - 62, y0 + h / 2);
+  if (any_floor)
+    s += fmt::format(
+        "<line class='floor' x1='{0:.1f}' y1='{1:.1f}' x2='{2:.1f}' y2='{1:.1f}' stroke='#999' "
+        "stroke-dasharray='2,3'/>\n",
+        x0, py(kFloor), x0 + w);
+
+  // The reference runs' cost: how much cheaper each point is than the run it is measured against.
+  for (const auto& r : wp.references) {
+    if (!r.wall_time_s || *r.wall_time_s <= 0) continue;
+    const double x = px(*r.wall_time_s);
+    // The label runs up along its line, so that references close in wall time stay readable.
+    s += fmt::format(
+        "<line class='reference' data-angle='{3:g}' x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' "
+        "stroke='#555' stroke-dasharray='6,4'/><text transform='translate({4:.1f},{5:.1f}) rotate(-90)' "
+        "font-size='11' fill='#555'>{6} {3:g}°</text>\n",
+        x, y0, y0 + h, r.angle_deg, x - 4, y0 + h - 6, xml_escape(wp.reference_group));
+  }
+
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const char* color = report::color(g);
+    const char* kind = report::marker_kind(g);
+    std::string line, marks;
+    for (const auto& r : wp.rows) {  // already by wall time within a group
+      if (r.group != groups[g] || !plotted(r)) continue;
+      const double e = std::abs(r.rel_error_w);
+      const bool at_floor = e < kFloor;
+      const double x = px(*r.wall_time_s), y = py(std::max(e, kFloor));
+      line += fmt::format("{:.1f},{:.1f} ", x, y);
+      if (r.rel_error_w_unc > 0)
+        marks += fmt::format("<line x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' stroke='{3}'/>\n", x,
+                             py(std::max(e - r.rel_error_w_unc, kFloor)),
+                             py(std::max(e + r.rel_error_w_unc, kFloor)), color);
+      marks += report::marker(kind, x, y, color, at_floor) + "\n";
+    }
+    s += fmt::format(
+        "<polyline class='group' data-group='{}' points='{}' fill='none' stroke='{}' stroke-width='1.5'/>\n",
+        xml_escape(groups[g]), line, color);
+    s += marks;
+  }
+
+  // Legend, right of the plot.
+  const double lx = x0 + w + 20;
+  double ly = y0 + 10;
+  for (std::size_t g = 0; g < groups.size(); ++g, ly += 20)
+    s += fmt::format("{}<text x='{:.1f}' y='{:.1f}'>{}</text>\n",
+                     report::marker(report::marker_kind(g), lx + 8, ly, report::color(g)), lx + 20, ly + 4,
+                     xml_escape(groups[g]));
+  s += fmt::format(
+      "<line x1='{0:.1f}' y1='{1:.1f}' x2='{2:.1f}' y2='{1:.1f}' stroke='#555' stroke-dasharray='6,4'/>"
+      "<text x='{3:.1f}' y='{4:.1f}'>reference wall time</text>\n",
+      lx, ly, lx + 16, lx + 20, ly + 4);
+  ly += 20;
+  if (any_floor)
+    s += fmt::format("{}<text x='{:.1f}' y='{:.1f}'>|error| &lt; {:g}, drawn at {:g}</text>\n",
+                     report::marker("circle", lx + 8, ly, "#555", true), lx + 20, ly + 4, kFloor, kFloor);
+  s += "</svg>\n";
+  return s;
+}
+
+}  // namespace boycott::driver

@@ -1,0 +1,321 @@
+// `query validation` and `query work-precision` on a database built through the real study API
+// (register_study, begin_attempt, record_result) with hand-made summaries.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+#include <gtest/gtest.h>
+
+#include "core/error.hpp"
+#include "driver/database.hpp"
+#include "driver/store.hpp"
+#include "driver/study.hpp"
+#include "driver/validation_query.hpp"
+#include "driver/work_precision.hpp"
+
+namespace bd = boycott::driver;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    char tmpl[] = "/tmp/boycott_querytest_XXXXXX";
+    path = mkdtemp(tmpl);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+// A work-precision study: fine reference, one coarser DEM step, one coarser mesh, at two angles.
+const char* kWorkPrecisionStudy = R"(
+name = "wp"
+[base.time]
+end = 2.0
+average_from = 1.0
+[[group]]
+name = "reference"
+set = { "time.dt_dem" = 1e-5 }
+[[group]]
+name = "dt_dem"
+set = { "time.dt_dem" = 4e-5 }
+[[group]]
+name = "cells"
+set = { "domain.cells" = [100, 6, 50] }
+[matrix]
+"gravity.angle_deg" = [65, 90]
+)";
+
+struct Run {
+  double w, err, wall;
+};
+
+nlohmann::json summary_of(const bd::StudyCase& c, const Run& r) {
+  return {{"scene", "inclined_settling"},
+          {"case_id", c.id},
+          {"status", "done"},
+          {"mean_settling_velocity_m_s", r.w},
+          {"settling_velocity_stderr_m_s", r.err},
+          {"simulated_time_s", 2.0},
+          {"wall_time_s", r.wall},
+          {"particle_steps", 1000}};
+}
+
+/// Records a result for every case of `study` that `runs` names by (group, angle).
+void record(bd::Database& db, const bd::Study& study,
+            const std::map<std::pair<std::string, double>, Run>& runs) {
+  for (const auto& c : study.cases) {
+    auto it = runs.find({c.group, c.params.gravity.angle_deg});
+    if (it == runs.end()) continue;
+    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, summary_of(c, it->second));
+  }
+}
+
+const bd::WorkPrecisionRow& row(const bd::WorkPrecision& wp, const std::string& group, double angle) {
+  for (const auto& r : wp.rows)
+    if (r.group == group && r.angle_deg == angle) return r;
+  throw std::runtime_error("no row " + group);
+}
+
+// Reference: w(65) = -0.1 +- 0.001, w(90) = -0.08 +- 0.0008.
+const std::map<std::pair<std::string, double>, Run> kRuns = {
+    {{"reference", 65}, {-0.1, 0.001, 400}}, {{"reference", 90}, {-0.08, 0.0008, 380}},
+    {{"dt_dem", 65}, {-0.11, 0.002, 100}},   {{"dt_dem", 90}, {-0.084, 0.0, 95}},
+    {{"cells", 65}, {-0.1, 0.001, 50}},      {{"cells", 90}, {-0.078, 0.0008, 60}},
+};
+
+std::string what_of(const std::function<void()>& fn) {
+  try {
+    fn();
+  } catch (const boycott::InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
+
+}  // namespace
+
+TEST(WorkPrecision, ErrorIsRelativeToTheReferenceOfTheSameAngle) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(kWorkPrecisionStudy);
+  bd::register_study(db, study);
+  record(db, study, kRuns);
+  const auto wp = bd::query_work_precision(db, "wp");
+  ASSERT_EQ(wp.rows.size(), 4u);  // the reference group is not compared with itself
+  const auto& r65 = row(wp, "dt_dem", 65);
+  EXPECT_DOUBLE_EQ(r65.w_ref_m_s, -0.1);
+  // w = -0.11 against w_ref = -0.1: settles 10 % faster.
+  EXPECT_NEAR(r65.rel_error_w, 0.10, 1e-12);
+  EXPECT_NEAR(row(wp, "dt_dem", 90).rel_error_w, -0.084 / -0.08 - 1.0, 1e-12);
+  EXPECT_NEAR(row(wp, "cells", 65).rel_error_w, 0.0, 1e-15);
+  EXPECT_EQ(r65.setting.size(), 1u);
+  EXPECT_EQ(r65.setting[0].key, "time.dt_dem");
+  EXPECT_DOUBLE_EQ(*r65.setting[0].value_num, 4e-5);
+  EXPECT_EQ(*r65.particle_steps, 1000);
+  ASSERT_EQ(wp.references.size(), 2u);
+  EXPECT_EQ(wp.references[0].angle_deg, 65.0);
+  EXPECT_DOUBLE_EQ(*wp.references[1].wall_time_s, 380.0);
+}
+
+TEST(WorkPrecision, UncertaintyPropagatesBothStandardErrorsToFirstOrder) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(kWorkPrecisionStudy);
+  bd::register_study(db, study);
+  record(db, study, kRuns);
+  const auto wp = bd::query_work_precision(db, "wp");
+  // e = w/w_ref - 1: sigma_e^2 = (s/w_ref)^2 + (w s_ref / w_ref^2)^2.
+  const double expected = std::sqrt(std::pow(0.002 / 0.1, 2) + std::pow(0.11 * 0.001 / 0.01, 2));
+  EXPECT_NEAR(row(wp, "dt_dem", 65).rel_error_w_unc, expected, 1e-12);
+  // A case without a standard error keeps the reference's.
+  EXPECT_NEAR(row(wp, "dt_dem", 90).rel_error_w_unc, 0.084 * 0.0008 / (0.08 * 0.08), 1e-12);
+}
+
+TEST(WorkPrecision, AccelerationRatioErrorComparesRatiosOfTheSameSetting) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(kWorkPrecisionStudy);
+  bd::register_study(db, study);
+  record(db, study, kRuns);
+  const auto wp = bd::query_work_precision(db, "wp");
+  const auto& r65 = row(wp, "dt_dem", 65);
+  // r_acc = 0.11/0.084 against the reference's 0.1/0.08 = 1.25.
+  const double R = (0.11 / 0.084) / 1.25;
+  ASSERT_TRUE(r65.rel_error_r_acc.has_value());
+  EXPECT_NEAR(*r65.rel_error_r_acc, R - 1.0, 1e-12);
+  // Independent relative errors add in quadrature (the 90 deg case has none).
+  EXPECT_NEAR(*r65.rel_error_r_acc_unc, R * std::sqrt(std::pow(0.002 / 0.11, 2) + 2 * std::pow(0.01, 2)),
+              1e-12);
+  EXPECT_NEAR(*row(wp, "cells", 65).rel_error_r_acc, (0.1 / 0.078) / 1.25 - 1.0, 1e-12);
+  // At 90 deg r_acc is 1 by definition: nothing to compare.
+  EXPECT_FALSE(row(wp, "dt_dem", 90).rel_error_r_acc.has_value());
+}
+
+TEST(WorkPrecision, RowsAreInStudyGroupOrderThenByWallTime) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(kWorkPrecisionStudy);
+  bd::register_study(db, study);
+  record(db, study, kRuns);
+  const auto wp = bd::query_work_precision(db, "wp");
+  std::vector<std::pair<std::string, double>> got;
+  for (const auto& r : wp.rows) got.emplace_back(r.group, *r.wall_time_s);
+  const std::vector<std::pair<std::string, double>> want = {
+      {"dt_dem", 95}, {"dt_dem", 100}, {"cells", 50}, {"cells", 60}};
+  EXPECT_EQ(got, want);
+  const auto table = bd::format_work_precision(wp, bd::CurveFormat::kTable);
+  EXPECT_NE(table.find("+10.00 % +- 2.28 %"), std::string::npos) << table;
+  EXPECT_NE(table.find("time.dt_dem=4e-05"), std::string::npos) << table;
+  const auto csv = bd::format_work_precision(wp, bd::CurveFormat::kCsv);
+  EXPECT_NE(csv.find("\"domain.cells=[100, 6, 50]\""), std::string::npos) << csv;  // quoted: it holds commas
+  const auto json = nlohmann::json::parse(bd::format_work_precision(wp, bd::CurveFormat::kJson));
+  EXPECT_EQ(json["rows"].size(), 4u);
+  EXPECT_TRUE(json["rows"][0]["rel_error_r_acc"].is_null());
+}
+
+TEST(WorkPrecision, MissingReferenceIsAnInputErrorNamingTheGroupAndAngle) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(kWorkPrecisionStudy);
+  bd::register_study(db, study);
+  auto runs = kRuns;
+  runs.erase({"reference", 65});
+  record(db, study, runs);
+  const auto msg = what_of([&] { bd::query_work_precision(db, "wp"); });
+  EXPECT_NE(msg.find("reference group 'reference'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("gravity.angle_deg = 65"), std::string::npos) << msg;
+  // A reference group the study does not have is named together with the groups it does have.
+  const auto msg2 = what_of([&] { bd::query_work_precision(db, "wp", "fine"); });
+  EXPECT_NE(msg2.find("no group 'fine'"), std::string::npos) << msg2;
+  EXPECT_NE(msg2.find("reference, dt_dem, cells"), std::string::npos) << msg2;
+  EXPECT_NE(what_of([&] { bd::query_work_precision(db, "nope"); }).find("no study 'nope'"),
+            std::string::npos);
+}
+
+TEST(WorkPrecision, TwoReferenceCasesAtOneAngleAreAnInputErrorNamingThem) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  // Two seeds per angle make the reference group ambiguous.
+  const auto study = bd::expand_study_string(R"(
+name = "wp2"
+[base.time]
+end = 2.0
+average_from = 1.0
+[[group]]
+name = "reference"
+set = { "time.dt_dem" = 1e-5 }
+[[group]]
+name = "dt_dem"
+set = { "time.dt_dem" = 4e-5 }
+[matrix]
+"gravity.angle_deg" = [90]
+seed = [1, 2]
+)");
+  bd::register_study(db, study);
+  std::vector<std::string> ref_ids;
+  for (const auto& c : study.cases) {
+    if (c.group == "reference") ref_ids.push_back(c.id);
+    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, summary_of(c, {-0.08, 0.001, 10}));
+  }
+  ASSERT_EQ(ref_ids.size(), 2u);
+  const auto msg = what_of([&] { bd::query_work_precision(db, "wp2"); });
+  EXPECT_NE(msg.find("2 finished cases at gravity.angle_deg = 90"), std::string::npos) << msg;
+  for (const auto& id : ref_ids) EXPECT_NE(msg.find(id), std::string::npos) << msg;
+}
+
+TEST(WorkPrecision, SvgHasOneLinePerGroupReferenceLinesAndFlagsZeroErrors) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(kWorkPrecisionStudy);
+  bd::register_study(db, study);
+  record(db, study, kRuns);
+  const auto svg = bd::work_precision_svg(bd::query_work_precision(db, "wp"), "wp & co");
+  auto count = [&](const std::string& needle) {
+    std::size_t n = 0;
+    for (auto p = svg.find(needle); p != std::string::npos; p = svg.find(needle, p + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_EQ(svg.substr(svg.size() - 7), "</svg>\n");
+  EXPECT_EQ(count("<"), count(">"));  // every tag closed, text escaped
+  EXPECT_EQ(count("<polyline"), 2u);
+  EXPECT_EQ(count("data-group='dt_dem'"), 1u);
+  EXPECT_EQ(count("data-group='cells'"), 1u);
+  EXPECT_EQ(count("class='reference'"), 2u);  // one per angle
+  EXPECT_NE(svg.find("wp &amp; co"), std::string::npos);
+  EXPECT_NE(svg.find("wall time (s)"), std::string::npos);
+  // cells at 65 deg equals the reference: drawn hollow on the floor of the log axis.
+  EXPECT_EQ(count("class='floor'"), 1u);
+  EXPECT_NE(svg.find("fill='white' stroke="), std::string::npos);
+}
+
+TEST(ValidationQuery, RowsListExactlyTheStoredErrorKeysWithTheirValues) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(kWorkPrecisionStudy);
+  bd::register_study(db, study);
+  const auto& c = study.cases[2];  // dt_dem, 65 deg
+  auto s = summary_of(c, {-0.11, 0.002, 100});
+  s["max_rel_error_vs_analytic"] = 0.0123;
+  s["rel_error"] = nullptr;  // NaN in the solver: no reference value
+  s["hindered_settling_rel_error"] = nlohmann::json::array({0.01, -0.02, nullptr});
+  s["mean_fluid_velocity_m_s"] = 0.001;
+  bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, s);
+
+  const auto rows = bd::query_validation(db, "wp");
+  ASSERT_EQ(rows.size(), 1u);
+  const auto& r = rows[0];
+  EXPECT_EQ(r.study, "wp");
+  EXPECT_EQ(r.group, "dt_dem");
+  EXPECT_EQ(r.case_id, c.id);
+  EXPECT_EQ(r.scene, "inclined_settling");
+  std::vector<std::string> keys;
+  for (const auto& e : r.errors) keys.push_back(e.first);
+  // The stored standard error contains "error" too but is not a validation error.
+  EXPECT_EQ(keys, (std::vector<std::string>{"hindered_settling_rel_error", "max_rel_error_vs_analytic",
+                                            "rel_error"}));
+  EXPECT_DOUBLE_EQ(r.errors[1].second.get<double>(), 0.0123);
+  EXPECT_TRUE(r.errors[2].second.is_null());
+  EXPECT_DOUBLE_EQ(*r.w_m_s, -0.11);
+  EXPECT_DOUBLE_EQ(*r.wall_time_s, 100.0);
+  ASSERT_EQ(r.values.size(), 2u);
+  EXPECT_EQ(r.values[0].key, "gravity.angle_deg");
+  EXPECT_EQ(r.values[1].key, "time.dt_dem");
+
+  const auto table = bd::format_validation(rows, bd::CurveFormat::kTable);
+  EXPECT_NE(table.find("max_rel_error_vs_analytic=+1.23 %"), std::string::npos) << table;
+  EXPECT_NE(table.find("rel_error=-"), std::string::npos) << table;
+  EXPECT_NE(table.find("hindered_settling_rel_error=[+1.00 %, -2.00 %, -]"), std::string::npos) << table;
+  EXPECT_NE(table.find("gravity.angle_deg=65; time.dt_dem=4e-05"), std::string::npos) << table;
+  const auto csv = bd::format_validation(rows, bd::CurveFormat::kCsv);
+  EXPECT_EQ(
+      csv.substr(0, csv.find('\n')),
+      "study,group,case_id,scene,values,mean_settling_velocity_m_s,wall_time_s,hindered_settling_rel_error,"
+      "max_rel_error_vs_analytic,rel_error");
+  EXPECT_NE(csv.find(",0.0123,\n"), std::string::npos) << csv;  // raw number; null is empty
+  const auto json = nlohmann::json::parse(bd::format_validation(rows, bd::CurveFormat::kJson));
+  EXPECT_TRUE(json[0]["errors"]["rel_error"].is_null());
+  EXPECT_DOUBLE_EQ(json[0]["values"]["time.dt_dem"].get<double>(), 4e-5);
+}
+
+TEST(ValidationQuery, OnlyFinishedCasesOfTheNamedStudyAreListed) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(kWorkPrecisionStudy);
+  bd::register_study(db, study);
+  record(db, study, {{{"reference", 90}, {-0.08, 0.001, 10}}, {{"cells", 65}, {-0.1, 0.001, 5}}});
+  // An unfinished attempt is not a result.
+  bd::begin_attempt(db, study.cases[2].id, 1, "x");
+  const auto rows = bd::query_validation(db, "wp");
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].group, "reference");  // study order
+  EXPECT_EQ(rows[1].group, "cells");
+  EXPECT_TRUE(rows[0].errors.empty());
+  EXPECT_NE(bd::format_validation(rows, bd::CurveFormat::kTable).find("  -\n"), std::string::npos);
+  EXPECT_EQ(bd::query_validation(db).size(), 2u);
+  EXPECT_NE(what_of([&] { bd::query_validation(db, "nope"); }).find("no study 'nope'"), std::string::npos);
+}
