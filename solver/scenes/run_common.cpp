@@ -1,5 +1,7 @@
 #include "scenes/run_common.hpp"
 
+#include <mpi.h>
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -47,6 +49,10 @@ nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const Mod
   j["settling_velocity_stderr_m_s"] = num_or_null(s.settling_velocity_stderr_m_s);
   j["models"] = timers.to_json();
   j["program_version"] = fmt::format("{}+{}", kVersion, kGitRevision);
+  int ranks = 1, initialized = 0;
+  MPI_Initialized(&initialized);
+  if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  j["mpi_ranks"] = ranks;
   return j;
 }
 
