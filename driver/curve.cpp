@@ -26,10 +26,10 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
   std::string s;
   auto opt = [](const std::optional<double>& v) { return v ? fmt::format("{:.6g}", *v) : std::string(); };
   if (f == CurveFormat::kCsv) {
-    s = "group,angle_deg,mean_settling_velocity_m_s,stderr_m_s,r_acc,r_acc_err,case_id\n";
+    s = "group,angle_deg,mean_settling_velocity_m_s,stderr_m_s,r_acc,r_acc_err,case_id,setting\n";
     for (const auto& p : pts)
-      s += fmt::format("{},{:g},{:.9g},{:.9g},{},{},{}\n", p.group, p.angle_deg, p.w_m_s, p.w_err_m_s,
-                       opt(p.r_acc), opt(p.r_acc_err), p.case_id);
+      s += fmt::format("{},{:g},{:.9g},{:.9g},{},{},{},{}\n", p.group, p.angle_deg, p.w_m_s, p.w_err_m_s,
+                       opt(p.r_acc), opt(p.r_acc_err), p.case_id, report::csv_field(p.setting));
   } else if (f == CurveFormat::kJson) {
     nlohmann::json j = nlohmann::json::array();
     for (const auto& p : pts) {
@@ -37,7 +37,8 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
                           {"angle_deg", p.angle_deg},
                           {"mean_settling_velocity_m_s", p.w_m_s},
                           {"stderr_m_s", p.w_err_m_s},
-                          {"case_id", p.case_id}};
+                          {"case_id", p.case_id},
+                          {"setting", p.setting}};
       e["r_acc"] = p.r_acc ? nlohmann::json(*p.r_acc) : nlohmann::json(nullptr);
       e["r_acc_err"] = p.r_acc_err ? nlohmann::json(*p.r_acc_err) : nlohmann::json(nullptr);
       j.push_back(e);
@@ -46,17 +47,20 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
   } else if (pts.empty()) {
     s = "(no finished cases)\n";
   } else {
-    s = fmt::format("{:<12} {:>6}  {:>24}  {:>18}\n", "group", "angle", "<<w_p>> (mm/s)", "r_acc");
+    s = fmt::format("{:<12} {:>6}  {:>24}  {:>18}  {}\n", "group", "angle", "<<w_p>> (mm/s)", "r_acc", "setting");
     for (const auto& p : pts) {
       const std::string r = p.r_acc ? fmt::format("{:.3f} +- {:.3f}", *p.r_acc, *p.r_acc_err) : "-";
-      s += fmt::format("{:<12} {:>6g}  {:>11.4f} +- {:<9.4f}  {:>18}\n", p.group, p.angle_deg, p.w_m_s * 1e3,
-                       p.w_err_m_s * 1e3, r);
+      s += fmt::format("{:<12} {:>6g}  {:>11.4f} +- {:<9.4f}  {:>18}  {}\n", p.group, p.angle_deg, p.w_m_s * 1e3,
+                       p.w_err_m_s * 1e3, r, p.setting);
     }
   }
   return s;
 }
 
 namespace {
+
+// One line per group, or per (group, setting) when a group sweeps more than the angle.
+std::string series_of(const CurvePoint& p) { return p.setting.empty() ? p.group : p.group + " " + p.setting; }
 
 struct Panel {
   double x0, y0, w, h;  // pixel box of the plot area
@@ -70,7 +74,7 @@ struct Panel {
 std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& title) {
   std::vector<std::string> groups;
   for (const auto& p : pts)
-    if (std::find(groups.begin(), groups.end(), p.group) == groups.end()) groups.push_back(p.group);
+    if (std::find(groups.begin(), groups.end(), series_of(p)) == groups.end()) groups.push_back(series_of(p));
 
   std::string s =
       "<svg xmlns='http://www.w3.org/2000/svg' width='1000' height='440' font-family='sans-serif' "
@@ -116,7 +120,7 @@ std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& tit
       std::string line;
       std::string marks;
       for (const auto& p : pts) {
-        if (p.group != groups[g]) continue;
+        if (series_of(p) != groups[g]) continue;
         auto v = value(p);
         if (!v) continue;
         const double x = pn.px(p.angle_deg), y = pn.py(v->first);

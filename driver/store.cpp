@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <map>
+#include <set>
 #include <thread>
 
 #include <fmt/format.h>
@@ -254,6 +255,7 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
   st.bind(1, study).bind(2, group);
   std::vector<CurvePoint> pts;
   std::map<std::string, std::int64_t> group_pos;
+  std::vector<std::int64_t> setting_pos;
   while (st.step()) {
     CurvePoint p;
     p.group = st.text(0);
@@ -263,17 +265,37 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
     p.w_err_m_s = st.is_null(4) ? 0.0 : st.real(4);
     auto& gp = group_pos.try_emplace(p.group, st.integer(5)).first->second;
     gp = std::min(gp, st.integer(5));
+    setting_pos.emplace_back(st.integer(5));
     pts.push_back(p);
+  }
+  // The setting names only what varies within the group (a group's own `set` is its name's job).
+  std::vector<std::vector<SweptValue>> swept(pts.size());
+  std::map<std::string, std::map<std::string, std::set<std::string>>> values_in_group;  // group -> key -> values
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    swept[i] = case_swept_values(db, pts[i].case_id);
+    for (const auto& v : swept[i]) values_in_group[pts[i].group][v.key].insert(v.value);
+  }
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    for (const auto& v : swept[i]) {
+      if (v.key == "gravity.angle_deg" || values_in_group[pts[i].group][v.key].size() < 2) continue;
+      pts[i].setting += (pts[i].setting.empty() ? "" : "; ") + v.key + "=" + v.display();
+    }
+  // A setting's place: the first position of any of its cases in the study file.
+  std::map<std::pair<std::string, std::string>, std::int64_t> first_pos;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    auto& fp = first_pos.try_emplace({pts[i].group, pts[i].setting}, setting_pos[i]).first->second;
+    fp = std::min(fp, setting_pos[i]);
   }
   std::stable_sort(pts.begin(), pts.end(), [&](const CurvePoint& a, const CurvePoint& b) {
     if (a.group != b.group) return group_pos[a.group] < group_pos[b.group];
+    if (a.setting != b.setting) return first_pos[{a.group, a.setting}] < first_pos[{b.group, b.setting}];
     return a.angle_deg < b.angle_deg;
   });
   // r_acc = w / w90 with first-order error propagation of independent standard errors.
   for (auto& p : pts) {
     const CurvePoint* ref = nullptr;
     for (const auto& q : pts)
-      if (q.group == p.group && q.angle_deg == 90.0) ref = &q;
+      if (q.group == p.group && q.setting == p.setting && q.angle_deg == 90.0) ref = &q;
     if (!ref || ref->w_m_s == 0.0) continue;
     const double r = p.w_m_s / ref->w_m_s;
     p.r_acc = r;

@@ -42,6 +42,9 @@ std::vector<CaseState> case_states(Database& db, const std::string& study, int r
 
 struct CurvePoint {
   std::string group;
+  /// What else the study sets on the case besides the angle ("key=value; ..."), empty when the
+  /// group sweeps only the angle: one curve per (group, setting), r_acc within it.
+  std::string setting;
   std::string case_id;
   double angle_deg = 0;
   double w_m_s = 0, w_err_m_s = 0;         ///< <<w_p>> and its standard error

@@ -319,3 +319,35 @@ TEST(ValidationQuery, OnlyFinishedCasesOfTheNamedStudyAreListed) {
   EXPECT_EQ(bd::query_validation(db).size(), 2u);
   EXPECT_NE(what_of([&] { bd::query_validation(db, "nope"); }).find("no study 'nope'"), std::string::npos);
 }
+
+TEST(CurveQuery, GroupSweepingMoreThanTheAngleGetsOneCurvePerSetting) {
+  // Two viscosities x two angles in one group: r_acc of each viscosity against its own 90 deg.
+  TempDir tmp;
+  bd::Database db((tmp.path / "c.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(R"(
+name = "c"
+[[group]]
+name = "g"
+set = { "fluid.density" = 1000.0 }
+[matrix]
+"fluid.viscosity" = [1e-3, 1e-2]
+"gravity.angle_deg" = [65, 90]
+)");
+  bd::register_study(db, study);
+  for (const auto& c : study.cases) {
+    const bool thin = c.params.fluid.viscosity_pa_s < 5e-3, steep = c.params.gravity.angle_deg == 90.0;
+    const double w = thin ? (steep ? -0.08 : -0.18) : (steep ? -0.02 : -0.06);
+    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, summary_of(c, Run{w, 0.0, 1.0}));
+  }
+  const auto pts = bd::query_curve(db, "c");
+  ASSERT_EQ(pts.size(), 4u);
+  for (const auto& p : pts) {
+    // Only what varies within the group names the setting (not the group's own `set`).
+    EXPECT_EQ(p.setting.find("fluid.density"), std::string::npos) << p.setting;
+    ASSERT_TRUE(p.r_acc.has_value());
+    const bool thin = p.setting == "fluid.viscosity=0.001";
+    EXPECT_TRUE(thin || p.setting == "fluid.viscosity=0.01") << p.setting;
+    const double expect = p.angle_deg == 90.0 ? 1.0 : (thin ? 0.18 / 0.08 : 0.06 / 0.02);
+    EXPECT_NEAR(*p.r_acc, expect, 1e-12) << p.setting << " at " << p.angle_deg;
+  }
+}
