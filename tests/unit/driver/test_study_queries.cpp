@@ -337,7 +337,7 @@ set = { "fluid.density" = 1000.0 }
   for (const auto& c : study.cases) {
     const bool thin = c.params.fluid.viscosity_pa_s < 5e-3, steep = c.params.gravity.angle_deg == 90.0;
     const double w = thin ? (steep ? -0.08 : -0.18) : (steep ? -0.02 : -0.06);
-    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, summary_of(c, Run{w, 0.0, 1.0}));
+    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, summary_of(c, ::Run{w, 0.0, 1.0}));
   }
   const auto pts = bd::query_curve(db, "c");
   ASSERT_EQ(pts.size(), 4u);
