@@ -2,12 +2,15 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include <fmt/format.h>
 
 #include "core/constants.hpp"
 #include "core/error.hpp"
+#include "core/version.hpp"
 #include "io/state_io.hpp"
+#include "scenes/run_common.hpp"
 
 namespace boycott::scenes {
 
@@ -119,6 +122,35 @@ void CoupledRun::load(const io::CheckpointReader& r) {
     throw CheckpointError(fmt::format("{}: the fluid grid was decomposed differently (other rank count?)", r.path().string()));
   fluid_->import_state(fs);
   coupler_->import_state(io::load_arrays(r, "coupler."));
+}
+
+std::optional<double> CoupledRun::resume(const std::filesystem::path& run_dir, bool quiet,
+                                         const std::function<void(const io::CheckpointReader&)>& load_scene) {
+  const auto ck = io::latest_checkpoint(run_dir);
+  if (!ck) return std::nullopt;
+  io::CheckpointReader r(*ck);
+  const std::string id = case_id(p_);
+  if (r.string("case_id") != id)
+    throw CheckpointError(fmt::format("{} belongs to case {}, not {}; it is left in place", ck->string(),
+                                      r.string("case_id"), id));
+  load(r);
+  load_scene(r);
+  truncate_csv_after(run_dir / "timeseries.csv", time_);
+  if (!quiet) std::fprintf(stderr, "resuming from %s at t = %g s\n", ck->c_str(), time_);
+  return r.scalar("run.wall_time_s");
+}
+
+void CoupledRun::checkpoint(const std::filesystem::path& run_dir, double wall_time_s,
+                            const std::function<void(io::CheckpointWriter&)>& save_scene) const {
+  io::CheckpointWriter w(io::checkpoint_path(run_dir, steps_));
+  w.put_string("case_id", case_id(p_));
+  w.put_string("case_json", to_json(p_).dump());
+  w.put_string("program_version", std::string(kVersion));
+  save(w);
+  save_scene(w);
+  w.put("run.wall_time_s", wall_time_s);
+  w.commit();
+  io::prune_checkpoints(run_dir, static_cast<int>(p_.output.keep_checkpoints));
 }
 
 io::SnapshotData CoupledRun::snapshot() const {

@@ -3,8 +3,11 @@
 // sample the fluid at the particles, sub-cycle the DEM, deposit volume and forces, set the
 // driving force, solve the fluid. Scenes choose what runs: frozen particles (no DEM), the
 // zero-slurry-velocity forcing of Eq. 25, which forces are on.
+#include <filesystem>
+#include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include "core/case_params.hpp"
 #include "core/timers.hpp"
@@ -56,6 +59,17 @@ class CoupledRun {
   /// is not called again on a resumed run).
   void save(io::CheckpointWriter& w) const;
   void load(const io::CheckpointReader& r);
+
+  /// Resumes from the newest checkpoint in `run_dir`, if any: refuses one of another case
+  /// (CheckpointError, the file left in place), loads this run's state, lets the scene load its
+  /// own running sums, and cuts the time series back to the checkpoint's time. Returns the wall
+  /// time the run had already spent (s), or nothing when there is no checkpoint to resume.
+  std::optional<double> resume(const std::filesystem::path& run_dir, bool quiet,
+                               const std::function<void(const io::CheckpointReader&)>& load_scene);
+  /// Writes a checkpoint of this run and the scene's running sums (atomically; the newest
+  /// output.keep_checkpoints are kept), recording the wall time spent so far (s).
+  void checkpoint(const std::filesystem::path& run_dir, double wall_time_s,
+                  const std::function<void(io::CheckpointWriter&)>& save_scene) const;
 
   /// Particles and cell-centred fluid fields (alpha_f, p, u, v, w) now, for io::write_snapshot.
   io::SnapshotData snapshot() const;

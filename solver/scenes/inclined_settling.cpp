@@ -68,16 +68,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   double slurry_max = 0.0, next_out = 0.0, wall_before = 0.0;
   // Stability record over the whole run (issue 7): alpha_f range and the largest kinetic energy.
   double alpha_min_seen = 1.0, alpha_max_seen = 0.0, ke_max_seen = 0.0;
-  const std::string id = case_id(p);
 
   // Resume from the newest checkpoint, or start.
-  const auto ck = io::latest_checkpoint(ctx.out_dir);
-  if (ck) {
-    io::CheckpointReader r(*ck);
-    if (r.string("case_id") != id)
-      throw CheckpointError(fmt::format("{} belongs to case {}, not {}; it is left in place", ck->string(),
-                                        r.string("case_id"), id));
-    run.load(r);
+  const auto resumed = run.resume(ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) {
     io::load(r, "stats.wp.", wp_avg);
     io::load(r, "stats.wf.", wf_avg);
     io::load(r, "stats.slurry.", slurry_avg);
@@ -90,9 +83,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       alpha_max_seen = r.scalar("stats.alpha_max_seen");
       ke_max_seen = r.scalar("stats.ke_max_seen");
     }
-    wall_before = r.scalar("run.wall_time_s");
-    truncate_csv_after(ctx.out_dir / "timeseries.csv", run.time_s());
-    if (!ctx.quiet) std::fprintf(stderr, "resuming from %s at t = %g s\n", ck->c_str(), run.time_s());
+  });
+  if (resumed) {
+    wall_before = *resumed;
   } else {
     insert_case_particles(run.dem(), p);
     run.start();
@@ -103,30 +96,24 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
 
   auto write_checkpoint = [&] {
     ModelTimers::Scope sc(timers, "checkpoints");
-    io::CheckpointWriter w(io::checkpoint_path(ctx.out_dir, run.steps()));
-    w.put_string("case_id", id);
-    w.put_string("case_json", to_json(p).dump());
-    w.put_string("program_version", std::string(kVersion));
-    run.save(w);
-    io::save(w, "stats.wp.", wp_avg);
-    io::save(w, "stats.wf.", wf_avg);
-    io::save(w, "stats.slurry.", slurry_avg);
-    io::save(w, "stats.pdf_y.", pdf_y);
-    io::save(w, "stats.pdf_w.", pdf_w);
-    w.put("stats.slurry_max", slurry_max);
-    w.put("stats.next_out", next_out);
-    w.put("stats.alpha_min_seen", alpha_min_seen);
-    w.put("stats.alpha_max_seen", alpha_max_seen);
-    w.put("stats.ke_max_seen", ke_max_seen);
-    w.put("run.wall_time_s", wall_before + clock.seconds());
-    w.commit();
-    io::prune_checkpoints(ctx.out_dir, static_cast<int>(p.output.keep_checkpoints));
+    run.checkpoint(ctx.out_dir, wall_before + clock.seconds(), [&](io::CheckpointWriter& w) {
+      io::save(w, "stats.wp.", wp_avg);
+      io::save(w, "stats.wf.", wf_avg);
+      io::save(w, "stats.slurry.", slurry_avg);
+      io::save(w, "stats.pdf_y.", pdf_y);
+      io::save(w, "stats.pdf_w.", pdf_w);
+      w.put("stats.slurry_max", slurry_max);
+      w.put("stats.next_out", next_out);
+      w.put("stats.alpha_min_seen", alpha_min_seen);
+      w.put("stats.alpha_max_seen", alpha_max_seen);
+      w.put("stats.ke_max_seen", ke_max_seen);
+    });
   };
 
   CsvWriter csv(ctx.out_dir / "timeseries.csv",
                 {"time_s", "mean_wp_m_s", "mean_wf_m_s", "slurry_velocity_m_s", "mean_up_m_s", "mean_vp_m_s",
                  "driving_gradient_pa_m", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
-                ck.has_value());
+                resumed.has_value());
   const double out_every = is_set(p.output.timeseries_every_s) ? p.output.timeseries_every_s : 0.0;
   const double ck_every = p.time.checkpoint_every_s;
   double next_ck = (std::floor(run.time_s() / ck_every + 1e-9) + 1.0) * ck_every;
@@ -222,7 +209,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   j["pressure_solver_fallbacks"] = run.fluid().pressure_fallbacks();
   j["dem_steps"] = run.dem().steps();
   j["samples_averaged"] = wp_avg.count();
-  j["resumed_from_checkpoint"] = ck.has_value();
+  j["resumed_from_checkpoint"] = resumed.has_value();
   j["pdf_outside_fraction"] = {{"y", pdf_y.total_ > 0 ? pdf_y.outside_ / pdf_y.total_ : 0.0},
                                {"wp", pdf_w.total_ > 0 ? pdf_w.outside_ / pdf_w.total_ : 0.0}};
   // A vertical suspension beside Richardson-Zaki: <<w_p>> is relative to zero volume flux, which

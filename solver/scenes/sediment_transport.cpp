@@ -13,7 +13,8 @@
 //   Nielsen (1992), Coastal Bottom Boundary Layers and Sediment Transport, World Scientific:
 //   q* = 12 tau*^0.5 (tau* - 0.05), the form Schmeeckle (2014, JGR Earth Surf. 119, 1240) and
 //   Sun & Xiao (2016, Comput. Geosci. 89, 207) compare their CFD-DEM transport rates with.
-// No checkpoints yet: an interrupted run exits 1 and says so.
+// Checkpoints as inclined_settling: every time.checkpoint_every, at the end, and on SIGINT/SIGTERM
+// (exit 75); the same command resumes.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -23,6 +24,8 @@
 #include "core/constants.hpp"
 #include "core/error.hpp"
 #include "core/statistics.hpp"
+#include "io/checkpoint_file.hpp"
+#include "io/state_io.hpp"
 #include "scenes/coupled_run.hpp"
 #include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
@@ -63,16 +66,29 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   opt.target_mean_flux_z_m_s = p.sediment.bulk_velocity_m_s;
   CoupledRun run(p, opt);
   const auto& s = run.dem().particles();
-  insert_case_particles(run.dem(), p);
-  // The paper starts from a bed packed on the bottom: pour it dry (DEM only, still fluid left
-  // out) until it rests, before the flow starts; this time is not part of the simulated time.
+  BatchMeans q_avg, g_avg, wf_avg, vp_avg;
+  double alpha_min_seen = 1.0, ke_max_seen = 0.0, next_out = 0.0, settle_s = 0.0, wall_before = 0.0;
   timers.activate("bed_pouring", "dry DEM until the bed rests");
-  double settle_s = 0.0;
-  {
-    ModelTimers::Scope sc(timers, "bed_pouring");
-    settle_s = settle_bed(run.dem(), p);
+  const auto resumed = run.resume(ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) {
+    for (auto [name, b] : {std::pair{"q", &q_avg}, {"g", &g_avg}, {"wf", &wf_avg}, {"vp", &vp_avg}})
+      io::load(r, fmt::format("stats.{}.", name), *b);
+    alpha_min_seen = r.scalar("stats.alpha_min_seen");
+    ke_max_seen = r.scalar("stats.ke_max_seen");
+    next_out = r.scalar("stats.next_out");
+    settle_s = r.scalar("stats.bed_pouring_time_s");
+  });
+  if (resumed) {
+    wall_before = *resumed;
+  } else {
+    insert_case_particles(run.dem(), p);
+    // The paper starts from a bed packed on the bottom: pour it dry (DEM only, still fluid left
+    // out) until it rests, before the flow starts; this time is not part of the simulated time.
+    {
+      ModelTimers::Scope sc(timers, "bed_pouring");
+      settle_s = settle_bed(run.dem(), p);
+    }
+    run.start();
   }
-  run.start();
   run.activate_models(timers);
   timers.activate("flux_controller", fmt::format("G(t) holds mean alpha_f w = {} m/s", p.sediment.bulk_velocity_m_s));
 
@@ -90,14 +106,26 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
     return q / A;  // m^2/s
   };
 
-  BatchMeans q_avg, g_avg, wf_avg, vp_avg;
-  double alpha_min_seen = 1.0, ke_max_seen = 0.0;
+  timers.activate("checkpoints", fmt::format("HDF5 every {} s, newest {} kept", p.time.checkpoint_every_s,
+                                             p.output.keep_checkpoints));
+  auto write_checkpoint = [&] {
+    ModelTimers::Scope sc(timers, "checkpoints");
+    run.checkpoint(ctx.out_dir, wall_before + clock.seconds(), [&](io::CheckpointWriter& w) {
+      for (auto [name, b] : {std::pair{"q", &q_avg}, {"g", &g_avg}, {"wf", &wf_avg}, {"vp", &vp_avg}})
+        io::save(w, fmt::format("stats.{}.", name), *b);
+      w.put("stats.alpha_min_seen", alpha_min_seen);
+      w.put("stats.ke_max_seen", ke_max_seen);
+      w.put("stats.next_out", next_out);
+      w.put("stats.bed_pouring_time_s", settle_s);
+    });
+  };
   CsvWriter csv(ctx.out_dir / "timeseries.csv",
                 {"time_s", "q_m2_s", "q_star", "driving_gradient_pa_m", "mean_flux_z_m_s", "mean_up_z_m_s",
                  "mean_vp_m_s", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
-                false);
+                resumed.has_value());
   const double out_every = is_set(p.output.timeseries_every_s) ? p.output.timeseries_every_s : 0.0;
-  double next_out = 0.0;
+  const double ck_every = p.time.checkpoint_every_s;
+  double next_ck = (std::floor(run.time_s() / ck_every + 1e-9) + 1.0) * ck_every;
   SummaryBase sb;
   int exit_code = kExitOk;
   while (run.time_s() < p.time.end_s - 1e-12) {
@@ -120,10 +148,16 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
       next_out = t + out_every;
       if (ctx.progress) ctx.progress(t);
     }
-    if (ctx.should_stop()) {
+    const bool stop = ctx.should_stop();
+    if (t >= next_ck - 1e-12 || t >= p.time.end_s - 1e-12 || stop) {
+      csv.flush();
+      write_checkpoint();
+      next_ck = (std::floor(t / ck_every + 1e-9) + 1.0) * ck_every;
+    }
+    if (stop) {
       sb.status = "interrupted";
-      exit_code = 1;
-      if (!ctx.quiet) std::fprintf(stderr, "sediment_transport writes no checkpoints yet: stopped at t = %g s, not resumable\n", t);
+      exit_code = kExitInterrupted;
+      if (!ctx.quiet) std::fprintf(stderr, "stopped at t = %g s after writing a checkpoint; run again to resume\n", t);
       break;
     }
   }
@@ -131,7 +165,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   run.report_timers(timers);
 
   sb.simulated_time_s = run.time_s();
-  sb.wall_time_s = clock.seconds();
+  sb.wall_time_s = wall_before + clock.seconds();
   sb.particle_steps = static_cast<double>(s.n_local) * static_cast<double>(run.dem().steps());
   sb.mean_settling_velocity_m_s = vp_avg.count() ? vp_avg.mean() : kUnset;
   sb.settling_velocity_stderr_m_s = vp_avg.stderr_of_mean();
@@ -150,6 +184,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   j["mean_driving_gradient_pa_m"] = Gm;
   j["bed_height_m"] = h_bed;
   j["bed_pouring_time_s"] = settle_s;
+  j["resumed_from_checkpoint"] = resumed.has_value();
   j["bed_shear_stress_pa"] = tau_b;
   j["shields_stress"] = tau_star;
   const double qwp = wong_parker_q(tau_star), qn = nielsen_q(tau_star);

@@ -5,6 +5,7 @@
 // studies/validation_sediment_transport.toml (not part of the quick suite).
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -46,6 +47,42 @@ TEST(SedimentTransport, BulkVelocityHeldBedPouredAndTransportDownstream) {
   EXPECT_NEAR(j["bed_height_m"].get<double>(), vp / (0.005 * 0.01 * 0.6), 1e-12);
   EXPECT_NEAR(j["q_star_wong_parker"].get<double>(), 3.97 * std::pow(tau - 0.0495, 1.5), 1e-12);
   EXPECT_NEAR(j["q_star_nielsen"].get<double>(), 12.0 * std::sqrt(tau) * (tau - 0.05), 1e-12);
+}
+
+TEST(SedimentTransport, StoppedAndResumedRunEqualsTheUninterruptedOneBitwise) {
+  CaseParams p = parse_case_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/cases/sediment_transport.toml");
+  for (const char* s : {"domain.length_x=0.005", "domain.height_z=0.01", "domain.cells=[5, 40, 10]",
+                        "particles.count=2000", "time.end=0.01", "time.average_from=0.004",
+                        "time.checkpoint_every=1.0"})
+    apply_override(p, s);
+  auto summary = [](const std::filesystem::path& d) {
+    std::ifstream in(d / "summary.json");
+    return nlohmann::json::parse(in);
+  };
+  RunContext a;
+  a.quiet = true;
+  a.out_dir = std::filesystem::temp_directory_path() / "boycott_sediment_whole";
+  std::filesystem::remove_all(a.out_dir);
+  ASSERT_EQ(run_case(p, a), 0);
+
+  std::atomic<bool> stop{false};
+  RunContext b;
+  b.quiet = true;
+  b.out_dir = std::filesystem::temp_directory_path() / "boycott_sediment_resumed";
+  std::filesystem::remove_all(b.out_dir);
+  b.stop_requested = &stop;
+  b.progress = [&](double t) {
+    if (t >= 0.006) stop = true;
+  };
+  ASSERT_EQ(run_case(p, b), kExitInterrupted);
+  stop = false;
+  b.progress = nullptr;
+  ASSERT_EQ(run_case(p, b), 0);
+  const auto ja = summary(a.out_dir), jb = summary(b.out_dir);
+  EXPECT_TRUE(jb["resumed_from_checkpoint"].get<bool>());
+  for (const char* k : {"q_star", "q_star_stderr", "shields_stress", "mean_flux_z_m_s", "mean_settling_velocity_m_s",
+                        "bed_pouring_time_s", "max_kinetic_energy_j"})
+    EXPECT_EQ(ja[k].get<double>(), jb[k].get<double>()) << k;
 }
 
 TEST(SedimentTransport, RefusesAnInclinedOrPeriodicChannel) {
