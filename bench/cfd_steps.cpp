@@ -86,6 +86,10 @@ int main(int argc, char** argv) {
   const double th = 65.0 * M_PI / 180.0;
   s.body_acceleration_m_s2 = {0.0, -9.81 * std::cos(th), -9.81 * std::sin(th)};
   s.dt_max_s = 1.0e-3;
+  // SIMPLE settings of a case (numerics.*) as bench options, for comparing schemes
+  PetscReal relax = s.velocity_relaxation;
+  PetscOptionsGetReal(nullptr, nullptr, "-velocity_relaxation", &relax, nullptr);
+  s.velocity_relaxation = relax;
   const double alpha_p = 120000 * M_PI / 6.0 * std::pow(kDiameter, 3) / (0.2 * 0.006 * 0.1);
   s.target_mean_flux_z_m_s = -alpha_p * kSettling;  // zero slurry flux, Eq. 25
   FluidSolver f(s);

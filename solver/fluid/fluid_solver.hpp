@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,8 @@ struct CaseParams;
 }
 
 namespace boycott::fluid {
+
+class StencilMatrixWriter;
 
 struct FluidSettings {
   GridSpec grid;
@@ -175,6 +178,8 @@ class FluidSolver {
   void create_layout();
   void update_ghosts();
   void compute_subgrid_viscosity();
+  void compute_face_fluxes();
+  void compute_effective_viscosity();
   void assemble_momentum(int c, double dt, double c0, double c1, double c2, bool first_iteration);
   void apply_flux_controller();
   double continuity_residual(double dt, double c0, double c1, double c2, Vec R);
@@ -186,6 +191,7 @@ class FluidSolver {
   DM da_ = nullptr;    // box stencil, width 2: ghosted fields
   DM dam_ = nullptr;   // star stencil, width 1, same ownership: matrices
   Mat A_ = nullptr;    // momentum matrix (one component at a time)
+  std::unique_ptr<StencilMatrixWriter> writer_;  // value slots of A_ and Ap_ (same pattern)
   Mat Ap_ = nullptr;   // pressure-correction matrix
   KSP ksp_m_ = nullptr, ksp_p_ = nullptr;
   KSP ksp_p_fallback_ = nullptr;  // GAMG, created on the first failed pressure solve
@@ -202,6 +208,8 @@ class FluidSolver {
   // ghosted local vectors
   Vec Ul_[3]{}, Pl_ = nullptr, alphal_[3]{}, nutl_ = nullptr, pcl_ = nullptr, Dl_[3]{};
   Vec dep_solid_ = nullptr, dep_S_[3]{}, dep_K_[3]{}, dep_KU_[3]{};
+  // per SIMPLE iteration: a_f u_d on each lower d-face (0 on walls), m/s; per step: nu + nu_t, m^2/s
+  Vec Fl_[3]{}, nuel_ = nullptr;
   bool deposition_open_ = false;
   bool coupling_armed_ = false;
   bool alpha_initialised_ = false;

@@ -66,7 +66,9 @@ std::vector<std::vector<double>> run(MPI_Comm comm) {
   int size;
   MPI_Comm_size(comm, &size);
   const OwnedBox b = f.owned_box();
-  if (size > 1) EXPECT_LT(b.size[0] * b.size[1] * b.size[2], 8 * 6 * 8) << "the grid was not decomposed";
+  if (size > 1) {
+    EXPECT_LT(b.size[0] * b.size[1] * b.size[2], 8 * 6 * 8) << "the grid was not decomposed";
+  }
   f.set_velocity(0, [](double, double y, double z) { return 0.05 * std::sin(M_PI * z) * y * (1 - y); });
   for (int n = 0; n < 8; ++n) {
     deposit(f, f.time_s());
