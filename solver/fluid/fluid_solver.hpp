@@ -14,11 +14,11 @@
 // cell (i,j,k) of the u, v, w vectors lives on that cell's LOWER x, y, z face. With y walls the
 // y-face j = 0 is the wall y = 0 (v = 0 kept there) and the top wall face j = ny is implicit.
 // Discretisation: finite volume, BDF2 (variable step) in time, QUICK convection by deferred
-// correction on implicit upwind, central diffusion and pressure gradient, SIMPLE with
+// correction on implicit upwind, central diffusion and pressure gradient, SIMPLE(C) with optional
 // under-relaxation; linear systems by PETSc KSP with prefixes "momentum_" and "pressure_"
-// (defaults: BiCGStab + block Jacobi/ILU; GMRES + BoomerAMG on one rank, GMRES + GAMG on
-// several, constant null space removed; the other AMG, prefix "pressure_fallback_", redoes a
-// failed pressure solve).
+// (defaults: BiCGStab + Jacobi; GMRES + BoomerAMG (HMIS, ext+i) on one rank, GMRES + GAMG on
+// several, to 1e-2 relative per SIMPLE iteration, constant null space removed; the other AMG,
+// prefix "pressure_fallback_", redoes a failed pressure solve).
 #include <mpi.h>
 #include <petscdmda.h>
 #include <petscksp.h>
@@ -53,7 +53,7 @@ struct FluidSettings {
   double target_mean_flux_z_m_s = std::numeric_limits<double>::quiet_NaN();
   int simple_max_iterations = 30;
   double simple_tolerance = 1.0e-6;
-  double velocity_relaxation = 0.8;
+  double velocity_relaxation = 1.0;  ///< see CaseParams::Numerics
   double pressure_relaxation = 0.5;  ///< used by plain SIMPLE; SIMPLEC corrects p fully
   /// SIMPLEC correction coefficient a/(rho (a_P - sum a_nb)) instead of SIMPLE's a/(rho a_P):
   /// plain SIMPLE diverges for diffusion-dominated cells of high aspect ratio (nu dt/h_y^2 >> 1
