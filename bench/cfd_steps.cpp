@@ -137,9 +137,11 @@ int main(int argc, char** argv) {
       unconverged += !rep.converged;
     }
   }
+  // collective diagnostics, on every rank (calling them on rank 0 alone hung the 2-rank bench)
+  const double dt_end = f.stable_dt(), flux_end = f.mean_flux_z(), wmax_end = f.max_abs_velocity(2);
   if (rank == 0) {
     std::printf("cfd_steps: mesh 200x6x100, %d rank(s), %d warm-up + %d timed steps, dt %.3g s\n", size, warmup, timed,
-                f.stable_dt());
+                dt_end);
     std::sort(step_times.begin(), step_times.end());
     std::printf("  ms per CFD step        %.2f (median %.2f; CPU ms of rank 0 %.2f)\n", 1e3 * step_s / timed,
                 1e3 * step_times[step_times.size() / 2], 1e3 * cpu_s / timed);
@@ -147,8 +149,8 @@ int main(int argc, char** argv) {
     std::printf("  pressure Krylov/step   %.2f\n", double(pk) / timed);
     std::printf("  momentum Krylov/step   %.2f\n", double(mk) / timed);
     std::printf("  deposition ms/step     %.2f (not in the CFD figure)\n", 1e3 * dep_s / timed);
-    std::printf("  mean alpha_f w %.6g m/s (target %.6g), G %.6g Pa/m, max |w| %.4g m/s\n", f.mean_flux_z(),
-                s.target_mean_flux_z_m_s, f.mean_pressure_gradient_pa_m(), f.max_abs_velocity(2));
+    std::printf("  mean alpha_f w %.6g m/s (target %.6g), G %.6g Pa/m, max |w| %.4g m/s\n", flux_end,
+                s.target_mean_flux_z_m_s, f.mean_pressure_gradient_pa_m(), wmax_end);
   }
   return 0;
 }
