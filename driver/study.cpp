@@ -203,7 +203,7 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
   } else if (root.contains("group")) {
     throw InputError("'group' must be an array of tables: [[group]]");
   }
-  if (groups.empty()) groups.push_back(Group{"base", {}});
+  if (groups.empty()) groups.push_back(Group{"base", {}, {}});
 
   const auto axes = read_axes(root);
   std::map<std::string, std::string> seen;  // id -> "group (values)"

@@ -115,8 +115,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
                  "driving_gradient_pa_m", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
                 resumed.has_value());
   const double out_every = is_set(p.output.timeseries_every_s) ? p.output.timeseries_every_s : 0.0;
-  const double ck_every = p.time.checkpoint_every_s;
-  double next_ck = (std::floor(run.time_s() / ck_every + 1e-9) + 1.0) * ck_every;
+  CheckpointClock checkpoints(p.time.checkpoint_every_s, run.time_s());
   // Snapshots at output.snapshot_times (sorted); those before a resumed run's time are done.
   std::vector<double> snaps = p.output.snapshot_times_s;
   std::sort(snaps.begin(), snaps.end());
@@ -171,10 +170,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     }
     const bool stop = ctx.should_stop();
     // Also at the end: the final state stays inspectable (and comparable across restarts).
-    if (t >= next_ck - 1e-12 || t >= end - 1e-12 || stop) {
+    if (checkpoints.due(t, end, stop)) {
       csv.flush();
       write_checkpoint();
-      next_ck = (std::floor(t / ck_every + 1e-9) + 1.0) * ck_every;
     }
     if (stop) {
       sb.status = "interrupted";

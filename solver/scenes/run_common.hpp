@@ -2,6 +2,7 @@
 // What every scene writes the same way: summary.json with the common keys of design brief
 // section 7, timeseries.csv, atomic file replacement.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -57,6 +58,23 @@ class WallClock {
 
  private:
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+/// When a time-stepping scene writes a checkpoint: on the grid k * every_s of simulated time (so
+/// a resumed run keeps the uninterrupted run's schedule), at the end, and when asked to stop.
+class CheckpointClock {
+ public:
+  CheckpointClock(double every_s, double now_s) : every_(every_s), next_(following(now_s)) {}
+  /// True when a step that reached t_s is due one (then the next is scheduled).
+  bool due(double t_s, double end_s, bool stop) {
+    if (t_s < next_ - 1e-12 && t_s < end_s - 1e-12 && !stop) return false;
+    next_ = following(t_s);
+    return true;
+  }
+
+ private:
+  double following(double t_s) const { return (std::floor(t_s / every_ + 1e-9) + 1.0) * every_; }
+  double every_, next_;
 };
 
 }  // namespace boycott::scenes

@@ -124,8 +124,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
                  "mean_vp_m_s", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
                 resumed.has_value());
   const double out_every = is_set(p.output.timeseries_every_s) ? p.output.timeseries_every_s : 0.0;
-  const double ck_every = p.time.checkpoint_every_s;
-  double next_ck = (std::floor(run.time_s() / ck_every + 1e-9) + 1.0) * ck_every;
+  CheckpointClock checkpoints(p.time.checkpoint_every_s, run.time_s());
   SummaryBase sb;
   int exit_code = kExitOk;
   while (run.time_s() < p.time.end_s - 1e-12) {
@@ -149,10 +148,9 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
       if (ctx.progress) ctx.progress(t);
     }
     const bool stop = ctx.should_stop();
-    if (t >= next_ck - 1e-12 || t >= p.time.end_s - 1e-12 || stop) {
+    if (checkpoints.due(t, p.time.end_s, stop)) {
       csv.flush();
       write_checkpoint();
-      next_ck = (std::floor(t / ck_every + 1e-9) + 1.0) * ck_every;
     }
     if (stop) {
       sb.status = "interrupted";
