@@ -1,3 +1,4 @@
+#include <filesystem>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -176,6 +177,24 @@ TEST(StudyExpansion, CaseFileWrittenForTheSolverHasTheSameId) {
     boycott::validate(p);
     EXPECT_EQ(boycott::case_id(p), c.id);
   }
+}
+
+TEST(StudyExpansion, EveryShippedStudyExpandsToValidCases) {
+  // the study files under studies/ are what users run first; each must expand and validate
+  namespace fs = std::filesystem;
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(fs::path(BOYCOTT_SOURCE_DIR) / "studies")) {
+    if (e.path().extension() != ".toml") continue;
+    ++files;
+    SCOPED_TRACE(e.path().string());
+    const auto st = bd::expand_study_file(e.path().string());
+    EXPECT_FALSE(st.cases.empty());
+    for (const auto& c : st.cases) {
+      auto p = boycott::parse_case_string(bd::case_to_toml(c.params));
+      EXPECT_NO_THROW(boycott::validate(p));
+    }
+  }
+  EXPECT_GE(files, 8);
 }
 
 TEST(StudyExpansionErrors, NameTheOffendingKey) {
