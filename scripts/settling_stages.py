@@ -62,9 +62,19 @@ def main():
     print(f"stage II  (resuspension):            {t[ip]:.2f} -> {t[it]:.2f} s, down to {sm[it] * 1e3:.1f} mm/s "
           f"({(sm[ip] - sm[it]) / sm[ip] * 100:.0f} % below the peak)")
     verdict = "yes" if reacc > 3 * se else "no"
-    print(f"stage III (secondary instability):   re-acceleration after {t[it]:.2f} s: {verdict} "
-          f"(plateau {m * 1e3:.1f} +- {se * 1e3:.1f} mm/s over the last {a.plateau:g} s, "
-          f"{reacc * 1e3:+.1f} mm/s against the trough)")
+    dip = sm[ip] - sm[it]
+    if dip < max(0.1 * sm[ip], 3 * se):
+        # a dip within 10 % (or within the noise) is no resuspension stage
+        print(f"no distinct stages: the speed rises to {sm[ip] * 1e3:.1f} mm/s by {t[ip]:.2f} s and the largest later "
+              f"dip is {dip / sm[ip] * 100:.0f} % (stages need > 10 %); plateau {m * 1e3:.1f} +- {se * 1e3:.1f} mm/s "
+              f"over the last {a.plateau:g} s")
+    else:
+        print(f"stage I   (stratified acceleration): 0 -> {t[ip]:.2f} s, settling speed up to {sm[ip] * 1e3:.1f} mm/s")
+        print(f"stage II  (resuspension):            {t[ip]:.2f} -> {t[it]:.2f} s, down to {sm[it] * 1e3:.1f} mm/s "
+              f"({dip / sm[ip] * 100:.0f} % below the peak)")
+        print(f"stage III (secondary instability):   re-acceleration after {t[it]:.2f} s: {verdict} "
+              f"(plateau {m * 1e3:.1f} +- {se * 1e3:.1f} mm/s over the last {a.plateau:g} s, "
+              f"{reacc * 1e3:+.1f} mm/s against the trough)")
     stat = "yes" if abs(m1 - m2) < 3 * math.hypot(se1, se2) else "no"
     print(f"plateau stationary (halves {m1 * 1e3:.1f} +- {se1 * 1e3:.1f} and {m2 * 1e3:.1f} +- {se2 * 1e3:.1f} mm/s): {stat}")
     out, nxt = [], 0.0
