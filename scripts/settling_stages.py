@@ -58,9 +58,6 @@ def main():
     m2, se2 = batch_mean(second)
     reacc = m - sm[it]
     print(f"run {a.run_dir}: {n} rows, t = {t[0]:.3f} .. {T:.3f} s, smoothing {2 * h * dt:.3f} s")
-    print(f"stage I   (stratified acceleration): 0 -> {t[ip]:.2f} s, settling speed up to {sm[ip] * 1e3:.1f} mm/s")
-    print(f"stage II  (resuspension):            {t[ip]:.2f} -> {t[it]:.2f} s, down to {sm[it] * 1e3:.1f} mm/s "
-          f"({(sm[ip] - sm[it]) / sm[ip] * 100:.0f} % below the peak)")
     verdict = "yes" if reacc > 3 * se else "no"
     dip = sm[ip] - sm[it]
     if dip < max(0.1 * sm[ip], 3 * se):
