@@ -8,7 +8,8 @@ Reads DIR/timeseries.csv (time_s, mean_wp_m_s) and prints, with settling speed s
             later mean exceeds the trough by more than 3 standard errors) to a plateau.
 The plateau is the mean over the last `--plateau` seconds with a batch-means standard error
 (10 batches), and the run is called stationary there if its two halves agree within 3 errors.
-Smoothing: centred moving average over `--smooth` seconds. Standard library only.
+Smoothing: centred moving average over `--smooth` seconds (0.5 s for the trough). A run whose
+plateau is under 5 % of its peak "settles to rest". Standard library only.
   usage: scripts/settling_stages.py RUN_DIR [--smooth 0.1] [--plateau 2.0] [--every 0.25]
 """
 import argparse
@@ -47,32 +48,39 @@ def main():
     # stage I: first peak = maximum over the first half of the run
     half = [i for i in range(n) if t[i] <= T / 2]
     ip = max(half, key=lambda i: sm[i])
-    # stage II: the minimum after the peak, within the next 3 s (before the plateau is reached)
-    after = [i for i in range(ip, n) if t[i] <= t[ip] + 3.0]
-    it = min(after, key=lambda i: sm[i])
+    # stage II: the minimum after the peak of a 0.5 s average (0.1 s leaves the plateau's noise
+    # in), within 3 s of the peak and before the plateau window
+    h2 = max(1, int(round(0.5 / dt / 2)))
+    sm2 = [sum(s[max(0, i - h2):i + h2 + 1]) / len(s[max(0, i - h2):i + h2 + 1]) for i in range(n)]
+    after = [i for i in range(ip, n) if t[i] <= min(t[ip] + 3.0, T - a.plateau)] or [ip]
+    it = min(after, key=lambda i: sm2[i])
     late = [s[i] for i in range(n) if t[i] >= T - a.plateau]
     m, se = batch_mean(late)
     first = [s[i] for i in range(n) if T - a.plateau <= t[i] < T - a.plateau / 2]
     second = [s[i] for i in range(n) if t[i] >= T - a.plateau / 2]
     m1, se1 = batch_mean(first)
     m2, se2 = batch_mean(second)
-    reacc = m - sm[it]
+    reacc = m - sm2[it]
     print(f"run {a.run_dir}: {n} rows, t = {t[0]:.3f} .. {T:.3f} s, smoothing {2 * h * dt:.3f} s")
     verdict = "yes" if reacc > 3 * se else "no"
-    dip = sm[ip] - sm[it]
-    if dip < max(0.1 * sm[ip], 3 * se):
+    dip = sm[ip] - sm2[it]
+    if abs(m) < 0.05 * sm[ip]:
+        print(f"settles to rest: the speed peaks at {sm[ip] * 1e3:.1f} mm/s at {t[ip]:.2f} s and falls to "
+              f"{m * 1e3:.2f} +- {se * 1e3:.2f} mm/s over the last {a.plateau:g} s (under 5 % of the peak)")
+    elif dip < max(0.1 * sm[ip], 3 * se):
         # a dip within 10 % (or within the noise) is no resuspension stage
         print(f"no distinct stages: the speed rises to {sm[ip] * 1e3:.1f} mm/s by {t[ip]:.2f} s and the largest later "
               f"dip is {dip / sm[ip] * 100:.0f} % (stages need > 10 %); plateau {m * 1e3:.1f} +- {se * 1e3:.1f} mm/s "
               f"over the last {a.plateau:g} s")
     else:
         print(f"stage I   (stratified acceleration): 0 -> {t[ip]:.2f} s, settling speed up to {sm[ip] * 1e3:.1f} mm/s")
-        print(f"stage II  (resuspension):            {t[ip]:.2f} -> {t[it]:.2f} s, down to {sm[it] * 1e3:.1f} mm/s "
+        print(f"stage II  (resuspension):            {t[ip]:.2f} -> {t[it]:.2f} s, down to {sm2[it] * 1e3:.1f} mm/s "
               f"({dip / sm[ip] * 100:.0f} % below the peak)")
         print(f"stage III (secondary instability):   re-acceleration after {t[it]:.2f} s: {verdict} "
               f"(plateau {m * 1e3:.1f} +- {se * 1e3:.1f} mm/s over the last {a.plateau:g} s, "
               f"{reacc * 1e3:+.1f} mm/s against the trough)")
-    stat = "yes" if abs(m1 - m2) < 3 * math.hypot(se1, se2) else "no"
+    # 0.1 mm/s floor: a bed at rest has batch errors of zero
+    stat = "yes" if abs(m1 - m2) < max(3 * math.hypot(se1, se2), 1e-4) else "no"
     print(f"plateau stationary (halves {m1 * 1e3:.1f} +- {se1 * 1e3:.1f} and {m2 * 1e3:.1f} +- {se2 * 1e3:.1f} mm/s): {stat}")
     out, nxt = [], 0.0
     for i in range(n):
