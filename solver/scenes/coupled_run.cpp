@@ -89,6 +89,7 @@ CoupledStep CoupledRun::step() {
   }
   const auto t0 = std::chrono::steady_clock::now();
   st.fluid = fluid_->step(dt);
+  if (!st.fluid.converged) ++unconverged_;
   seconds_fluid_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   dt_prev_ = dt;
   time_ += dt;
@@ -103,6 +104,8 @@ void CoupledRun::save(io::CheckpointWriter& w) const {
   w.put("run.time_s", time_);
   w.put("run.dt_prev_s", dt_prev_);
   w.put_int("run.steps", steps_);
+  w.put_int("run.unconverged_fluid_steps", unconverged_);
+  w.put_int("run.pressure_fallbacks", pressure_fallbacks());
   io::save(w, "dem.", dem_->export_state());
   io::save(w, "fluid.", fluid_->export_state());
   io::save(w, "coupler.", coupler_->export_state());
@@ -112,6 +115,9 @@ void CoupledRun::load(const io::CheckpointReader& r) {
   time_ = r.scalar("run.time_s");
   dt_prev_ = r.scalar("run.dt_prev_s");
   steps_ = r.integer("run.steps");
+  // absent from checkpoints written before these counters existed
+  unconverged_ = r.has("run.unconverged_fluid_steps") ? r.integer("run.unconverged_fluid_steps") : 0;
+  fallbacks_before_ = (r.has("run.pressure_fallbacks") ? r.integer("run.pressure_fallbacks") : 0) - fluid_->pressure_fallbacks();
   particles::DemState ds;
   io::load(r, "dem.", ds);
   dem_->import_state(ds);

@@ -48,6 +48,10 @@ class CoupledRun {
   CoupledStep step();
   double time_s() const { return time_; }
   std::int64_t steps() const { return steps_; }
+  /// Fluid steps that ended at numerics.simple_max_iterations without meeting simple_tolerance,
+  /// and pressure solves redone by the fallback solver, over the whole run (resumes included).
+  std::int64_t unconverged_fluid_steps() const { return unconverged_; }
+  std::int64_t pressure_fallbacks() const { return fallbacks_before_ + fluid_->pressure_fallbacks(); }
 
   // Measurements (Eqs. 28, 25).
   double mean_particle_velocity(int c) const;   ///< <u_p,c>, m/s
@@ -87,6 +91,7 @@ class CoupledRun {
   std::unique_ptr<coupling::Coupler> coupler_;
   double time_ = 0.0, dt_prev_ = 0.0;
   std::int64_t steps_ = 0;
+  std::int64_t unconverged_ = 0, fallbacks_before_ = 0;  // counts before this process: from the checkpoint
   double seconds_fluid_ = 0.0;
 };
 

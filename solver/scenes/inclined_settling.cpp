@@ -204,7 +204,8 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   j["min_fluid_fraction"] = alpha_min_seen;
   j["max_fluid_fraction"] = alpha_max_seen;
   j["max_kinetic_energy_j"] = ke_max_seen;
-  j["pressure_solver_fallbacks"] = run.fluid().pressure_fallbacks();
+  j["pressure_solver_fallbacks"] = run.pressure_fallbacks();
+  j["unconverged_fluid_steps"] = run.unconverged_fluid_steps();
   j["dem_steps"] = run.dem().steps();
   j["samples_averaged"] = wp_avg.count();
   j["resumed_from_checkpoint"] = resumed.has_value();

@@ -196,7 +196,8 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   j["max_kinetic_energy_j"] = ke_max_seen;
   j["cfd_steps"] = run.steps();
   j["dem_steps"] = run.dem().steps();
-  j["pressure_solver_fallbacks"] = run.fluid().pressure_fallbacks();
+  j["pressure_solver_fallbacks"] = run.pressure_fallbacks();
+  j["unconverged_fluid_steps"] = run.unconverged_fluid_steps();
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   if (!ctx.quiet)
     std::printf("sediment_transport: t = %.4g s, q* = %.4g, tau* = %.4g (Wong-Parker q* %.4g, Nielsen %.4g)\n",

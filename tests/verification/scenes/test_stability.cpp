@@ -3,6 +3,7 @@
 // are refused before anything is written, naming the limit; a NaN stops the run before it is
 // checkpointed. Reduced boxes (a few hundred to two thousand particles, 0.1 s) so that the whole
 // suite takes about a minute.
+#include <algorithm>
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
@@ -133,6 +134,36 @@ TEST(StiffAndExtremeCases, DenseBedAtHalfSolidFraction) {
 TEST(StiffAndExtremeCases, HorizontalAndVerticalChannel) {
   expect_stable("theta_0", {"gravity.angle_deg=0.0"});
   expect_stable("theta_90", {"gravity.angle_deg=90.0"});
+}
+
+TEST(StiffAndExtremeCases, CappedSimpleIterationsAreCountedInTheSummary) {
+  // A run with SIMPLE capped below convergence says so (the fluid steps it did not converge),
+  // and the count survives a resume; the default run converges every step.
+  const CaseParams capped = small_case({"numerics.simple_max_iterations=1", "time.end=0.02", "time.average_from=0.01", "time.checkpoint_every=0.01"});
+  RunContext ctx;
+  ctx.quiet = true;
+  ctx.out_dir = fresh_dir("capped_simple");
+  ASSERT_EQ(run_case(capped, ctx), 0);
+  const auto j = read_summary(ctx.out_dir);
+  EXPECT_EQ(j["unconverged_fluid_steps"].get<std::int64_t>(), j["cfd_steps"].get<std::int64_t>());
+  EXPECT_GT(j["cfd_steps"].get<std::int64_t>(), 0);
+  // resume from the first checkpoint: the counter carries on from what it was there
+  const auto ck = ctx.out_dir / "checkpoints";
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(ck)) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  ASSERT_GE(files.size(), 2u);
+  fs::remove(files.back());
+  fs::remove(ctx.out_dir / "summary.json");
+  ASSERT_EQ(run_case(capped, ctx), 0);
+  const auto r = read_summary(ctx.out_dir);
+  EXPECT_TRUE(r["resumed_from_checkpoint"].get<bool>());
+  EXPECT_EQ(r["unconverged_fluid_steps"].get<std::int64_t>(), r["cfd_steps"].get<std::int64_t>());
+
+  const CaseParams plain = small_case({"time.end=0.02", "time.average_from=0.01"});
+  ctx.out_dir = fresh_dir("default_simple");
+  ASSERT_EQ(run_case(plain, ctx), 0);
+  EXPECT_EQ(read_summary(ctx.out_dir)["unconverged_fluid_steps"].get<std::int64_t>(), 0);
 }
 
 // ---- refusals: at once, naming the limit, nothing written ----
