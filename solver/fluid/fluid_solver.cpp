@@ -58,8 +58,6 @@ class LogScope {
   PetscLogEvent e_;
 };
 
-/// Variable-step BDF2 weights: (c0 y^{n+1} - c1 y^n + c2 y^{n-1}) / dt with w = dt/dt_prev,
-/// c0 = (1 + 2w)/(1 + w), c1 = 1 + w, c2 = w^2/(1 + w); BDF1 when there is no previous step.
 // The two algebraic multigrids for the pressure correction. BoomerAMG on one rank: it is
 // deterministic, so a resumed run repeats an uninterrupted one bit for bit (GAMG's set-up is
 // not: Checkpoint.ExportImportContinuesBitwise differs in the last bits with it). GAMG on
@@ -96,6 +94,8 @@ void set_pressure_amg(PC pc, bool boomeramg) {
   check(PCSetType(pc, PCGAMG), "PCSetType");
 }
 
+/// Variable-step BDF2 weights: (c0 y^{n+1} - c1 y^n + c2 y^{n-1}) / dt with w = dt/dt_prev,
+/// c0 = (1 + 2w)/(1 + w), c1 = 1 + w, c2 = w^2/(1 + w); BDF1 when there is no previous step.
 void bdf_weights(double dt, double dt_prev, double c[3]) {
   if (dt_prev <= 0.0) {
     c[0] = 1.0, c[1] = 1.0, c[2] = 0.0;
@@ -206,9 +206,9 @@ void FluidSolver::create_layout() {
   MPI_Comm_size(comm_, &nranks);
   BC_PETSC(KSPSetType(ksp_p_, KSPGMRES));
   // 1e-2 relative per SIMPLE iteration: SIMPLE iterates until the continuity residual of the
-  // momentum solution is below simple_tolerance, so an exact p' each iteration buys nothing (the
-  // same 5 SIMPLE iterations per bench step at 1e-8 and 1e-2; 1e-8 costs 3x the V-cycles), and
-  // the final correction leaves 1e-2 of an already converged residual.
+  // momentum solution is below simple_tolerance, so an exact p' each iteration buys nothing (8.75
+  // SIMPLE iterations per bench step at 1e-8, 1e-3 and 1e-2 alike; 1e-8 costs ~3x the V-cycles),
+  // and the final correction leaves 1e-2 of an already converged residual.
   BC_PETSC(KSPSetTolerances(ksp_p_, 1e-2, 1e-50, PETSC_DEFAULT, 1000));
   {
     PC pc;
