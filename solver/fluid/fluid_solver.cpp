@@ -206,7 +206,7 @@ void FluidSolver::create_layout() {
   MPI_Comm_size(comm_, &nranks);
   BC_PETSC(KSPSetType(ksp_p_, KSPGMRES));
   // 1e-2 relative per SIMPLE iteration: SIMPLE iterates until the continuity residual of the
-  // momentum solution is below simple_tolerance, so an exact p' each iteration buys nothing (8.75
+  // momentum solution is below simple_tolerance, so an exact p' each iteration buys nothing (8.5-8.75
   // SIMPLE iterations per bench step at 1e-8, 1e-3 and 1e-2 alike; 1e-8 costs ~3x the V-cycles),
   // and the final correction leaves 1e-2 of an already converged residual.
   BC_PETSC(KSPSetTolerances(ksp_p_, 1e-2, 1e-50, PETSC_DEFAULT, 1000));
