@@ -11,6 +11,7 @@
 
 #include "core/case_params.hpp"
 #include "core/error.hpp"
+#include "fluid/petsc_check.hpp"
 #include "fluid/stencil_matrix.hpp"
 #include "fluid/vreman.hpp"
 
@@ -18,14 +19,11 @@ namespace boycott::fluid {
 
 namespace {
 
-void check(PetscErrorCode ierr, const char* what) {
-  if (ierr != 0) throw std::runtime_error(fmt::format("PETSc call failed ({}): {}", static_cast<int>(ierr), what));
-}
+constexpr auto check = petsc_check;
 #define BC_PETSC(call) check((call), #call)
 
 constexpr int kE[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 
-inline double at(PetscScalar*** a, int i, int j, int k) { return a[k][j][i]; }
 
 /// PETSc log events of the fluid step, so that `-log_view` shows where a step's time goes beside
 /// the KSP events (registered once per process, after PetscInitialize).

@@ -1,7 +1,8 @@
 #include "fluid/stencil_matrix.hpp"
 
+#include "fluid/petsc_check.hpp"
+
 #include <algorithm>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -9,9 +10,7 @@ namespace boycott::fluid {
 
 namespace {
 
-void check(PetscErrorCode ierr, const char* what) {
-  if (ierr != 0) throw std::runtime_error(std::string("PETSc call failed: ") + what);
-}
+constexpr auto check = petsc_check;
 
 constexpr std::int64_t kMissing = INT64_MIN;
 
