@@ -86,15 +86,20 @@ class DemSystem {
   template <class Rolling>
   void compute_forces_impl(const Rolling& rolling);
   void compute_forces();
-  void kick(double h);
+  void kick(double h, bool predict);
   void drift();
   bool needs_rebuild() const;
   void rebuild();
   void collect_histories();
+  /// Zeroes the shear history of the pairs that were in contact and are not among the first nc
+  /// entries of contact_p_.
+  void forget_separated_pairs(std::size_t nc);
+  /// Rebuilds prev_wall_contacts_ from the wall histories (after a reordering or a restart).
+  void rescan_wall_contacts();
   void update_uniform_mass();
   /// r_i + r_j - |x_i - x_j| (minimum image), m; positive when the pair overlaps.
   double pair_overlap(std::size_t i, std::size_t j) const;
-  void predict_velocities(bool from_half_step);
+  void predict_velocities();
   void restore_histories(const std::vector<std::int64_t>& ida, const std::vector<std::int64_t>& idb,
                          const std::vector<double>& h);
 
@@ -103,13 +108,22 @@ class DemSystem {
   NeighborList nl_;
   double cutoff_m_ = 0.0;
   double uniform_mass_kg_ = 0.0;
-  std::vector<double> pred_[6], old_[6];  ///< v, w seen by the forces; v, w at the step's start  ///< > 0 when every particle has this mass
+  std::vector<double> pred_[6];  ///< v, w (m/s, rad/s) seen by the forces: predicted to the force time
   std::vector<double> ref_x_, ref_y_, ref_z_;
   // Tangential spring displacement per list pair (seen from the lower-index particle i), m;
   // x, y, z interleaved so a pair's history is one cache line.
   std::vector<double> h_;
+  // This evaluation's contacts (particle i and list slot p of each, found by the first pass of
+  // the force loop), the list slots in contact at the last one, and a mark per list slot.
+  std::vector<std::uint32_t> contact_i_, contact_p_, prev_contacts_;
+  std::vector<std::uint8_t> pair_mark_;
+  // Per contact of this evaluation: force on i (N), torques on i and on j (N m), 9 blocks.
+  std::vector<double> contact_out_;
   // Per wall, per particle: tangential displacement, m.
   std::vector<std::vector<double>> whx_, why_, whz_;
+  // Particles touching each wall at the last evaluation, and this evaluation's (scratch).
+  std::vector<std::vector<std::uint32_t>> prev_wall_contacts_;
+  std::vector<std::uint32_t> wall_contact_;
   std::vector<std::int64_t> carry_a_, carry_b_;
   std::vector<double> carry_h_;
   double time_ = 0.0;
