@@ -17,7 +17,9 @@ int main(int argc, char** argv) {
   const long nrun = argc > 2 ? std::atol(argv[2]) : 20000;
   CaseParams p = parse_case_file(BOYCOTT_SOURCE_DIR "/studies/cases/dem_only.toml");
   validate(p);
-  particles::DemSystem dem(particles::DemConfig::from_case(p));
+  auto dc = particles::DemConfig::from_case(p);
+  dc.dry = true;  // as the dem_only scene runs it
+  particles::DemSystem dem(dc);
   const double r = 0.5 * p.particles.diameter_m;
   dem.insert_random(p.particles.count, r, p.particles.density_kg_m3, {0.0, 0.0, 0.0},
                     {p.domain.length_x_m, p.domain.width_y_m, p.domain.height_z_m}, 15485863);

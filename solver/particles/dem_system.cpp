@@ -122,6 +122,11 @@ void DemSystem::insert_random(std::int64_t count, double r, double rho, std::arr
 }
 
 void DemSystem::initialize() {
+  if (cfg_.dry)
+    for (std::size_t i = 0; i < s_.size(); ++i)
+      if (s_.ext_x[i] != 0.0 || s_.ext_y[i] != 0.0 || s_.ext_z[i] != 0.0 || s_.ufx[i] != 0.0 || s_.ufy[i] != 0.0 ||
+          s_.ufz[i] != 0.0 || s_.madd[i] != 0.0)
+        throw std::logic_error("DemConfig::dry is set but a particle has a fluid force, velocity or added mass");
   double rmax = 0.0;
   for (double r : s_.radius) rmax = std::max(rmax, r);
   cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
@@ -614,6 +619,60 @@ void kick_component(std::size_t n, double h, double g, const double* __restrict 
 }
 }  // namespace
 
+namespace {
+/// Half kick without fluid (DemConfig::dry): the general kick with F_ext = 0, u_f = 0 and
+/// m_add = 0, which gives the same bits. All three components and the spin in one pass, so
+/// that m, beta and I are read once.
+template <bool Predict>
+void kick_dry(std::size_t n, double h, const std::array<double, 3>& g, ParticleStore& s, std::vector<double>* pred) {
+  const double gx = g[0], gy = g[1], gz = g[2];
+  const double* __restrict m = s.mass.data();
+  const double* __restrict b = s.beta.data();
+  const double* __restrict I = s.inertia.data();
+  const double* __restrict fx = s.fx.data();
+  const double* __restrict fy = s.fy.data();
+  const double* __restrict fz = s.fz.data();
+  const double* __restrict tx = s.tx.data();
+  const double* __restrict ty = s.ty.data();
+  const double* __restrict tz = s.tz.data();
+  double* __restrict vx = s.vx.data();
+  double* __restrict vy = s.vy.data();
+  double* __restrict vz = s.vz.data();
+  double* __restrict wx = s.wx.data();
+  double* __restrict wy = s.wy.data();
+  double* __restrict wz = s.wz.data();
+  double* __restrict p0 = Predict ? pred[0].data() : nullptr;
+  double* __restrict p1 = Predict ? pred[1].data() : nullptr;
+  double* __restrict p2 = Predict ? pred[2].data() : nullptr;
+  double* __restrict p3 = Predict ? pred[3].data() : nullptr;
+  double* __restrict p4 = Predict ? pred[4].data() : nullptr;
+  double* __restrict p5 = Predict ? pred[5].data() : nullptr;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double M = m[i], D = M + h * b[i];
+    const double v0x = vx[i], v0y = vy[i], v0z = vz[i];
+    const double v1x = (M * v0x + h * (fx[i] + M * gx)) / D;
+    const double v1y = (M * v0y + h * (fy[i] + M * gy)) / D;
+    const double v1z = (M * v0z + h * (fz[i] + M * gz)) / D;
+    vx[i] = v1x;
+    vy[i] = v1y;
+    vz[i] = v1z;
+    const double w0x = wx[i], w0y = wy[i], w0z = wz[i];
+    const double w1x = w0x + h * tx[i] / I[i], w1y = w0y + h * ty[i] / I[i], w1z = w0z + h * tz[i] / I[i];
+    wx[i] = w1x;
+    wy[i] = w1y;
+    wz[i] = w1z;
+    if constexpr (Predict) {
+      p0[i] = 2.0 * v1x - v0x;
+      p1[i] = 2.0 * v1y - v0y;
+      p2[i] = 2.0 * v1z - v0z;
+      p3[i] = 2.0 * w1x - w0x;
+      p4[i] = 2.0 * w1y - w0y;
+      p5[i] = 2.0 * w1z - w0z;
+    }
+  }
+}
+}  // namespace
+
 void DemSystem::kick(double h, bool predict) {
   // Half kick of velocity Verlet with the drag implicit (backward Euler over the half step):
   //   (M + h beta) v_new = M v + h (F + F_ext + m g + beta u_f),  M = m + m_add.
@@ -630,31 +689,36 @@ void DemSystem::kick(double h, bool predict) {
   const double* __restrict b = s_.beta.data();
   const double* __restrict I = s_.inertia.data();
   const bool track = cfg_.track_drag_impulse;
-  for (int c = 0; c < 3; ++c) {
-    // One component at a time keeps the streams few enough to vectorise.
-    double* v = (c == 0 ? s_.vx : c == 1 ? s_.vy : s_.vz).data();
-    const double* f = (c == 0 ? s_.fx : c == 1 ? s_.fy : s_.fz).data();
-    const double* e = (c == 0 ? s_.ext_x : c == 1 ? s_.ext_y : s_.ext_z).data();
-    const double* u = (c == 0 ? s_.ufx : c == 1 ? s_.ufy : s_.ufz).data();
-    double* J = (c == 0 ? s_.drag_jx : c == 1 ? s_.drag_jy : s_.drag_jz).data();
-    double* p = predict ? pred_[c].data() : nullptr;
-    const double g = c == 0 ? gx : c == 1 ? gy : gz;
-    if (predict && track) kick_component<true, true>(n, h, g, m, ma, b, f, e, u, v, J, p);
-    else if (predict) kick_component<true, false>(n, h, g, m, ma, b, f, e, u, v, J, p);
-    else if (track) kick_component<false, true>(n, h, g, m, ma, b, f, e, u, v, J, p);
-    else kick_component<false, false>(n, h, g, m, ma, b, f, e, u, v, J, p);
-    double* __restrict w = (c == 0 ? s_.wx : c == 1 ? s_.wy : s_.wz).data();
-    const double* __restrict t = (c == 0 ? s_.tx : c == 1 ? s_.ty : s_.tz).data();
-    if (predict) {
-      double* __restrict pw = pred_[3 + c].data();
-      for (std::size_t i = 0; i < n; ++i) {
-        const double w0 = w[i];
-        const double w1 = w0 + h * t[i] / I[i];
-        w[i] = w1;
-        pw[i] = 2.0 * w1 - w0;
+  if (cfg_.dry && !track) {
+    if (predict) kick_dry<true>(n, h, cfg_.gravity_m_s2, s_, pred_);
+    else kick_dry<false>(n, h, cfg_.gravity_m_s2, s_, pred_);
+  } else {
+    for (int c = 0; c < 3; ++c) {
+      // One component at a time keeps the streams few enough to vectorise.
+      double* v = (c == 0 ? s_.vx : c == 1 ? s_.vy : s_.vz).data();
+      const double* f = (c == 0 ? s_.fx : c == 1 ? s_.fy : s_.fz).data();
+      const double* e = (c == 0 ? s_.ext_x : c == 1 ? s_.ext_y : s_.ext_z).data();
+      const double* u = (c == 0 ? s_.ufx : c == 1 ? s_.ufy : s_.ufz).data();
+      double* J = (c == 0 ? s_.drag_jx : c == 1 ? s_.drag_jy : s_.drag_jz).data();
+      double* p = predict ? pred_[c].data() : nullptr;
+      const double g = c == 0 ? gx : c == 1 ? gy : gz;
+      if (predict && track) kick_component<true, true>(n, h, g, m, ma, b, f, e, u, v, J, p);
+      else if (predict) kick_component<true, false>(n, h, g, m, ma, b, f, e, u, v, J, p);
+      else if (track) kick_component<false, true>(n, h, g, m, ma, b, f, e, u, v, J, p);
+      else kick_component<false, false>(n, h, g, m, ma, b, f, e, u, v, J, p);
+      double* __restrict w = (c == 0 ? s_.wx : c == 1 ? s_.wy : s_.wz).data();
+      const double* __restrict t = (c == 0 ? s_.tx : c == 1 ? s_.ty : s_.tz).data();
+      if (predict) {
+        double* __restrict pw = pred_[3 + c].data();
+        for (std::size_t i = 0; i < n; ++i) {
+          const double w0 = w[i];
+          const double w1 = w0 + h * t[i] / I[i];
+          w[i] = w1;
+          pw[i] = 2.0 * w1 - w0;
+        }
+      } else {
+        for (std::size_t i = 0; i < n; ++i) w[i] += h * t[i] / I[i];
       }
-    } else {
-      for (std::size_t i = 0; i < n; ++i) w[i] += h * t[i] / I[i];
     }
   }
   if (predict) {

@@ -26,6 +26,10 @@ struct DemConfig {
   double rolling_friction = 0.1;
   /// Accumulate the applied drag impulse per particle (ParticleStore::drag_j*), for coupling.
   bool track_drag_impulse = false;
+  /// No fluid (the dem_only scene): the external forces, fluid velocities and added masses are
+  /// all zero, so the kicks need not read them (a DEM step is memory-bound: 21 streams instead
+  /// of 36). Only the implicit drag beta toward rest remains. initialize() checks the zeros.
+  bool dry = false;
 
   /// Channel of the case: periodic x and z, walls at y = 0 and y = W unless periodic_y.
   static DemConfig from_case(const CaseParams& p);

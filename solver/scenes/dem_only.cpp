@@ -24,7 +24,9 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
                                  "against still fluid) or \"none\"",
                                  p.forces.drag));
   ModelTimers timers;
-  particles::DemSystem dem(particles::DemConfig::from_case(p));
+  auto dc = particles::DemConfig::from_case(p);
+  dc.dry = true;  // no fluid arrays in the kicks; Stokes drag is the beta toward rest
+  particles::DemSystem dem(dc);
   insert_case_particles(dem, p);
   auto& s = dem.particles();
   const bool stokes = p.forces.drag == "stokes";
