@@ -232,9 +232,12 @@ void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const st
   const std::size_t np = nl_.pair_count();
   h_.assign(3 * np, 0.0);
   // A new list: the pairs with a history (restored below) are the ones forget_separated_pairs
-  // must look at next.
+  // must look at next, and the flat row index of each slot is refreshed.
   pair_mark_.assign(np, 0);
   prev_contacts_.clear();
+  pair_i_.resize(np);
+  for (std::size_t i = 0; i < s_.size(); ++i)
+    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) pair_i_[p] = static_cast<std::uint32_t>(i);
   if (ida.empty()) return;
   // Sorted (key, slot) table; only pairs that overlap now can carry a history (it is reset
   // whenever a pair separates), so only those are looked up.
@@ -344,37 +347,37 @@ namespace {
 inline double wrap_rn(double d, double L, double inv_L) { return d - L * std::nearbyint(d * inv_L); }
 
 /// First pass of the force loop: appends (i, list slot) of each overlapping list pair to ci, cp
-/// and returns their number. The periodic directions are template flags so that the loop body
-/// has no branch at all.
+/// and returns their number. The test runs over the flat pair arrays (pair_i, nb) so that it
+/// vectorises (gathers) into a byte per pair; the append is a second, branch-free scalar pass.
+/// The periodic directions are template flags so that the loop body has no branch at all.
 template <bool PX, bool PY, bool PZ>
-std::size_t find_contacts(std::size_t n, const std::uint32_t* __restrict off, const std::uint32_t* __restrict nb,
+std::size_t find_contacts(std::size_t np, const std::uint32_t* __restrict pair_i, const std::uint32_t* __restrict nb,
                           const double* __restrict x, const double* __restrict y, const double* __restrict z,
-                          const double* __restrict rad, const std::array<double, 3>& len, std::uint32_t* __restrict ci,
-                          std::uint32_t* __restrict cp) {
+                          const double* __restrict rad, const std::array<double, 3>& len, std::uint8_t* __restrict flag,
+                          std::uint32_t* __restrict ci, std::uint32_t* __restrict cp) {
   const double Lx = len[0], Ly = len[1], Lz = len[2];
   const double iLx = 1.0 / Lx, iLy = 1.0 / Ly, iLz = 1.0 / Lz;
+  for (std::size_t p = 0; p < np; ++p) {
+    const std::uint32_t i = pair_i[p], j = nb[p];
+    double dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
+    if constexpr (PX) dx = wrap_rn(dx, Lx, iLx);
+    if constexpr (PY) dy = wrap_rn(dy, Ly, iLy);
+    if constexpr (PZ) dz = wrap_rn(dz, Lz, iLz);
+    const double rsum = rad[i] + rad[j];
+    flag[p] = dx * dx + dy * dy + dz * dz < rsum * rsum;
+  }
   std::size_t nc = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double xi = x[i], yi = y[i], zi = z[i], ri = rad[i];
-    const std::uint32_t end = off[i + 1];
-    for (std::uint32_t p = off[i]; p < end; ++p) {
-      const std::uint32_t j = nb[p];
-      double dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
-      if constexpr (PX) dx = wrap_rn(dx, Lx, iLx);
-      if constexpr (PY) dy = wrap_rn(dy, Ly, iLy);
-      if constexpr (PZ) dz = wrap_rn(dz, Lz, iLz);
-      const double rsum = ri + rad[j];
-      ci[nc] = static_cast<std::uint32_t>(i);
-      cp[nc] = p;
-      nc += dx * dx + dy * dy + dz * dz < rsum * rsum;
-    }
+  for (std::size_t p = 0; p < np; ++p) {
+    ci[nc] = pair_i[p];
+    cp[nc] = static_cast<std::uint32_t>(p);
+    nc += flag[p];
   }
   return nc;
 }
 
 using FindContactsFn = std::size_t (*)(std::size_t, const std::uint32_t*, const std::uint32_t*, const double*,
                                        const double*, const double*, const double*, const std::array<double, 3>&,
-                                       std::uint32_t*, std::uint32_t*);
+                                       std::uint8_t*, std::uint32_t*, std::uint32_t*);
 // Indexed by periodic x | y << 1 | z << 2.
 constexpr FindContactsFn kFindContacts[8] = {
     find_contacts<false, false, false>, find_contacts<true, false, false>, find_contacts<false, true, false>,
@@ -427,14 +430,15 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   // bench) are apart, so this is a short branch-free loop that only appends the pair to the
   // contact list; the contact work below then runs without mispredicted branches.
   const std::uint32_t* __restrict nb = nl_.neighbors.data();
-  const std::uint32_t* __restrict off = nl_.offsets.data();
   const std::size_t np = nl_.pair_count();
   contact_i_.resize(np);
   contact_p_.resize(np);
   std::uint32_t* __restrict ci = contact_i_.data();
   std::uint32_t* __restrict cp = contact_p_.data();
   const int periodic_bits = (px ? 1 : 0) | (py ? 2 : 0) | (pz ? 4 : 0);
-  const std::size_t nc = kFindContacts[periodic_bits](n, off, nb, x, y, z, rad, cfg_.box.len, ci, cp);
+  pair_flag_.resize(np);
+  const std::size_t nc =
+      kFindContacts[periodic_bits](np, pair_i_.data(), nb, x, y, z, rad, cfg_.box.len, pair_flag_.data(), ci, cp);
   forget_separated_pairs(nc);
   contacts = static_cast<std::int64_t>(nc);
 
@@ -621,8 +625,9 @@ void kick_component(std::size_t n, double h, double g, const double* __restrict 
 
 namespace {
 /// Half kick without fluid (DemConfig::dry): the general kick with F_ext = 0, u_f = 0 and
-/// m_add = 0, which gives the same bits. All three components and the spin in one pass, so
-/// that m, beta and I are read once.
+/// m_add = 0, with one reciprocal per particle instead of a division per component (the
+/// results differ from the general kick in the last bit). All three components and the spin in
+/// one pass, so that m, beta and I are read once.
 template <bool Predict>
 void kick_dry(std::size_t n, double h, const std::array<double, 3>& g, ParticleStore& s, std::vector<double>* pred) {
   const double gx = g[0], gy = g[1], gz = g[2];
@@ -648,16 +653,17 @@ void kick_dry(std::size_t n, double h, const std::array<double, 3>& g, ParticleS
   double* __restrict p4 = Predict ? pred[4].data() : nullptr;
   double* __restrict p5 = Predict ? pred[5].data() : nullptr;
   for (std::size_t i = 0; i < n; ++i) {
-    const double M = m[i], D = M + h * b[i];
+    // Two divisions per particle, not six: divisions, not memory, bound this loop otherwise.
+    const double M = m[i], inv_D = 1.0 / (M + h * b[i]), h_I = h / I[i];
     const double v0x = vx[i], v0y = vy[i], v0z = vz[i];
-    const double v1x = (M * v0x + h * (fx[i] + M * gx)) / D;
-    const double v1y = (M * v0y + h * (fy[i] + M * gy)) / D;
-    const double v1z = (M * v0z + h * (fz[i] + M * gz)) / D;
+    const double v1x = (M * v0x + h * (fx[i] + M * gx)) * inv_D;
+    const double v1y = (M * v0y + h * (fy[i] + M * gy)) * inv_D;
+    const double v1z = (M * v0z + h * (fz[i] + M * gz)) * inv_D;
     vx[i] = v1x;
     vy[i] = v1y;
     vz[i] = v1z;
     const double w0x = wx[i], w0y = wy[i], w0z = wz[i];
-    const double w1x = w0x + h * tx[i] / I[i], w1y = w0y + h * ty[i] / I[i], w1z = w0z + h * tz[i] / I[i];
+    const double w1x = w0x + h_I * tx[i], w1y = w0y + h_I * ty[i], w1z = w0z + h_I * tz[i];
     wx[i] = w1x;
     wy[i] = w1y;
     wz[i] = w1z;

@@ -121,6 +121,10 @@ class DemSystem {
   // the force loop), the list slots in contact at the last one, and a mark per list slot.
   std::vector<std::uint32_t> contact_i_, contact_p_, prev_contacts_;
   std::vector<std::uint8_t> pair_mark_;
+  // Particle i of each list slot (the list's row, flattened; rebuilt with the list) and the
+  // overlap test's result per slot (scratch).
+  std::vector<std::uint32_t> pair_i_;
+  std::vector<std::uint8_t> pair_flag_;
   // Per contact of this evaluation: force on i (N), torques on i and on j (N m), 9 blocks.
   std::vector<double> contact_out_;
   // Per wall, per particle: tangential displacement, m.

@@ -72,6 +72,13 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
   offsets.assign(n + 1, 0);
   neighbors.clear();
   neighbors.reserve(n * 8);
+  // Stored cell by cell (bin_and_order, and a restart at the reference positions), a cell's
+  // members are a contiguous, increasing index range: then the half list (j > i) needs nothing
+  // from lower cells and only the tail of the own cell, which halves the distance tests. The
+  // pairs kept and their order are the same as with the full scan.
+  bool by_cell = true;
+  for (std::size_t i = 0; i < n && by_cell; ++i)
+    by_cell = cell_items_[i] == i && (i == 0 || cell_of_[i - 1] <= cell_of_[i]);
   for (std::size_t i = 0; i < n; ++i) {
     const int c = cell_of_[i];
     const int cx = c % nc_[0], cy = (c / nc_[0]) % nc_[1], cz = c / (nc_[0] * nc_[1]);
@@ -88,7 +95,12 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
           if (g.periodic[0]) kx = (kx + nc_[0]) % nc_[0];
           else if (kx < 0 || kx >= nc_[0]) continue;
           const int nb = kx + nc_[0] * (ky + nc_[1] * kz);
-          for (std::uint32_t q = cell_start_[nb]; q < cell_start_[nb + 1]; ++q) {
+          std::uint32_t q0 = cell_start_[nb];
+          if (by_cell) {
+            if (nb < c) continue;
+            if (nb == c) q0 = static_cast<std::uint32_t>(i + 1);
+          }
+          for (std::uint32_t q = q0; q < cell_start_[nb + 1]; ++q) {
             const std::uint32_t j = cell_items_[q];
             if (j <= i) continue;
             const double dx = min_image(s.x[i] - s.x[j], g.len[0], g.periodic[0]);
