@@ -2,7 +2,8 @@
 # Installs the Debian packages the build needs, only when one is missing.
 set -euo pipefail
 pkgs=(build-essential cmake pkg-config git libpetsc-real-dev libhdf5-openmpi-dev openmpi-bin libcli11-dev
-      libsqlite3-dev sqlite3 libgtest-dev libtomlplusplus-dev libfmt-dev nlohmann-json3-dev libbenchmark-dev)
+      libsqlite3-dev sqlite3 libgtest-dev libtomlplusplus-dev libfmt-dev nlohmann-json3-dev libbenchmark-dev
+      libfftw3-dev)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -12,6 +12,7 @@
 #include "core/case_params.hpp"
 #include "core/error.hpp"
 #include "fluid/petsc_check.hpp"
+#include "fluid/spectral_poisson_pc.hpp"
 #include "fluid/stencil_matrix.hpp"
 #include "fluid/vreman.hpp"
 
@@ -90,6 +91,19 @@ void set_pressure_amg(PC pc, bool boomeramg) {
 #endif
   (void)boomeramg;
   check(PCSetType(pc, PCGAMG), "PCSetType");
+}
+
+PetscErrorCode apply_spectral_pc(PC pc, Vec x, Vec y) {
+  void* ctx = nullptr;
+  PetscCall(PCShellGetContext(pc, &ctx));
+  const PetscScalar* xa;
+  PetscScalar* ya;
+  PetscCall(VecGetArrayRead(x, &xa));
+  PetscCall(VecGetArray(y, &ya));
+  static_cast<SpectralPoissonPreconditioner*>(ctx)->apply(xa, ya);
+  PetscCall(VecRestoreArrayRead(x, &xa));
+  PetscCall(VecRestoreArray(y, &ya));
+  return 0;
 }
 
 /// Variable-step BDF2 weights: (c0 y^{n+1} - c1 y^n + c2 y^{n-1}) / dt with w = dt/dt_prev,
@@ -211,7 +225,22 @@ void FluidSolver::create_layout() {
   {
     PC pc;
     BC_PETSC(KSPGetPC(ksp_p_, &pc));
-    set_pressure_amg(pc, nranks == 1);
+    PetscBool user_pc = PETSC_FALSE;
+    BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-pressure_pc_type", &user_pc));
+    if (nranks == 1 && !user_pc) {
+      // One rank: the spectral preconditioner (spectral_poisson_pc.hpp); AMG stays the
+      // fallback. More ranks: AMG (the FFTs here are not distributed).
+      spectral_pc_ = std::make_unique<SpectralPoissonPreconditioner>((int)g.n[0], (int)g.n[1], (int)g.n[2], g.periodic[1]);
+      BC_PETSC(PCSetType(pc, PCSHELL));
+      BC_PETSC(PCShellSetContext(pc, spectral_pc_.get()));
+      BC_PETSC(PCShellSetApply(pc, apply_spectral_pc));
+      BC_PETSC(PCShellSetName(pc, "spectral constant-coefficient Poisson (FFT in x, z)"));
+      // With this preconditioner a tighter solve is cheap (about one Krylov iteration per
+      // decade) and saves SIMPLE iterations: 5.8 -> 5.0 per bench step at 1e-3 (1e-4: 5.0).
+      BC_PETSC(KSPSetTolerances(ksp_p_, 1e-3, 1e-50, PETSC_DEFAULT, 1000));
+    } else {
+      set_pressure_amg(pc, nranks == 1);
+    }
   }
   BC_PETSC(KSPSetFromOptions(ksp_p_));
   // Periodic x, z and walls (or periodicity) in y: pure Neumann, the constant is the null space.
@@ -709,6 +738,8 @@ void FluidSolver::assemble_pressure() {
     return af * D[d][qk][qj][qi] / (h[d] * h[d]);
   };
   std::int64_t o = 0;
+  // Mean face coefficient per direction (walls excluded), for the spectral preconditioner.
+  double csum[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
   for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
     for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j)
       for (int i = (int)b.lo[0]; i < b.lo[0] + b.size[0]; ++i, ++o) {
@@ -716,6 +747,10 @@ void FluidSolver::assemble_pressure() {
         for (int d = 0; d < 3; ++d) {
           const double cm = coef(d, i, j, k);
           const double cp = coef(d, i + kE[d][0], j + kE[d][1], k + kE[d][2]);
+          if (cm != 0.0) {
+            csum[d] += cm;
+            csum[3 + d] += 1.0;
+          }
           diag += cm + cp;
           if (cm != 0.0) W.add(o, 1 + 2 * d, -cm);
           if (cp != 0.0) W.add(o, 2 + 2 * d, -cp);
@@ -725,6 +760,13 @@ void FluidSolver::assemble_pressure() {
   for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecRestoreArray(da_, Dl_[d], &D[d]));
   BC_PETSC(DMDAVecRestoreArray(da_, alphal_[0], &al));
   W.end(Ap_);
+  if (spectral_pc_) {
+    double gsum[6];
+    MPI_Allreduce(csum, gsum, 6, MPI_DOUBLE, MPI_SUM, comm_);
+    double c[3];
+    for (int d = 0; d < 3; ++d) c[d] = gsum[3 + d] > 0.0 ? gsum[d] / gsum[3 + d] : 0.0;
+    spectral_pc_->set_coefficients(c[0], c[1], c[2]);
+  }
   BC_PETSC(KSPSetOperators(ksp_p_, Ap_, Ap_));
 }
 

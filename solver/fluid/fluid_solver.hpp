@@ -40,6 +40,7 @@ struct CaseParams;
 namespace boycott::fluid {
 
 class StencilMatrixWriter;
+class SpectralPoissonPreconditioner;
 
 struct FluidSettings {
   GridSpec grid;
@@ -195,6 +196,8 @@ class FluidSolver {
   Mat Ap_ = nullptr;   // pressure-correction matrix
   KSP ksp_m_ = nullptr, ksp_p_ = nullptr;
   KSP ksp_p_fallback_ = nullptr;  // GAMG, created on the first failed pressure solve
+  // The pressure preconditioner on one rank unless the user picks another (-pressure_pc_type).
+  std::unique_ptr<SpectralPoissonPreconditioner> spectral_pc_;
   int pressure_fallbacks_ = 0;
   MatNullSpace null_ = nullptr;
 

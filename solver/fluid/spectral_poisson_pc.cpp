@@ -1,0 +1,109 @@
+#include "fluid/spectral_poisson_pc.hpp"
+
+#include <fftw3.h>
+
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+namespace boycott::fluid {
+
+namespace {
+constexpr double kTwoPi = 6.283185307179586476925286766559;
+}
+
+SpectralPoissonPreconditioner::SpectralPoissonPreconditioner(int nx, int ny, int nz, bool periodic_y)
+    : nx_(nx), ny_(ny), nz_(nz), nkx_(nx / 2 + 1), periodic_y_(periodic_y) {
+  if (nx < 1 || ny < 1 || nz < 1) throw std::invalid_argument("SpectralPoissonPreconditioner: empty grid");
+  // y eigenvectors. Walls (cell-centred Neumann): cos(pi m (j + 1/2) / ny), eigenvalue
+  // 2 - 2 cos(pi m / ny). Periodic: the real Fourier basis, eigenvalue 2 - 2 cos(2 pi m' / ny).
+  qy_.assign(static_cast<std::size_t>(ny) * ny, 0.0);
+  sy_.assign(ny, 0.0);
+  for (int m = 0; m < ny; ++m) {
+    double lambda;
+    for (int j = 0; j < ny; ++j) {
+      double v;
+      if (!periodic_y) {
+        v = std::cos(M_PI * m * (j + 0.5) / ny);
+      } else {
+        // m = 0: constant; odd m -> cos of wavenumber (m+1)/2, even m -> sin of wavenumber m/2
+        const int w = (m + 1) / 2;
+        v = (m % 2 == 1) ? std::cos(kTwoPi * w * j / ny) : (m == 0 ? 1.0 : std::sin(kTwoPi * w * j / ny));
+      }
+      qy_[static_cast<std::size_t>(j) * ny + m] = v;
+    }
+    lambda = periodic_y ? 2.0 - 2.0 * std::cos(kTwoPi * ((m + 1) / 2) / ny) : 2.0 - 2.0 * std::cos(M_PI * m / ny);
+    sy_[m] = lambda;
+    double nrm = 0.0;
+    for (int j = 0; j < ny; ++j) nrm += qy_[static_cast<std::size_t>(j) * ny + m] * qy_[static_cast<std::size_t>(j) * ny + m];
+    if (nrm < 1e-12) {  // the sine of the Nyquist wavenumber vanishes on the grid: unused mode
+      sy_[m] = -1.0;
+      continue;
+    }
+    nrm = 1.0 / std::sqrt(nrm);
+    for (int j = 0; j < ny; ++j) qy_[static_cast<std::size_t>(j) * ny + m] *= nrm;
+  }
+  sx_.resize(nkx_);
+  for (int k = 0; k < nkx_; ++k) sx_[k] = 2.0 - 2.0 * std::cos(kTwoPi * k / nx);
+  sz_.resize(nz);
+  for (int k = 0; k < nz; ++k) sz_[k] = 2.0 - 2.0 * std::cos(kTwoPi * k / nz);
+
+  const std::size_t nreal = static_cast<std::size_t>(ny) * nz * nx;
+  const std::size_t ncplx = static_cast<std::size_t>(ny) * nz * nkx_;
+  real_ = fftw_alloc_real(nreal);
+  auto* spec = fftw_alloc_complex(ncplx);
+  spec_ = spec;
+  col_.resize(ny);
+  int n[2] = {nz, nx};
+  // FFTW_ESTIMATE: plans in microseconds; MEASURE would time candidate plans at every start.
+  fwd_ = fftw_plan_many_dft_r2c(2, n, ny, real_, nullptr, 1, nz * nx, spec, nullptr, 1, nz * nkx_, FFTW_ESTIMATE);
+  bwd_ = fftw_plan_many_dft_c2r(2, n, ny, spec, nullptr, 1, nz * nkx_, real_, nullptr, 1, nz * nx, FFTW_ESTIMATE);
+  if (!fwd_ || !bwd_) throw std::runtime_error("SpectralPoissonPreconditioner: FFTW plan failed");
+}
+
+SpectralPoissonPreconditioner::~SpectralPoissonPreconditioner() {
+  if (fwd_) fftw_destroy_plan(static_cast<fftw_plan>(fwd_));
+  if (bwd_) fftw_destroy_plan(static_cast<fftw_plan>(bwd_));
+  fftw_free(real_);
+  fftw_free(spec_);
+}
+
+void SpectralPoissonPreconditioner::set_coefficients(double cx, double cy, double cz) { c_ = {cx, cy, cz}; }
+
+void SpectralPoissonPreconditioner::apply(const double* r, double* z) {
+  const std::size_t plane = static_cast<std::size_t>(nz_) * nx_;
+  // r[i + nx (j + ny k)] -> real_[j][k][i]
+  for (int k = 0; k < nz_; ++k)
+    for (int j = 0; j < ny_; ++j)
+      std::memcpy(real_ + j * plane + static_cast<std::size_t>(k) * nx_,
+                  r + static_cast<std::size_t>(nx_) * (j + static_cast<std::size_t>(ny_) * k), sizeof(double) * nx_);
+  fftw_execute(static_cast<fftw_plan>(fwd_));
+  auto* spec = reinterpret_cast<std::complex<double>*>(spec_);
+  const std::size_t cplane = static_cast<std::size_t>(nz_) * nkx_;
+  // Per (kz, kx): to the y eigenbasis, divide by the eigenvalue, back. The zero eigenvalue (the
+  // constant) is dropped: that is the null space of the pure-Neumann/periodic pressure system.
+  const double scale = 1.0 / (static_cast<double>(nx_) * nz_);
+  for (int kz = 0; kz < nz_; ++kz)
+    for (int kx = 0; kx < nkx_; ++kx) {
+      const std::size_t o = static_cast<std::size_t>(kz) * nkx_ + kx;
+      const double lxz = c_[0] * sx_[kx] + c_[2] * sz_[kz];
+      for (int m = 0; m < ny_; ++m) {
+        std::complex<double> a = 0.0;
+        for (int j = 0; j < ny_; ++j) a += qy_[static_cast<std::size_t>(j) * ny_ + m] * spec[j * cplane + o];
+        const double lam = lxz + c_[1] * sy_[m];
+        col_[m] = (sy_[m] < 0.0 || lam <= 1e-12 * (c_[0] + c_[1] + c_[2])) ? 0.0 : a * (scale / lam);
+      }
+      for (int j = 0; j < ny_; ++j) {
+        std::complex<double> a = 0.0;
+        for (int m = 0; m < ny_; ++m) a += qy_[static_cast<std::size_t>(j) * ny_ + m] * col_[m];
+        spec[j * cplane + o] = a;
+      }
+    }
+  fftw_execute(static_cast<fftw_plan>(bwd_));
+  for (int k = 0; k < nz_; ++k)
+    for (int j = 0; j < ny_; ++j)
+      std::memcpy(z + static_cast<std::size_t>(nx_) * (j + static_cast<std::size_t>(ny_) * k),
+                  real_ + j * plane + static_cast<std::size_t>(k) * nx_, sizeof(double) * nx_);
+}
+
+}  // namespace boycott::fluid
