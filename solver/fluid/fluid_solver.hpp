@@ -41,6 +41,7 @@ namespace boycott::fluid {
 
 class StencilMatrixWriter;
 class SpectralPoissonPreconditioner;
+struct SpectralPcShell;
 
 struct FluidSettings {
   GridSpec grid;
@@ -182,6 +183,8 @@ class FluidSolver {
   void compute_face_fluxes();
   void compute_effective_viscosity();
   void assemble_momentum(int c, double dt, double c0, double c1, double c2, bool first_iteration);
+  template <int c, bool wall, bool use_quick>
+  void assemble_momentum_t(double dt, double c0, double c1, double c2, bool first_iteration);
   void apply_flux_controller();
   double continuity_residual(double dt, double c0, double c1, double c2, Vec R);
   void assemble_pressure();
@@ -197,7 +200,7 @@ class FluidSolver {
   KSP ksp_m_ = nullptr, ksp_p_ = nullptr;
   KSP ksp_p_fallback_ = nullptr;  // GAMG, created on the first failed pressure solve
   // The pressure preconditioner on one rank unless the user picks another (-pressure_pc_type).
-  std::unique_ptr<SpectralPoissonPreconditioner> spectral_pc_;
+  std::unique_ptr<SpectralPcShell> spectral_pc_;
   int pressure_fallbacks_ = 0;
   MatNullSpace null_ = nullptr;
 
