@@ -675,36 +675,25 @@ void kick_wet(std::size_t n, double h, const std::array<double, 3>& g, ParticleS
 
 namespace {
 /// Half kick without fluid (DemConfig::dry): the general kick with F_ext = 0, u_f = 0 and
-/// m_add = 0, with one reciprocal per particle instead of a division per component (the
-/// results differ from the general kick in the last bit). All three components and the spin in
-/// one pass, so that m, beta and I are read once.
+/// m_add = 0, with one reciprocal per particle instead of a division per component. All three
+/// components in one pass, so that m and beta are read once; then the spin.
 template <bool Predict>
 void kick_dry(std::size_t n, double h, const std::array<double, 3>& g, ParticleStore& s, std::vector<double>* pred) {
   const double gx = g[0], gy = g[1], gz = g[2];
   const double* __restrict m = s.mass.data();
   const double* __restrict b = s.beta.data();
-  const double* __restrict I = s.inertia.data();
   const double* __restrict fx = s.fx.data();
   const double* __restrict fy = s.fy.data();
   const double* __restrict fz = s.fz.data();
-  const double* __restrict tx = s.tx.data();
-  const double* __restrict ty = s.ty.data();
-  const double* __restrict tz = s.tz.data();
   double* __restrict vx = s.vx.data();
   double* __restrict vy = s.vy.data();
   double* __restrict vz = s.vz.data();
-  double* __restrict wx = s.wx.data();
-  double* __restrict wy = s.wy.data();
-  double* __restrict wz = s.wz.data();
   double* __restrict p0 = Predict ? pred[0].data() : nullptr;
   double* __restrict p1 = Predict ? pred[1].data() : nullptr;
   double* __restrict p2 = Predict ? pred[2].data() : nullptr;
-  double* __restrict p3 = Predict ? pred[3].data() : nullptr;
-  double* __restrict p4 = Predict ? pred[4].data() : nullptr;
-  double* __restrict p5 = Predict ? pred[5].data() : nullptr;
   for (std::size_t i = 0; i < n; ++i) {
-    // Two divisions per particle, not six: divisions, not memory, bound this loop otherwise.
-    const double M = m[i], inv_D = 1.0 / (M + h * b[i]), h_I = h / I[i];
+    // One division per particle, not three: divisions, not memory, bound this loop otherwise.
+    const double M = m[i], inv_D = 1.0 / (M + h * b[i]);
     const double v0x = vx[i], v0y = vy[i], v0z = vz[i];
     const double v1x = (M * v0x + h * (fx[i] + M * gx)) * inv_D;
     const double v1y = (M * v0y + h * (fy[i] + M * gy)) * inv_D;
@@ -712,20 +701,18 @@ void kick_dry(std::size_t n, double h, const std::array<double, 3>& g, ParticleS
     vx[i] = v1x;
     vy[i] = v1y;
     vz[i] = v1z;
-    const double w0x = wx[i], w0y = wy[i], w0z = wz[i];
-    const double w1x = w0x + h_I * tx[i], w1y = w0y + h_I * ty[i], w1z = w0z + h_I * tz[i];
-    wx[i] = w1x;
-    wy[i] = w1y;
-    wz[i] = w1z;
     if constexpr (Predict) {
       p0[i] = 2.0 * v1x - v0x;
       p1[i] = 2.0 * v1y - v0y;
       p2[i] = 2.0 * v1z - v0z;
-      p3[i] = 2.0 * w1x - w0x;
-      p4[i] = 2.0 * w1y - w0y;
-      p5[i] = 2.0 * w1z - w0z;
     }
   }
+  // The spin arrays share nothing with the translation: a second loop reads no stream twice.
+  double* p[3] = {nullptr, nullptr, nullptr};
+  if constexpr (Predict)
+    for (int c = 0; c < 3; ++c) p[c] = pred[3 + c].data();
+  kick_spin<Predict>(n, h, s.inertia.data(), s.tx.data(), s.ty.data(), s.tz.data(), s.wx.data(), s.wy.data(),
+                     s.wz.data(), p[0], p[1], p[2]);
 }
 }  // namespace
 
