@@ -461,59 +461,59 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   // a select on the loop-invariant flag would keep the loop from vectorising.
   const double Pxl = px ? Lx : 0.0, Pyl = py ? Ly : 0.0, Pzl = pz ? Lz : 0.0;
   const double damping_factor = cm.damping_factor;
-// Equal masses (the usual case) and mixed ones are separate loops: a select between them would
+  // Equal masses (the usual case) and mixed ones are separate loops: a select between them would
   // turn the mass loads into masked gathers, which do not vectorise.
   auto contact_loop = [&](auto uniform_masses) {
 #pragma GCC ivdep
-  for (std::size_t k = 0; k < nc; ++k) {
-    const std::uint32_t i = ci[k], p = cp[k], j = nb[p];
-    const double ri = rad[i], rj = rad[j], mi = mass[i], mj = mass[j];
-    double dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
-    dx = wrap_rn(dx, Pxl, iLx);
-    dy = wrap_rn(dy, Pyl, iLy);
-    dz = wrap_rn(dz, Pzl, iLz);
-    const double rsum = ri + rj;
-    const double r = std::sqrt(dx * dx + dy * dy + dz * dz);
-    const double inv = 1.0 / r;
-    const double nx = dx * inv, ny = dy * inv, nz = dz * inv;
-    // (R_i w_i + R_j w_j) x n: surface velocities of the two spheres at the contact point.
-    const double cx = ri * wx[i] + rj * wx[j], cy = ri * wy[i] + rj * wy[j], cz = ri * wz[i] + rj * wz[j];
-    const double vrx = vx[i] - vx[j] - (cy * nz - cz * ny);
-    const double vry = vy[i] - vy[j] - (cz * nx - cx * nz);
-    const double vrz = vz[i] - vz[j] - (cx * ny - cy * nx);
-    // gamma_n needs sqrt(m_eff k_n): a constant when all masses are equal (the usual case).
-    double gn = gn_pair;
-    if constexpr (!decltype(uniform_masses)::value) gn = damping_factor * std::sqrt(mi * mj / (mi + mj) * kn);
-    double ftx, fty, ftz;
-    const double fn = spring_dashpot(cm, dt, nx, ny, nz, rsum - r, vrx, vry, vrz, gn, hist[3 * p], hist[3 * p + 1],
-                                     hist[3 * p + 2], ftx, fty, ftz);
-    oFx[k] = fn * nx + ftx;
-    oFy[k] = fn * ny + fty;
-    oFz[k] = fn * nz + ftz;
-    // Torque -R n x F_t on both spheres (the arm of j is +R_j n, its force -F_t).
-    const double mx = ny * ftz - nz * fty, my = nz * ftx - nx * ftz, mz = nx * fty - ny * ftx;
-    double rtx = 0.0, rty = 0.0, rtz = 0.0;
-    if constexpr (Rolling::enabled) {
-      // Rolling resistance q per unit radius (T_i = -R_i q, T_j = +R_j q), |q| <= mu_r |F_n|
-      // (Eq. 11). q is the value that, with this contact's friction torque, stops the relative
-      // rolling within the coming step; capped, it is Eq. 11's constant torque along the
-      // rolling direction. Below the cap the contact holds like static friction instead of
-      // flipping sign every step (chatter) or creeping at O(g dt).
-      const double orx = spx[i] - spx[j], ory = spy[i] - spy[j], orz = spz[i] - spz[j];
-      const double on = orx * nx + ory * ny + orz * nz;
-      const double ai = ri / inertia[i], aj = rj / inertia[j], ik = 1.0 / (ai + aj);
-      const double qx = ((orx - on * nx) * inv_dt + (aj - ai) * mx) * ik;
-      const double qy = ((ory - on * ny) * inv_dt + (aj - ai) * my) * ik;
-      const double qz = ((orz - on * nz) * inv_dt + (aj - ai) * mz) * ik;
-      cap_rolling(qx, qy, qz, rolling.mu_r * std::abs(fn), rtx, rty, rtz);
+    for (std::size_t k = 0; k < nc; ++k) {
+      const std::uint32_t i = ci[k], p = cp[k], j = nb[p];
+      const double ri = rad[i], rj = rad[j], mi = mass[i], mj = mass[j];
+      double dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
+      dx = wrap_rn(dx, Pxl, iLx);
+      dy = wrap_rn(dy, Pyl, iLy);
+      dz = wrap_rn(dz, Pzl, iLz);
+      const double rsum = ri + rj;
+      const double r = std::sqrt(dx * dx + dy * dy + dz * dz);
+      const double inv = 1.0 / r;
+      const double nx = dx * inv, ny = dy * inv, nz = dz * inv;
+      // (R_i w_i + R_j w_j) x n: surface velocities of the two spheres at the contact point.
+      const double cx = ri * wx[i] + rj * wx[j], cy = ri * wy[i] + rj * wy[j], cz = ri * wz[i] + rj * wz[j];
+      const double vrx = vx[i] - vx[j] - (cy * nz - cz * ny);
+      const double vry = vy[i] - vy[j] - (cz * nx - cx * nz);
+      const double vrz = vz[i] - vz[j] - (cx * ny - cy * nx);
+      // gamma_n needs sqrt(m_eff k_n): a constant when all masses are equal (the usual case).
+      double gn = gn_pair;
+      if constexpr (!decltype(uniform_masses)::value) gn = damping_factor * std::sqrt(mi * mj / (mi + mj) * kn);
+      double ftx, fty, ftz;
+      const double fn = spring_dashpot(cm, dt, nx, ny, nz, rsum - r, vrx, vry, vrz, gn, hist[3 * p], hist[3 * p + 1],
+                                       hist[3 * p + 2], ftx, fty, ftz);
+      oFx[k] = fn * nx + ftx;
+      oFy[k] = fn * ny + fty;
+      oFz[k] = fn * nz + ftz;
+      // Torque -R n x F_t on both spheres (the arm of j is +R_j n, its force -F_t).
+      const double mx = ny * ftz - nz * fty, my = nz * ftx - nx * ftz, mz = nx * fty - ny * ftx;
+      double rtx = 0.0, rty = 0.0, rtz = 0.0;
+      if constexpr (Rolling::enabled) {
+        // Rolling resistance q per unit radius (T_i = -R_i q, T_j = +R_j q), |q| <= mu_r |F_n|
+        // (Eq. 11). q is the value that, with this contact's friction torque, stops the relative
+        // rolling within the coming step; capped, it is Eq. 11's constant torque along the
+        // rolling direction. Below the cap the contact holds like static friction instead of
+        // flipping sign every step (chatter) or creeping at O(g dt).
+        const double orx = spx[i] - spx[j], ory = spy[i] - spy[j], orz = spz[i] - spz[j];
+        const double on = orx * nx + ory * ny + orz * nz;
+        const double ai = ri / inertia[i], aj = rj / inertia[j], ik = 1.0 / (ai + aj);
+        const double qx = ((orx - on * nx) * inv_dt + (aj - ai) * mx) * ik;
+        const double qy = ((ory - on * ny) * inv_dt + (aj - ai) * my) * ik;
+        const double qz = ((orz - on * nz) * inv_dt + (aj - ai) * mz) * ik;
+        cap_rolling(qx, qy, qz, rolling.mu_r * std::abs(fn), rtx, rty, rtz);
+      }
+      oTix[k] = -ri * mx - ri * rtx;
+      oTiy[k] = -ri * my - ri * rty;
+      oTiz[k] = -ri * mz - ri * rtz;
+      oTjx[k] = -rj * mx + rj * rtx;
+      oTjy[k] = -rj * my + rj * rty;
+      oTjz[k] = -rj * mz + rj * rtz;
     }
-    oTix[k] = -ri * mx - ri * rtx;
-    oTiy[k] = -ri * my - ri * rty;
-    oTiz[k] = -ri * mz - ri * rtz;
-    oTjx[k] = -rj * mx + rj * rtx;
-    oTjy[k] = -rj * my + rj * rty;
-    oTjz[k] = -rj * mz + rj * rtz;
-  }
   };
   if (uniform) contact_loop(std::true_type{});
   else contact_loop(std::false_type{});
