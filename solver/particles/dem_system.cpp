@@ -606,11 +606,12 @@ void DemSystem::compute_forces() {
 }
 
 namespace {
-/// The half kick with fluid (see DemSystem::kick), all components in one pass so that m, m_add
-/// and beta are read once (restrict-qualified parameters let GCC vectorise it) and (M + h beta) is inverted once per particle. Predict: also write
-/// 2 v_new - v_old to p; Track: accumulate the drag impulse in J.
-template <bool Predict, bool Track>
-void kick_wet_loop(std::size_t n, double h, double gx, double gy, double gz, const double* __restrict m,
+/// The half kick (see DemSystem::kick), all components in one pass so that m, m_add and beta are
+/// read once and (M + h beta) is inverted once per particle; restrict-qualified parameters let
+/// GCC vectorise it. Predict: also write 2 v_new - v_old to p; Track: accumulate the drag
+/// impulse in J; Wet: read the fluid arrays (F_ext, u_f, m_add), which a dry kick leaves out.
+template <bool Predict, bool Track, bool Wet>
+void kick_loop(std::size_t n, double h, double gx, double gy, double gz, const double* __restrict m,
                    const double* __restrict ma, const double* __restrict b, const double* __restrict fx,
                    const double* __restrict fy, const double* __restrict fz, const double* __restrict ex,
                    const double* __restrict ey, const double* __restrict ez, const double* __restrict ux,
@@ -618,11 +619,26 @@ void kick_wet_loop(std::size_t n, double h, double gx, double gy, double gz, con
                    double* __restrict vz, double* __restrict Jx, double* __restrict Jy, double* __restrict Jz,
                    double* __restrict px, double* __restrict py, double* __restrict pz) {
   for (std::size_t i = 0; i < n; ++i) {
-    const double M = m[i] + ma[i], bi = b[i], inv_D = 1.0 / (M + h * bi);
+    // Dry (!Wet): F_ext, u_f and m_add are zero and not read (DemConfig::dry).
+    const double M = Wet ? m[i] + ma[i] : m[i], bi = b[i], inv_D = 1.0 / (M + h * bi);
     const double v0x = vx[i], v0y = vy[i], v0z = vz[i];
-    const double v1x = (M * v0x + h * (fx[i] + ex[i] + m[i] * gx + bi * ux[i])) * inv_D;
-    const double v1y = (M * v0y + h * (fy[i] + ey[i] + m[i] * gy + bi * uy[i])) * inv_D;
-    const double v1z = (M * v0z + h * (fz[i] + ez[i] + m[i] * gz + bi * uz[i])) * inv_D;
+    double ax = fx[i], ay = fy[i], az = fz[i];
+    if constexpr (Wet) {
+      ax += ex[i];
+      ay += ey[i];
+      az += ez[i];
+    }
+    ax += m[i] * gx;
+    ay += m[i] * gy;
+    az += m[i] * gz;
+    if constexpr (Wet) {
+      ax += bi * ux[i];
+      ay += bi * uy[i];
+      az += bi * uz[i];
+    }
+    const double v1x = (M * v0x + h * ax) * inv_D;
+    const double v1y = (M * v0y + h * ay) * inv_D;
+    const double v1z = (M * v0z + h * az) * inv_D;
     vx[i] = v1x;
     vy[i] = v1y;
     vz[i] = v1z;
@@ -659,12 +675,12 @@ void kick_spin(std::size_t n, double h, const double* __restrict I, const double
   }
 }
 
-template <bool Predict, bool Track>
-void kick_wet(std::size_t n, double h, const std::array<double, 3>& g, ParticleStore& s, std::vector<double>* pred) {
+template <bool Predict, bool Track, bool Wet>
+void kick_all(std::size_t n, double h, const std::array<double, 3>& g, ParticleStore& s, std::vector<double>* pred) {
   double* p[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
   if constexpr (Predict)
     for (int c = 0; c < 6; ++c) p[c] = pred[c].data();
-  kick_wet_loop<Predict, Track>(n, h, g[0], g[1], g[2], s.mass.data(), s.madd.data(), s.beta.data(), s.fx.data(),
+  kick_loop<Predict, Track, Wet>(n, h, g[0], g[1], g[2], s.mass.data(), s.madd.data(), s.beta.data(), s.fx.data(),
                                 s.fy.data(), s.fz.data(), s.ext_x.data(), s.ext_y.data(), s.ext_z.data(), s.ufx.data(),
                                 s.ufy.data(), s.ufz.data(), s.vx.data(), s.vy.data(), s.vz.data(), s.drag_jx.data(),
                                 s.drag_jy.data(), s.drag_jz.data(), p[0], p[1], p[2]);
@@ -673,48 +689,6 @@ void kick_wet(std::size_t n, double h, const std::array<double, 3>& g, ParticleS
 }
 }  // namespace
 
-namespace {
-/// Half kick without fluid (DemConfig::dry): the general kick with F_ext = 0, u_f = 0 and
-/// m_add = 0, with one reciprocal per particle instead of a division per component. All three
-/// components in one pass, so that m and beta are read once; then the spin.
-template <bool Predict>
-void kick_dry(std::size_t n, double h, const std::array<double, 3>& g, ParticleStore& s, std::vector<double>* pred) {
-  const double gx = g[0], gy = g[1], gz = g[2];
-  const double* __restrict m = s.mass.data();
-  const double* __restrict b = s.beta.data();
-  const double* __restrict fx = s.fx.data();
-  const double* __restrict fy = s.fy.data();
-  const double* __restrict fz = s.fz.data();
-  double* __restrict vx = s.vx.data();
-  double* __restrict vy = s.vy.data();
-  double* __restrict vz = s.vz.data();
-  double* __restrict p0 = Predict ? pred[0].data() : nullptr;
-  double* __restrict p1 = Predict ? pred[1].data() : nullptr;
-  double* __restrict p2 = Predict ? pred[2].data() : nullptr;
-  for (std::size_t i = 0; i < n; ++i) {
-    // One division per particle, not three: divisions, not memory, bound this loop otherwise.
-    const double M = m[i], inv_D = 1.0 / (M + h * b[i]);
-    const double v0x = vx[i], v0y = vy[i], v0z = vz[i];
-    const double v1x = (M * v0x + h * (fx[i] + M * gx)) * inv_D;
-    const double v1y = (M * v0y + h * (fy[i] + M * gy)) * inv_D;
-    const double v1z = (M * v0z + h * (fz[i] + M * gz)) * inv_D;
-    vx[i] = v1x;
-    vy[i] = v1y;
-    vz[i] = v1z;
-    if constexpr (Predict) {
-      p0[i] = 2.0 * v1x - v0x;
-      p1[i] = 2.0 * v1y - v0y;
-      p2[i] = 2.0 * v1z - v0z;
-    }
-  }
-  // The spin arrays share nothing with the translation: a second loop reads no stream twice.
-  double* p[3] = {nullptr, nullptr, nullptr};
-  if constexpr (Predict)
-    for (int c = 0; c < 3; ++c) p[c] = pred[3 + c].data();
-  kick_spin<Predict>(n, h, s.inertia.data(), s.tx.data(), s.ty.data(), s.tz.data(), s.wx.data(), s.wy.data(),
-                     s.wz.data(), p[0], p[1], p[2]);
-}
-}  // namespace
 
 void DemSystem::kick(double h, bool predict) {
   // Half kick of velocity Verlet with the drag implicit (backward Euler over the half step):
@@ -727,16 +701,15 @@ void DemSystem::kick(double h, bool predict) {
   if (predict)
     for (int c = 0; c < 6; ++c) pred_[c].resize(s_.size());
   const bool track = cfg_.track_drag_impulse;
-  if (cfg_.dry && !track) {
-    if (predict) kick_dry<true>(n, h, cfg_.gravity_m_s2, s_, pred_);
-    else kick_dry<false>(n, h, cfg_.gravity_m_s2, s_, pred_);
-  } else if (predict) {
-    if (track) kick_wet<true, true>(n, h, cfg_.gravity_m_s2, s_, pred_);
-    else kick_wet<true, false>(n, h, cfg_.gravity_m_s2, s_, pred_);
-  } else {
-    if (track) kick_wet<false, true>(n, h, cfg_.gravity_m_s2, s_, pred_);
-    else kick_wet<false, false>(n, h, cfg_.gravity_m_s2, s_, pred_);
-  }
+  // Dry only without drag tracking (tracking is for the coupling, which has fluid).
+  const bool wet = !cfg_.dry || track;
+  auto& g = cfg_.gravity_m_s2;
+  if (predict && track) kick_all<true, true, true>(n, h, g, s_, pred_);
+  else if (track) kick_all<false, true, true>(n, h, g, s_, pred_);
+  else if (predict && wet) kick_all<true, false, true>(n, h, g, s_, pred_);
+  else if (wet) kick_all<false, false, true>(n, h, g, s_, pred_);
+  else if (predict) kick_all<true, false, false>(n, h, g, s_, pred_);
+  else kick_all<false, false, false>(n, h, g, s_, pred_);
   if (predict) {
     // Ghost copies are not integrated here: they see the velocities their owner sent.
     const std::vector<double>* cur[6] = {&s_.vx, &s_.vy, &s_.vz, &s_.wx, &s_.wy, &s_.wz};
