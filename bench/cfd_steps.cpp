@@ -149,7 +149,7 @@ int main(int argc, char** argv) {
     std::printf("  pressure Krylov/step   %.2f\n", double(pk) / timed);
     std::printf("  momentum Krylov/step   %.2f\n", double(mk) / timed);
     std::printf("  deposition ms/step     %.2f (not in the CFD figure)\n", 1e3 * dep_s / timed);
-    std::printf("  mean alpha_f w %.6g m/s (target %.6g), G %.6g Pa/m, max |w| %.4g m/s\n", flux_end,
+    std::printf("  mean alpha_f w %.6g m/s (target %.6g), G %.12g Pa/m, max |w| %.12g m/s\n", flux_end,
                 s.target_mean_flux_z_m_s, f.mean_pressure_gradient_pa_m(), wmax_end);
   }
   return 0;

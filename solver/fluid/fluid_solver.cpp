@@ -573,6 +573,11 @@ void FluidSolver::assemble_momentum(int c, double dt, double c0, double c1, doub
   else by_flags(std::integral_constant<int, 2>{});
 }
 
+// The row loop is split by neighbour (loop fission): for one (k, j) row of cells, each of the
+// six neighbour terms is a pass over i that GCC vectorises, because every branch of the old
+// per-cell code depends on j only (walls) and becomes a row constant, and QUICK's upwind choice
+// becomes a select between loads at fixed offsets. Each coefficient is summed in the same order
+// as before. The coefficients go to row buffers and from there into the matrix's value slots.
 template <int c, bool wall, bool use_quick>
 void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2, bool first_iteration) {
   const auto& g = s_.grid;
@@ -582,9 +587,8 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
   const double lam = s_.velocity_relaxation;
   const OwnedBox b = owned_box();
   const GhostBox gb = ghost_box();
-  // Flat views: the triple-pointer DMDA arrays cost three dependent loads per value, and a row
-  // reads ~60 values (this took 44 ms per component on the bench mesh). Ghosted arrays are
-  // indexed by G = (k - gz) sz + (j - gy) gx + (i - gx0), owned ones by the loop counter o.
+  // Flat views: the triple-pointer DMDA arrays cost three dependent loads per value. Ghosted
+  // arrays are indexed by G = (k - gz) sz + (j - gy) gx + (i - gx0), owned ones by o.
   const std::int64_t off[3] = {1, gb.size[0], gb.size[0] * gb.size[1]};
   const std::int64_t oc = off[c];
   const double *u[3], *al[3], *p, *nue, *Fd[3], *un, *unm1, *S, *K, *KU;
@@ -605,110 +609,180 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
   StencilMatrixWriter& W = *writer_;
   W.begin(A_);
 
-  const double* uc = u[c];
-  // u_c at the face node X in y-row jx: v = 0 on the y walls (j = 0 and j = ny; the latter is
-  // outside the ghosted box and must not be read)
-  auto uvc = [&](std::int64_t X, int jx) -> double {
-    return (c == 1 && wall && (jx <= 0 || jx >= n1)) ? 0.0 : uc[X];
-  };
+  const double* __restrict uc = u[c];
+  const double* __restrict nu = nue;
+  // v = 0 on the y walls (j = 0 and j = ny): a u_c node in y-row jx is a known zero
+  auto zero_node = [&](int jx) -> bool { return c == 1 && wall && (jx <= 0 || jx >= n1); };
   // face node in y-row jx is inside the domain (QUICK's far upwind node may not be)
   auto face_ok = [&](int jx) -> bool {
     if (!wall) return true;
     return c == 1 ? (jx >= 0 && jx <= n1) : (jx >= 0 && jx <= n1 - 1);
   };
   const double body = s_.body_acceleration_m_s2[c] - (c == 2 ? G_ / rho : 0.0);
-  // Reciprocals: the row loop had ~20 divisions per cell in dependent chains (a third of the
-  // assembly time on the bench mesh).
   const double ih[3] = {1.0 / h[0], 1.0 / h[1], 1.0 / h[2]};
   const double ih2[3] = {ih[0] * ih[0], ih[1] * ih[1], ih[2] * ih[2]};
   const double inv_dt = 1.0 / dt, inv_rho = 1.0 / rho, inv_lam = 1.0 / lam;
+  const bool simplec = s_.simplec, top_slip = s_.top_slip;
 
-  std::int64_t o = 0;
+  // row buffers: a_P, right-hand side, a_face, transpose stress, sum |a_nb|, 6 neighbour coefficients
+  const int nx = (int)b.size[0];
+  row_buffers_.assign(static_cast<std::size_t>(11) * nx, 0.0);
+  double* __restrict aP = row_buffers_.data();
+  double* __restrict bb = aP + nx;
+  double* __restrict a1v = bb + nx;
+  double* __restrict ts = a1v + nx;
+  double* __restrict snb = ts + nx;
+  double* anb[7] = {nullptr};
+  for (int e = 1; e < 7; ++e) anb[e] = snb + e * nx;
+
+  std::int64_t o0 = 0;
   for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
-    for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j) {
-      std::int64_t P = (k - gb.lo[2]) * off[2] + (j - gb.lo[1]) * off[1] + (b.lo[0] - gb.lo[0]);
-      for (int i = (int)b.lo[0]; i < b.lo[0] + b.size[0]; ++i, ++o, ++P) {
-        if (c == 1 && wall && j == 0) {
-          W.add(o, 0, 1.0);
-          rhs[o] = 0.0;
-          if (first_iteration) Dv[o] = 0.0;
-          prev[o] = 0.0;
-          continue;
+    for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j, o0 += nx) {
+      const std::int64_t P0 = (k - gb.lo[2]) * off[2] + (j - gb.lo[1]) * off[1] + (b.lo[0] - gb.lo[0]);
+      if (c == 1 && wall && j == 0) {  // v = 0 on the wall itself: an identity row
+        #pragma GCC ivdep
+        for (int i = 0; i < nx; ++i) {
+          W.add(o0 + i, 0, 1.0);
+          rhs[o0 + i] = 0.0;
+          if (first_iteration) Dv[o0 + i] = 0.0;
+          prev[o0 + i] = 0.0;
         }
-        const std::int64_t Pm = P - oc;  // the cell below this c-face
-        const double a1 = 0.5 * (al[0][P] + al[0][Pm]);
-        const double a_n = 0.5 * (al[1][P] + al[1][Pm]);
-        const double a_nm1 = 0.5 * (al[2][P] + al[2][Pm]);
-        const double uP = uc[P];
-        double aP = c0 * a1 * inv_dt + K[o] * inv_rho;
-        double b_ = (c1 * a_n * un[o] - c2 * a_nm1 * unm1[o]) * inv_dt;
-        b_ += a1 * body - a1 * (p[P] - p[Pm]) * (inv_rho * ih[c]);
-        b_ += (S[o] + KU[o]) * inv_rho;
-
-        double tstress = 0.0;  // explicit div(nu grad u^T) component c
-        double sum_nb = 0.0;   // sum of |a_nb| (SIMPLEC)
-        for (int d = 0; d < 3; ++d) {
-          const std::int64_t od = off[d];
-          for (int s = -1; s <= 1; s += 2) {
-            const std::int64_t N = P + s * od;
-            const int jN = j + s * kE[d][1];
-            double F = 0.0, nuf = 0.0, tT = 0.0;
-            bool nb_known_zero = false;  // neighbour is a wall value v = 0 (not an unknown)
-            if (d == c) {
-              // face at a cell centre: Q = P (s = +1) or P - e_c (s = -1)
-              const std::int64_t Q = s > 0 ? P : Pm;
-              const int jQ = s > 0 ? j : j - kE[c][1];
-              F = s * 0.5 * (Fd[c][Q] + Fd[c][Q + oc]);
-              nuf = nue[Q];
-              tT = nuf * (uvc(Q + oc, jQ + kE[c][1]) - uvc(Q, jQ)) * ih[c];
-              nb_known_zero = c == 1 && wall && (jN <= 0 || jN >= n1);
-            } else {
-              // face on an edge: the d-face of cell E = P + e_d (s = +1) or P (s = -1)
-              const std::int64_t E = s > 0 ? N : P;
-              const int jE = s > 0 ? jN : j;
-              if (d == 1 && wall && (jE <= 0 || jE >= n1)) {
-                // u_c = 0 on the wall half a cell away (no-slip), or no stress (slip top);
-                // v = 0 there, so the transpose stress term vanishes
-                nuf = 0.5 * (nue[P] + nue[Pm]);
-                const bool slip = s > 0 && s_.top_slip;
-                if (!slip) aP += 2.0 * a1 * nuf * ih2[d];
-                continue;
+        continue;
+      }
+      {  // time derivative, drag, pressure gradient, body force and sources
+        const double *__restrict a0 = al[0] + P0, *__restrict an = al[1] + P0, *__restrict anm = al[2] + P0;
+        const double *__restrict pp = p + P0, *__restrict Ko = K + o0, *__restrict uno = un + o0;
+        const double *__restrict unmo = unm1 + o0, *__restrict So = S + o0, *__restrict KUo = KU + o0;
+        #pragma GCC ivdep
+        for (int i = 0; i < nx; ++i) {
+          const double a1 = 0.5 * (a0[i] + a0[i - oc]);
+          const double a_n = 0.5 * (an[i] + an[i - oc]);
+          const double a_nm1 = 0.5 * (anm[i] + anm[i - oc]);
+          aP[i] = c0 * a1 * inv_dt + Ko[i] * inv_rho;
+          double b_ = (c1 * a_n * uno[i] - c2 * a_nm1 * unmo[i]) * inv_dt;
+          b_ += a1 * body - a1 * (pp[i] - pp[i - oc]) * (inv_rho * ih[c]);
+          b_ += (So[i] + KUo[i]) * inv_rho;
+          bb[i] = b_;
+          a1v[i] = a1;
+          ts[i] = 0.0;
+          snb[i] = 0.0;
+        }
+      }
+      unsigned present = 1u;  // bit e: entry e of these rows is written
+      for (int d = 0; d < 3; ++d) {
+        const std::int64_t od = off[d];
+        for (int s = -1; s <= 1; s += 2) {
+          const int e = 1 + 2 * d + (s > 0);
+          const int jN = j + s * kE[d][1];
+          // face flux, viscosity and transpose-stress reads of this neighbour, as offsets from P
+          std::int64_t fo;                 // first flux node (the second is fo - oc or fo + oc)
+          bool nb_known_zero = false;      // neighbour is a wall value v = 0 (not an unknown)
+          if (d != c) {
+            const int jE = s > 0 ? jN : j;  // the d-face of cell E = P + e_d (s > 0) or P
+            if (d == 1 && wall && (jE <= 0 || jE >= n1)) {
+              // u_c = 0 on the wall half a cell away (no-slip), or no stress (slip top); v = 0
+              // there, so the transpose stress term vanishes
+              if (!(s > 0 && top_slip)) {
+                const double* __restrict nP = nu + P0;
+                #pragma GCC ivdep
+                for (int i = 0; i < nx; ++i) {
+                  const double nuf = 0.5 * (nP[i] + nP[i - oc]);
+                  aP[i] += 2.0 * a1v[i] * nuf * ih2[d];
+                }
               }
-              F = s * 0.5 * (Fd[d][E] + Fd[d][E - oc]);
-              nuf = 0.25 * (nue[E] + nue[E - oc] + nue[E - od] + nue[E - oc - od]);
-              tT = nuf * (u[d][E] - u[d][E - oc]) * ih[c];
+              continue;
             }
-            tstress += s * tT * ih[d];
-            const double dcoef = a1 * nuf * ih2[d];
-            const double conv = F * ih[d];
-            aP += dcoef + std::max(conv, 0.0);
-            const double anb = -dcoef + std::min(conv, 0.0);
-            if (!nb_known_zero) {
-              W.add(o, 1 + 2 * d + (s > 0), anb);
-              sum_nb += std::abs(anb);
+            fo = s > 0 ? od : 0;
+          } else {
+            fo = s > 0 ? 0 : -oc;  // face at the cell centre Q = P or P - e_c
+            nb_known_zero = zero_node(jN);
+          }
+          // QUICK: the upwind node is P (conv > 0) or N; its far node is P - s e_d or N + s e_d.
+          // Row constants say which of those nodes exist and which are wall zeros; reads of a
+          // node that does not exist or is a wall zero (v at j = ny lies outside the ghosted
+          // box) are redirected to P and their value is multiplied by zero.
+          const bool okN = face_ok(jN);
+          const bool ok_up = face_ok(j - s * kE[d][1]) && face_ok(j) && okN;
+          const bool ok_dn = face_ok(j + 2 * s * kE[d][1]) && face_ok(j) && okN;
+          const double zP = zero_node(j) ? 0.0 : 1.0, zN = zero_node(jN) ? 0.0 : 1.0;
+          const double zUu = zero_node(j - s * kE[d][1]) ? 0.0 : 1.0, zUd = zero_node(j + 2 * s * kE[d][1]) ? 0.0 : 1.0;
+          const double qup = ok_up ? 1.0 : 0.0, qdn = ok_dn ? 1.0 : 0.0;
+          const std::int64_t oN = okN && zN != 0.0 ? s * od : 0;
+          const std::int64_t oUu = ok_up && zUu != 0.0 ? -s * od : 0, oUd = ok_dn && zUd != 0.0 ? 2 * s * od : 0;
+          double* __restrict ae = anb[e];
+          const double* __restrict uP_ = uc + P0;
+          const double sh = s * 0.5;
+          const double ihd = ih[d], ih2d = ih2[d], ihc = ih[c];
+          if (!nb_known_zero) present |= 1u << e;
+          const auto tail = [&](int i, double F, double nuf, double tT) {
+            ts[i] += s * tT * ih[d];
+            const double dcoef = a1v[i] * nuf * ih2d;
+            const double conv = F * ihd;
+            aP[i] += dcoef + std::max(conv, 0.0);
+            const double a = -dcoef + std::min(conv, 0.0);
+            ae[i] = a;
+            snb[i] += nb_known_zero ? 0.0 : std::abs(a);
+            if constexpr (use_quick) {
+              // rhs -= F (phi_QUICK - phi_upwind) / h, deferred correction
+              const double vP = zP * uP_[i], vN = zN * uP_[i + oN];
+              const double vUu = zUu * uP_[i + oUu], vUd = zUd * uP_[i + oUd];
+              const bool up = conv > 0.0;
+              const double pc = up ? vP : vN, pd = up ? vN : vP, pu = up ? vUu : vUd;
+              const double ok = up ? qup : qdn;
+              const double quick = 0.75 * pc + 0.375 * pd - 0.125 * pu;
+              bb[i] -= ok * (conv * (quick - pc));
             }
-            // QUICK by deferred correction: rhs -= F (phi_QUICK - phi_upwind) / h
-            if (use_quick && conv != 0.0) {
-              const bool up_p = conv > 0.0;  // upwind node is P (else N)
-              const std::int64_t C = up_p ? P : N, Dn = up_p ? N : P, Uu = 2 * C - Dn;
-              const int jC = up_p ? j : jN, jD = up_p ? jN : j, jU = 2 * jC - jD;
-              if (face_ok(jU) && face_ok(jC) && face_ok(jD)) {
-                const double pc = uvc(C, jC), pd = uvc(Dn, jD), pu = uvc(Uu, jU);
-                const double quick = 0.75 * pc + 0.375 * pd - 0.125 * pu;
-                b_ -= conv * (quick - pc);
-              }
+          };
+          if (d == c) {
+            const double* __restrict F0 = Fd[c] + P0 + fo;
+            const double* __restrict nQ = nu + P0 + fo;
+            const double* __restrict uQ = uc + P0 + fo;
+            const double zlo = zero_node(s > 0 ? j : j - kE[c][1]) ? 0.0 : 1.0;
+            const double zhi = zero_node(s > 0 ? j + kE[c][1] : j) ? 0.0 : 1.0;
+            const std::int64_t ohi = zhi != 0.0 ? oc : 0;  // v at j = ny is outside the ghosted box
+            #pragma GCC ivdep
+            for (int i = 0; i < nx; ++i) {
+              const double F = sh * (F0[i] + F0[i + oc]);
+              const double nuf = nQ[i];
+              const double tT = nuf * (zhi * uQ[i + ohi] - zlo * uQ[i]) * ihc;
+              tail(i, F, nuf, tT);
+            }
+          } else {
+            const double* __restrict FE = Fd[d] + P0 + fo;
+            const double* __restrict nE = nu + P0 + fo;
+            const double* __restrict uE = u[d] + P0 + fo;
+            #pragma GCC ivdep
+            for (int i = 0; i < nx; ++i) {
+              const double F = sh * (FE[i] + FE[i - oc]);
+              const double nuf = 0.25 * (nE[i] + nE[i - oc] + nE[i - od] + nE[i - oc - od]);
+              const double tT = nuf * (uE[i] - uE[i - oc]) * ihc;
+              tail(i, F, nuf, tT);
             }
           }
         }
-        b_ += a1 * tstress;
-        const double aPr = aP * inv_lam;
-        b_ += (aPr - aP) * uP;
-        W.add(o, 0, aPr);
-        rhs[o] = b_;
+      }
+      {
+        const double* __restrict uP_ = uc + P0;
+        double *__restrict rh = rhs + o0, *__restrict pv = prev + o0, *__restrict Dd = Dv + o0;
+        #pragma GCC ivdep
+        for (int i = 0; i < nx; ++i) {
+          const double b_ = bb[i] + a1v[i] * ts[i];
+          const double aPr = aP[i] * inv_lam;
+          rh[i] = b_ + (aPr - aP[i]) * uP_[i];
+          pv[i] = uP_[i];
+          aP[i] = aPr;
+        }
         // SIMPLE: u' = -(a/(rho a_P)) grad p'; SIMPLEC (Van Doormaal and Raithby 1984) subtracts
         // the neighbour sum, which keeps diffusion-dominated, high-aspect cells convergent.
-        if (first_iteration) Dv[o] = a1 / (rho * (s_.simplec ? aPr - sum_nb : aPr));
-        prev[o] = uP;
+        if (first_iteration)
+          #pragma GCC ivdep
+          for (int i = 0; i < nx; ++i) Dd[i] = a1v[i] / (rho * (simplec ? aP[i] - snb[i] : aP[i]));
+      }
+      #pragma GCC ivdep
+      for (int i = 0; i < nx; ++i) {
+        W.add(o0 + i, 0, aP[i]);
+        for (int e = 1; e < 7; ++e)
+          if (present >> e & 1u) W.add(o0 + i, e, anb[e][i]);
       }
     }
 

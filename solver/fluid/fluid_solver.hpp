@@ -230,6 +230,7 @@ class FluidSolver {
   double last_dt_ = 0.0;
   double last_defect_ = 0.0;
   int momentum_its_ = 0;
+  std::vector<double> row_buffers_;  // momentum assembly, one (k, j) row of cells at a time
 };
 
 }  // namespace boycott::fluid
