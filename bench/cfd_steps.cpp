@@ -4,6 +4,7 @@
 // developing flow from rest, then the timed steps. Prints ms per step, SIMPLE iterations and
 // Krylov iterations per step. Run under mpirun for several ranks (bench/cfd_steps.sh).
 //   usage: boycott_bench_cfd [timed_steps=50] [warmup_steps=50] [PETSc options]
+// -piso [-piso_correctors N] runs PISO instead of SIMPLE (numerics.pressure_velocity_coupling).
 #include <mpi.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "fluid/fluid_solver.hpp"
@@ -69,6 +71,8 @@ void deposit(FluidSolver& f, const Particles& p, double mu) {
   f.end_deposition();
 }
 
+std::string fmt_piso(int n) { return "PISO, " + std::to_string(n) + " correctors"; }
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -92,6 +96,12 @@ int main(int argc, char** argv) {
   PetscReal relax = s.velocity_relaxation;
   PetscOptionsGetReal(nullptr, nullptr, "-velocity_relaxation", &relax, nullptr);
   s.velocity_relaxation = relax;
+  PetscBool piso = PETSC_FALSE;
+  PetscOptionsGetBool(nullptr, nullptr, "-piso", &piso, nullptr);
+  s.piso = piso;
+  PetscInt correctors = s.piso_correctors;
+  PetscOptionsGetInt(nullptr, nullptr, "-piso_correctors", &correctors, nullptr);
+  s.piso_correctors = static_cast<int>(correctors);
   const double alpha_p = 120000 * M_PI / 6.0 * std::pow(kDiameter, 3) / (0.2 * 0.006 * 0.1);
   s.target_mean_flux_z_m_s = -alpha_p * kSettling;  // zero slurry flux, Eq. 25
   FluidSolver f(s);
@@ -140,8 +150,8 @@ int main(int argc, char** argv) {
   // collective diagnostics, on every rank (calling them on rank 0 alone hung the 2-rank bench)
   const double dt_end = f.stable_dt(), flux_end = f.mean_flux_z(), wmax_end = f.max_abs_velocity(2);
   if (rank == 0) {
-    std::printf("cfd_steps: mesh 200x6x100, %d rank(s), %d warm-up + %d timed steps, dt %.3g s\n", size, warmup, timed,
-                dt_end);
+    std::printf("cfd_steps: mesh 200x6x100, %d rank(s), %d warm-up + %d timed steps, dt %.3g s, %s\n", size, warmup,
+                timed, dt_end, s.piso ? fmt_piso(s.piso_correctors).c_str() : "SIMPLE");
     std::sort(step_times.begin(), step_times.end());
     std::printf("  ms per CFD step        %.2f (median %.2f; CPU ms of rank 0 %.2f)\n", 1e3 * step_s / timed,
                 1e3 * step_times[step_times.size() / 2], 1e3 * cpu_s / timed);

@@ -100,6 +100,8 @@ void visit_keys(P& p, V&& v) {
   v("numerics.simple_tolerance", p.numerics.simple_tolerance, open_range(0.0, 1.0, true, false));
   v("numerics.velocity_relaxation", p.numerics.velocity_relaxation, open_range(0.0, 1.0, true, false));
   v("numerics.pressure_relaxation", p.numerics.pressure_relaxation, open_range(0.0, 1.0, true, false));
+  v("numerics.pressure_velocity_coupling", p.numerics.pressure_velocity_coupling, choice({"simple", "piso"}));
+  v("numerics.piso_correctors", p.numerics.piso_correctors, range(1, 100));
   v("numerics.cfl_max", p.numerics.cfl_max, open_range(0.0, 1.0, true, false));
   v("numerics.neighbor_skin", p.numerics.neighbor_skin_m, positive("m"));
   v("numerics.void_fraction_kernel", p.numerics.void_fraction_kernel,

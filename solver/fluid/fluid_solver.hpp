@@ -64,6 +64,10 @@ struct FluidSettings {
   double cfl_max = 0.5;
   double dt_max_s = 1.0e-3;
   bool quick = true;  ///< false: first-order upwind convection (for comparisons)
+  /// PISO instead of SIMPLE (numerics.pressure_velocity_coupling): one momentum solve and
+  /// piso_correctors pressure corrections per step, no convergence test.
+  bool piso = false;
+  int piso_correctors = 2;
   /// Builds the settings of a case: grid, fluid, numerics, `[flow]` forcing.
   static FluidSettings from_case(const CaseParams& p);
 };
@@ -182,9 +186,23 @@ class FluidSolver {
   void compute_subgrid_viscosity();
   void compute_face_fluxes();
   void compute_effective_viscosity();
-  void assemble_momentum(int c, double dt, double c0, double c1, double c2, bool first_iteration);
+  /// Assembles component c's momentum equations into A and rhs_ (and their diagonal into aP_out
+  /// unless null); D_[c] on the first iteration of a step.
+  void assemble_momentum(int c, double dt, double c0, double c1, double c2, bool first_iteration, Mat A,
+                         Vec aP_out);
   template <int c, bool wall, bool use_quick>
-  void assemble_momentum_t(double dt, double c0, double c1, double c2, bool first_iteration);
+  void assemble_momentum_t(double dt, double c0, double c1, double c2, bool first_iteration, Mat A, Vec aP_out);
+  void step_simple(double dt, const double c[3], StepReport& rep);
+  void step_piso(double dt, const double c[3], StepReport& rep);
+  /// U_[cc] = A^-1 rhs_ (from U_[cc]).
+  void solve_momentum(int cc, Mat A, StepReport& rep);
+  /// Pressure correction from the continuity residual in R_, then the velocity and pressure update.
+  void solve_pressure_correction(StepReport& rep);
+  /// max |d a/dt + div(a u)| h_min / U of U_ (also refreshes the ghosted velocities).
+  double relative_continuity_residual(double dt, const double c[3], double umax);
+  double max_abs_velocity_all() const;
+  /// PISO: one Jacobi sweep of the frozen momentum equations at the current pressure.
+  void momentum_sweep(double G_asm);
   void apply_flux_controller();
   double continuity_residual(double dt, double c0, double c1, double c2, Vec R);
   void assemble_pressure();
@@ -195,6 +213,10 @@ class FluidSolver {
   DM da_ = nullptr;    // box stencil, width 2: ghosted fields
   DM dam_ = nullptr;   // star stencil, width 1, same ownership: matrices
   Mat A_ = nullptr;    // momentum matrix (one component at a time)
+  // PISO: each component's matrix, right-hand side and diagonal, kept for the corrector sweeps,
+  // and the pressure they were assembled with
+  Mat Am_[3]{};
+  Vec bm_[3]{}, aPm_[3]{}, P_asm_ = nullptr;
   std::unique_ptr<StencilMatrixWriter> writer_;  // value slots of A_ and Ap_ (same pattern)
   Mat Ap_ = nullptr;   // pressure-correction matrix
   KSP ksp_m_ = nullptr, ksp_p_ = nullptr;

@@ -61,8 +61,10 @@ void deposit(FluidSolver& f, double t) {
   f.end_deposition();
 }
 
-std::vector<std::vector<double>> run(MPI_Comm comm) {
-  FluidSolver f(case_settings(), comm);
+std::vector<std::vector<double>> run(MPI_Comm comm, bool piso) {
+  FluidSettings s = case_settings();
+  s.piso = piso;
+  FluidSolver f(s, comm);
   int size;
   MPI_Comm_size(comm, &size);
   const OwnedBox b = f.owned_box();
@@ -80,12 +82,12 @@ std::vector<std::vector<double>> run(MPI_Comm comm) {
   return out;
 }
 
-TEST(ParallelFluid, OneAndTwoRanksGiveTheSameField) {
+void compare_ranks(bool piso) {
   int size;
   MPI_Comm_size(PETSC_COMM_WORLD, &size);
-  const auto par = run(PETSC_COMM_WORLD);
-  const auto ser = run(PETSC_COMM_SELF);
-  std::printf("ranks %d\n", size);
+  const auto par = run(PETSC_COMM_WORLD, piso);
+  const auto ser = run(PETSC_COMM_SELF, piso);
+  std::printf("ranks %d, %s\n", size, piso ? "PISO" : "SIMPLE");
   const char* names[6] = {"u", "v", "w", "p", "nu_t", "G"};
   for (int c = 0; c < 6; ++c) {
     double diff = 0.0, ref = 0.0;
@@ -97,6 +99,10 @@ TEST(ParallelFluid, OneAndTwoRanksGiveTheSameField) {
     EXPECT_LE(diff, 1e-6 * ref) << names[c];
   }
 }
+
+TEST(ParallelFluid, OneAndTwoRanksGiveTheSameField) { compare_ranks(false); }
+
+TEST(ParallelFluid, OneAndTwoRanksGiveTheSameFieldWithPiso) { compare_ranks(true); }
 
 }  // namespace
 }  // namespace boycott::fluid
