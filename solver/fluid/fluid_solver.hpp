@@ -70,6 +70,11 @@ struct FluidSettings {
   int piso_correctors = 2;
   /// Builds the settings of a case: grid, fluid, numerics, `[flow]` forcing.
   static FluidSettings from_case(const CaseParams& p);
+  /// Pressure-velocity coupling in words ("SIMPLEC", "SIMPLE" or "PISO, 2 correctors").
+  std::string coupling_name() const {
+    if (piso) return "PISO, " + std::to_string(piso_correctors) + " correctors";
+    return simplec ? "SIMPLEC" : "SIMPLE";
+  }
 };
 
 /// What one step did.
@@ -183,6 +188,7 @@ class FluidSolver {
  private:
   void create_layout();
   void update_ghosts();
+  void update_flow_ghosts();  ///< u and p only
   void compute_subgrid_viscosity();
   void compute_face_fluxes();
   void compute_effective_viscosity();

@@ -58,7 +58,7 @@ int run_channel_flow(const CaseParams& p, RunContext& ctx) {
   WallClock clock;
   ModelTimers timers;
   const auto settings = fluid::FluidSettings::from_case(p);
-  timers.activate("fluid", settings.simplec ? "staggered FV, QUICK, BDF2, SIMPLEC" : "staggered FV, QUICK, BDF2, SIMPLE");
+  timers.activate("fluid", "staggered FV, QUICK, BDF2, " + settings.coupling_name());
   if (settings.vreman) timers.activate("subgrid_viscosity", "vreman");
   if (std::isfinite(settings.target_mean_flux_z_m_s)) timers.activate("flux_controller", "mean pressure gradient z");
 

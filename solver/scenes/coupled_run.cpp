@@ -215,7 +215,8 @@ double CoupledRun::slurry_velocity_z() const {
 
 void CoupledRun::activate_models(ModelTimers& t) const {
   const auto& f = p_.forces;
-  t.activate("fluid", fmt::format("set II, SIMPLEC, QUICK{}", p_.fluid.subgrid_model == "vreman" ? ", Vreman" : ""));
+  t.activate("fluid", fmt::format("set II, {}, QUICK{}", fluid_->settings().coupling_name(),
+                                  p_.fluid.subgrid_model == "vreman" ? ", Vreman" : ""));
   t.activate("coupling_sample", fmt::format("kernel {}", p_.numerics.void_fraction_kernel));
   t.activate("coupling_deposit", fmt::format("kernel {}", p_.numerics.void_fraction_kernel));
   if (f.drag != "none") t.activate("drag", fmt::format("{}, implicit on both sides (timed with coupling_sample)", f.drag));

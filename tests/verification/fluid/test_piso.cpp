@@ -118,7 +118,9 @@ TEST(PisoCoupling, SecondOrderInTimeOnTaylorGreen) {
     const auto a = run(use_piso, 0.04), b = run(use_piso, 0.02), c = run(use_piso, 0.01);
     const double e1 = max_diff(a, b), e2 = max_diff(b, c), order = std::log2(e1 / e2);
     std::printf("%s: temporal differences %.3g %.3g, observed order %.3f\n", use_piso ? "PISO" : "SIMPLE", e1, e2, order);
-    if (use_piso) EXPECT_GE(order, 1.8);
+    if (use_piso) {
+      EXPECT_GE(order, 1.8);
+    }
   }
 }
 
