@@ -466,6 +466,9 @@ double FluidSolver::stable_dt() const {
   return std::min(s_.dt_max_s, s_.cfl_max / rate);
 }
 
+// The gradient is formed one (k, j) row of cells at a time in passes over i that GCC vectorises:
+// every wall rule depends on j only, so it becomes a row constant (a coefficient and an offset
+// per term), and the sums keep the order of the cell-by-cell form they replaced (same bits).
 void FluidSolver::compute_subgrid_viscosity() {
   const LogScope log_scope(fluid_events().subgrid);
   if (!s_.vreman) {
@@ -474,57 +477,87 @@ void FluidSolver::compute_subgrid_viscosity() {
     return;
   }
   const auto& g = s_.grid;
-  const int n[3] = {(int)g.n[0], (int)g.n[1], (int)g.n[2]};
+  const int n1 = (int)g.n[1];
   const double h[3] = {g.dx(0), g.dx(1), g.dx(2)};
   const bool wall = !g.periodic[1];
   const std::array<double, 3> delta = {h[0], h[1], h[2]};
+  const double cv = s_.vreman_constant;
   const OwnedBox b = owned_box();
-  PetscScalar** *u[3], ***nt;
-  for (int c = 0; c < 3; ++c) BC_PETSC(DMDAVecGetArray(da_, Ul_[c], &u[c]));
-  BC_PETSC(DMDAVecGetArray(da_, nut_, &nt));
+  const GhostBox gb = ghost_box();
+  const std::int64_t off[3] = {1, gb.size[0], gb.size[0] * gb.size[1]};
+  const double* u[3];
+  double* nt;
+  for (int c = 0; c < 3; ++c) BC_PETSC(VecGetArrayRead(Ul_[c], &u[c]));
+  BC_PETSC(VecGetArray(nut_, &nt));
+  const int nx = (int)b.size[0];
+  row_buffers_.assign(static_cast<std::size_t>(9) * nx, 0.0);
+  double* G[3][3];  // G[i][j] = d u_j / d x_i over the row
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) G[i][j] = row_buffers_.data() + (3 * i + j) * nx;
+  // u_c at y-row jx is a known zero (v on the y walls); reads there are redirected to P
+  auto zero = [&](int c, int jx) { return c == 1 && wall && (jx <= 0 || jx >= n1); };
+  std::int64_t o0 = 0;
   for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
-    for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j)
-      for (int i = (int)b.lo[0]; i < b.lo[0] + b.size[0]; ++i) {
-        const int P[3] = {i, j, k};
-        // value of u_c at face node Q (y walls: v = 0 at j = 0 and j = ny)
-        auto val = [&](int c, int qi, int qj, int qk) -> double {
-          if (c == 1 && wall && (qj <= 0 || qj >= n[1])) return 0.0;
-          return u[c][qk][qj][qi];
-        };
-        std::array<std::array<double, 3>, 3> grad{};  // grad[i][j] = d u_j / d x_i
-        for (int jc = 0; jc < 3; ++jc) {
-          grad[jc][jc] = (val(jc, i + kE[jc][0], j + kE[jc][1], k + kE[jc][2]) - val(jc, i, j, k)) / h[jc];
-          for (int id = 0; id < 3; ++id) {
-            if (id == jc) continue;
-            // d u_jc / d x_id averaged over the four edges of the cell in the (id, jc) plane.
-            double sum = 0.0;
-            for (int a = 0; a < 2; ++a)
-              for (int s = 0; s < 2; ++s) {
-                int Q[3] = {P[0] + a * kE[jc][0], P[1] + a * kE[jc][1], P[2] + a * kE[jc][2]};
-                if (id == 1 && wall) {
-                  // one-sided at the walls: u_jc = 0 (no-slip) or zero gradient (slip top)
-                  const int qlo = s == 0 ? Q[1] - 1 : Q[1];
-                  const int qhi = s == 0 ? Q[1] : Q[1] + 1;
-                  if (qlo < 0) {
-                    sum += val(jc, Q[0], qhi, Q[2]) / (0.5 * h[1]);
-                    continue;
-                  }
-                  if (qhi > n[1] - 1) {
-                    if (!s_.top_slip) sum += -val(jc, Q[0], qlo, Q[2]) / (0.5 * h[1]);
-                    continue;
-                  }
+    for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j, o0 += nx) {
+      const std::int64_t P0 = (k - gb.lo[2]) * off[2] + (j - gb.lo[1]) * off[1] + (b.lo[0] - gb.lo[0]);
+      for (int jc = 0; jc < 3; ++jc) {
+        const double* __restrict uc = u[jc] + P0;
+        {  // d u_jc / d x_jc
+          const double zh = zero(jc, j + kE[jc][1]) ? 0.0 : 1.0, zl = zero(jc, j) ? 0.0 : 1.0;
+          const std::int64_t oh = zh != 0.0 ? off[jc] : 0;
+          const double hc = h[jc];
+          double* __restrict out = G[jc][jc];
+#pragma GCC ivdep
+          for (int i = 0; i < nx; ++i) out[i] = (zh * uc[i + oh] - zl * uc[i]) / hc;
+        }
+        for (int id = 0; id < 3; ++id) {
+          if (id == jc) continue;
+          // d u_jc / d x_id averaged over the four edges of the cell in the (id, jc) plane:
+          // term (a, s) = (f_hi u[hi] - f_lo u[lo]) / den, f and den row constants
+          double fh[4], fl[4], den[4];
+          std::int64_t oh[4], ol[4];
+          for (int a = 0; a < 2; ++a)
+            for (int s = 0; s < 2; ++s) {
+              const int t = 2 * a + s;
+              const std::int64_t qo = a * off[jc];  // Q = P + a e_jc
+              const int qj = j + a * kE[jc][1];
+              std::int64_t lo = qo - (s == 0) * off[id], hi = lo + off[id];
+              int jlo = qj - (s == 0) * kE[id][1], jhi = jlo + kE[id][1];
+              fh[t] = 1.0, fl[t] = 1.0, den[t] = h[id];
+              if (id == 1 && wall) {
+                // one-sided at the walls: u_jc = 0 (no-slip) or zero gradient (slip top)
+                if (jlo < 0) {
+                  fl[t] = 0.0, den[t] = 0.5 * h[1];
+                } else if (jhi > n1 - 1) {
+                  fh[t] = 0.0, den[t] = 0.5 * h[1];
+                  if (s_.top_slip) fl[t] = 0.0;
                 }
-                const int lo[3] = {Q[0] - (s == 0) * kE[id][0], Q[1] - (s == 0) * kE[id][1], Q[2] - (s == 0) * kE[id][2]};
-                const int hi[3] = {lo[0] + kE[id][0], lo[1] + kE[id][1], lo[2] + kE[id][2]};
-                sum += (val(jc, hi[0], hi[1], hi[2]) - val(jc, lo[0], lo[1], lo[2])) / h[id];
               }
-            grad[id][jc] = 0.25 * sum;
+              if (zero(jc, jhi)) fh[t] = 0.0;
+              if (zero(jc, jlo)) fl[t] = 0.0;
+              oh[t] = fh[t] != 0.0 ? hi : 0;
+              ol[t] = fl[t] != 0.0 ? lo : 0;
+            }
+          double* __restrict out = G[id][jc];
+#pragma GCC ivdep
+          for (int i = 0; i < nx; ++i) {
+            double sum = 0.0;
+            for (int t = 0; t < 4; ++t) sum += (fh[t] * uc[i + oh[t]] - fl[t] * uc[i + ol[t]]) / den[t];
+            out[i] = 0.25 * sum;
           }
         }
-        nt[k][j][i] = vreman_viscosity(grad, delta, s_.vreman_constant);
       }
-  for (int c = 0; c < 3; ++c) BC_PETSC(DMDAVecRestoreArray(da_, Ul_[c], &u[c]));
-  BC_PETSC(DMDAVecRestoreArray(da_, nut_, &nt));
+      double* __restrict nto = nt + o0;
+#pragma GCC ivdep
+      for (int i = 0; i < nx; ++i) {
+        const std::array<std::array<double, 3>, 3> grad = {{{G[0][0][i], G[0][1][i], G[0][2][i]},
+                                                           {G[1][0][i], G[1][1][i], G[1][2][i]},
+                                                           {G[2][0][i], G[2][1][i], G[2][2][i]}}};
+        nto[i] = vreman_viscosity(grad, delta, cv);
+      }
+    }
+  for (int c = 0; c < 3; ++c) BC_PETSC(VecRestoreArrayRead(Ul_[c], &u[c]));
+  BC_PETSC(VecRestoreArray(nut_, &nt));
   BC_PETSC(DMGlobalToLocal(da_, nut_, INSERT_VALUES, nutl_));
 }
 

@@ -21,7 +21,6 @@ inline double vreman_viscosity(const std::array<std::array<double, 3>, 3>& grad,
   double aa = 0.0;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) aa += grad[i][j] * grad[i][j];
-  if (aa <= 0.0) return 0.0;
   double b[3][3];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
@@ -32,11 +31,11 @@ inline double vreman_viscosity(const std::array<std::array<double, 3>, 3>& grad,
   const double bb = b[0][0] * b[1][1] - b[0][1] * b[0][1] + b[0][0] * b[2][2] - b[0][2] * b[0][2] + b[1][1] * b[2][2] -
                     b[1][2] * b[1][2];
   // Round-off can leave B_beta slightly negative for rank-one gradients; it is >= 0 in exact
-  // arithmetic (a sum of 2x2 principal minors of a Gram matrix).
-  if (bb <= 1e-14 * aa * aa * (delta_m[0] * delta_m[0] + delta_m[1] * delta_m[1] + delta_m[2] * delta_m[2]) *
-                (delta_m[0] * delta_m[0] + delta_m[1] * delta_m[1] + delta_m[2] * delta_m[2]))
-    return 0.0;
-  return c * std::sqrt(bb / aa);
+  // arithmetic (a sum of 2x2 principal minors of a Gram matrix). A select, not early returns,
+  // so that the solver's loop over a row of cells vectorises (the discarded value may be NaN).
+  const double d2 = delta_m[0] * delta_m[0] + delta_m[1] * delta_m[1] + delta_m[2] * delta_m[2];
+  const bool on = aa > 0.0 && bb > 1e-14 * aa * aa * d2 * d2;
+  return on ? c * std::sqrt(bb / aa) : 0.0;
 }
 
 }  // namespace boycott::fluid
