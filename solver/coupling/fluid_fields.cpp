@@ -55,6 +55,17 @@ void FluidFields::import_state(const std::vector<std::vector<double>>& st) {
 
 double FluidFields::nu_cell(int i, int j, int k) const { return nu_ + nut_.at(i, j, k); }
 
+template <class Rule>
+void FluidFields::fill_padded(Padded& dst, int nx, int ny, int nz, Rule&& value) {
+  constexpr int p = Padded::kPad;
+  dst.nx = nx + 2 * p, dst.ny = ny + 2 * p;
+  dst.a.resize(static_cast<std::size_t>(nx + 2 * p) * (ny + 2 * p) * (nz + 2 * p));
+  std::size_t q = 0;
+  for (int k = -p; k < nz + p; ++k)
+    for (int j = -p; j < ny + p; ++j)
+      for (int i = -p; i < nx + p; ++i) dst.a[q++] = value(i, j, k);
+}
+
 void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous, bool need_material,
                          bool need_vorticity) {
   int size = 1;
@@ -82,6 +93,16 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
     for (int k = 0; k < n[2]; ++k)
       for (int i = 0; i < n[0]; ++i) u_[1].at(i, 0, k) = u_[1].at(i, n[1], k) = 0.0;
   }
+  for (int c = 0; c < 3; ++c)
+    fill_padded(upad_[c], n[0], u_[c].ny, n[2], [&](int i, int j, int k) { return uval(c, i, j, k); });
+  // p and nu_t are read inside the walls only (y rows 0 .. ny - 1); their y pads stay unread.
+  // Wall mirror two rows out needs ny >= 2 (the fluid grid requires it).
+  auto inside = [&](int j) { return !walls_ || (j >= 0 && j < n[1]); };
+  fill_padded(ppad_, n[0], n[1], n[2], [&](int i, int j, int k) { return inside(j) ? p_.at(i, j, k) : 0.0; });
+  fill_padded(nupad_, n[0], n[1], n[2], [&](int i, int j, int k) { return inside(j) ? nu_cell(i, j, k) : 0.0; });
+  const Padded* const U[3] = {&upad_[0], &upad_[1], &upad_[2]};
+  auto uv = [&](int c, int i, int j, int k) { return (*U[c])(i, j, k); };
+  auto nuc = [&](int i, int j, int k) { return nupad_(i, j, k); };
   const bool first = !have_prev_ || dt_s <= 0.0;
   have_prev_ = true;
   const double G = fs.mean_pressure_gradient_pa_m();
@@ -95,7 +116,7 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
           const bool wall_row = walls_ && c == 1 && (j == 0 || j == n[1]);
           if (wall_row) continue;  // filled from the nearest interior row below
           const int im = i - ec[0], jm = j - ec[1], km = k - ec[2];
-          gradp_[c].at(i, j, k) = (p_.at(i, j, k) - p_.at(im, jm, km)) / h[c] + (c == 2 ? G : 0.0);
+          gradp_[c].at(i, j, k) = (ppad_(i, j, k) - ppad_(im, jm, km)) / h[c] + (c == 2 ? G : 0.0);
 
           if (need_viscous) {
             // The fluid momentum equation's viscous operator (fluid_solver.cpp), per unit mass.
@@ -107,22 +128,22 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
                 double nuf = 0.0, tT = 0.0;
                 if (d == c) {
                   const int Q[3] = {s > 0 ? i : im, s > 0 ? j : jm, s > 0 ? k : km};
-                  nuf = nu_cell(Q[0], Q[1], Q[2]);
-                  tT = nuf * (uval(c, Q[0] + ec[0], Q[1] + ec[1], Q[2] + ec[2]) - uval(c, Q[0], Q[1], Q[2])) / h[c];
-                  lap += nuf * (uval(c, N[0], N[1], N[2]) - uP) / (h[d] * h[d]);
+                  nuf = nuc(Q[0], Q[1], Q[2]);
+                  tT = nuf * (uv(c, Q[0] + ec[0], Q[1] + ec[1], Q[2] + ec[2]) - uv(c, Q[0], Q[1], Q[2])) / h[c];
+                  lap += nuf * (uv(c, N[0], N[1], N[2]) - uP) / (h[d] * h[d]);
                 } else {
                   const int E[3] = {s > 0 ? N[0] : i, s > 0 ? N[1] : j, s > 0 ? N[2] : k};
                   if (d == 1 && walls_ && (E[1] <= 0 || E[1] >= n[1])) {
-                    nuf = 0.5 * (nu_cell(i, j, k) + nu_cell(im, jm, km));
+                    nuf = 0.5 * (nuc(i, j, k) + nuc(im, jm, km));
                     const bool slip = s > 0 && top_slip_;
                     if (!slip) lap += -2.0 * nuf * uP / (h[d] * h[d]);
                     tT = 0.0;  // v = 0 along the wall
                   } else {
                     const int O[3] = {E[0] - kE[d][0], E[1] - kE[d][1], E[2] - kE[d][2]};
-                    nuf = 0.25 * (nu_cell(E[0], E[1], E[2]) + nu_cell(E[0] - ec[0], E[1] - ec[1], E[2] - ec[2]) +
-                                  nu_cell(O[0], O[1], O[2]) + nu_cell(O[0] - ec[0], O[1] - ec[1], O[2] - ec[2]));
-                    tT = nuf * (uval(d, E[0], E[1], E[2]) - uval(d, E[0] - ec[0], E[1] - ec[1], E[2] - ec[2])) / h[c];
-                    lap += nuf * (uval(c, N[0], N[1], N[2]) - uP) / (h[d] * h[d]);
+                    nuf = 0.25 * (nuc(E[0], E[1], E[2]) + nuc(E[0] - ec[0], E[1] - ec[1], E[2] - ec[2]) +
+                                  nuc(O[0], O[1], O[2]) + nuc(O[0] - ec[0], O[1] - ec[1], O[2] - ec[2]));
+                    tT = nuf * (uv(d, E[0], E[1], E[2]) - uv(d, E[0] - ec[0], E[1] - ec[1], E[2] - ec[2])) / h[c];
+                    lap += nuf * (uv(c, N[0], N[1], N[2]) - uP) / (h[d] * h[d]);
                   }
                 }
                 tstress += s * tT / h[d];
@@ -138,11 +159,11 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
                 ud = u_[c].at(i, j, k);
               } else {
                 const int e[3] = {kE[d][0], kE[d][1], kE[d][2]};
-                ud = 0.25 * (uval(d, i, j, k) + uval(d, i + e[0], j + e[1], k + e[2]) + uval(d, im, jm, km) +
-                             uval(d, im + e[0], jm + e[1], km + e[2]));
+                ud = 0.25 * (uv(d, i, j, k) + uv(d, i + e[0], j + e[1], k + e[2]) + uv(d, im, jm, km) +
+                             uv(d, im + e[0], jm + e[1], km + e[2]));
               }
-              const double dudx = (uval(c, i + kE[d][0], j + kE[d][1], k + kE[d][2]) -
-                                   uval(c, i - kE[d][0], j - kE[d][1], k - kE[d][2])) /
+              const double dudx = (uv(c, i + kE[d][0], j + kE[d][1], k + kE[d][2]) -
+                                   uv(c, i - kE[d][0], j - kE[d][1], k - kE[d][2])) /
                                   (2.0 * h[d]);
               conv += ud * dudx;
             }
@@ -167,7 +188,7 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
   if (need_vorticity) {
     // Cell-centred velocity with the wall mirror rule, then central differences.
     auto uc = [&](int e, int i, int j, int k) {
-      return 0.5 * (uval(e, i, j, k) + uval(e, i + kE[e][0], j + kE[e][1], k + kE[e][2]));
+      return 0.5 * (uv(e, i, j, k) + uv(e, i + kE[e][0], j + kE[e][1], k + kE[e][2]));
     };
     auto ucell = [&](int e, int i, int j, int k) {
       if (walls_ && e != 1) {

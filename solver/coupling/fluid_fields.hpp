@@ -78,10 +78,26 @@ class FluidFields {
   double uval(int c, int i, int j, int k) const;
   double nu_cell(int i, int j, int k) const;
 
+  /// A copy of a field with two layers of padding on every side, filled by the field's own
+  /// boundary rule (periodic wrap, wall mirror), so that the stencils below read it without the
+  /// wrap and wall branches of GridField::at and uval (they were about half of a coupled step's
+  /// field update). The stencils reach one node out in each direction, corners included.
+  struct Padded {
+    static constexpr int kPad = 2;
+    int nx = 0, ny = 0;  // padded extents in x and y
+    std::vector<double> a;
+    double operator()(int i, int j, int k) const {
+      return a[(static_cast<std::size_t>(k + kPad) * ny + (j + kPad)) * nx + (i + kPad)];
+    }
+  };
+  template <class Rule>
+  static void fill_padded(Padded& dst, int nx, int ny, int nz, Rule&& value);
+
   GridSpec g_;
   bool walls_, top_slip_;
   double rho_ = 1000.0, nu_ = 1e-6;
   GridField u_[3], uprev_[3], gradp_[3], visc_[3], dudt_[3], vort_[3], p_, nut_;
+  Padded upad_[3], ppad_, nupad_;  // uval, p and nu + nu_t, padded
   bool have_prev_ = false;
 };
 
