@@ -236,6 +236,8 @@ class FluidSolver {
   Vec U_[3]{}, Un_[3]{}, Unm1_[3]{}, P_ = nullptr, alpha_[3]{};  // alpha_[0]=n+1, [1]=n, [2]=n-1
   Vec Ustar_prev_[3]{};  // iterate before the momentum solve (relaxation)
   Vec D_[3]{};           // a_face / (rho a_P') per face (SIMPLE correction coefficient)
+  Vec inv_diag_[3]{};    // 1 / diagonal of each component's momentum matrix (Jacobi)
+  Vec jacobi_inv_diag_ = nullptr;  // the one the momentum solve in progress uses
   Vec S_[3]{}, K_[3]{}, KU_[3]{};  // coupling fields on faces
   Vec nut_ = nullptr;
   Vec rhs_ = nullptr, sol_ = nullptr, R_ = nullptr, pc_ = nullptr;
