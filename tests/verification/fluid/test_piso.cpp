@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "fluid/fluid_solver.hpp"
+#include "tests/verification/fluid/fluid_cases.hpp"
 
 namespace boycott::fluid {
 namespace {
@@ -17,31 +18,15 @@ FluidSettings piso(FluidSettings s) {
   return s;
 }
 
+// tighter SIMPLE tolerances than the Taylor-Green and channel tests: SIMPLE is the reference here
 FluidSettings taylor_green(int n, double dt, double nu) {
-  FluidSettings s;
-  s.grid.n = {n, 2, n};
-  s.grid.length_m = {2.0 * M_PI, 2.0 * M_PI / n * 2, 2.0 * M_PI};
-  s.grid.periodic = {true, true, true};
-  s.density_kg_m3 = 1.0;
-  s.viscosity_pa_s = nu;
-  s.dt_max_s = dt;
+  FluidSettings s = testing::taylor_green_settings(n, dt, nu);
   s.simple_tolerance = 1e-11;
   s.simple_max_iterations = 200;
   return s;
 }
-
-void init_taylor_green(FluidSolver& f) {
-  f.set_velocity(0, [](double x, double, double z) { return std::sin(x) * std::cos(z); });
-  f.set_velocity(1, [](double, double, double) { return 0.0; });
-  f.set_velocity(2, [](double x, double, double z) { return -std::cos(x) * std::sin(z); });
-}
-
-double kinetic(const FluidSolver& f) {
-  double e = 0.0;
-  for (int c = 0; c < 3; c += 2)
-    for (double v : f.gather(c)) e += 0.5 * v * v;
-  return e;
-}
+using testing::init_taylor_green;
+using testing::kinetic_energy;
 
 double max_diff(const std::vector<double>& a, const std::vector<double>& b) {
   double d = 0.0;
@@ -49,16 +34,8 @@ double max_diff(const std::vector<double>& a, const std::vector<double>& b) {
   return d;
 }
 
-/// A 3-D channel flow with convection, pressure, walls and a moving, non-uniform fluid fraction.
 FluidSettings wavy_channel() {
-  FluidSettings s;
-  s.grid.n = {8, 6, 8};
-  s.grid.length_m = {2.0, 1.0, 2.0};
-  s.grid.periodic = {true, false, true};
-  s.density_kg_m3 = 1.0;
-  s.viscosity_pa_s = 0.05;
-  s.body_acceleration_m_s2 = {0.0, 0.0, 0.4};
-  s.dt_max_s = 0.01;
+  FluidSettings s = testing::wavy_channel();
   s.simple_tolerance = 1e-11;
   s.simple_max_iterations = 200;
   return s;
@@ -73,10 +50,7 @@ auto moving_alpha(double t) {
 /// Runs the wavy channel to t = 0.1 s; returns u, v, w and the worst continuity defect (1/s).
 std::pair<std::vector<std::vector<double>>, double> run_wavy(const FluidSettings& s, double dt) {
   FluidSolver f(s);
-  f.set_velocity(0, [](double x, double y, double z) { return 0.2 * std::sin(M_PI * x) * std::cos(M_PI * z) * y * (1 - y); });
-  f.set_velocity(2, [](double x, double y, double z) {
-    return y * (1 - y) * (1.0 - 0.2 * std::cos(M_PI * x) * std::sin(M_PI * z));
-  });
+  testing::perturb_wavy_channel(f);
   f.set_fluid_fraction(moving_alpha(0.0));
   double worst = 0.0;
   const int steps = static_cast<int>(std::lround(0.1 / dt));
@@ -94,9 +68,9 @@ TEST(PisoCoupling, TaylorGreenDecayRateWithinOnePercent) {
   FluidSolver f(piso(taylor_green(32, 0.02, nu)));
   init_taylor_green(f);
   f.step(0.02);
-  const double t1 = f.time_s(), e1 = kinetic(f);
+  const double t1 = f.time_s(), e1 = kinetic_energy(f);
   while (f.time_s() < 1.0 - 1e-9) f.step(0.02);
-  const double rate = std::log(e1 / kinetic(f)) / (f.time_s() - t1);
+  const double rate = std::log(e1 / kinetic_energy(f)) / (f.time_s() - t1);
   std::printf("PISO energy decay rate %.6f, exact %.6f (rel. error %.3g)\n", rate, 4.0 * nu, rate / (4.0 * nu) - 1.0);
   EXPECT_NEAR(rate / (4.0 * nu), 1.0, 0.01);
 }

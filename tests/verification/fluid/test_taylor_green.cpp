@@ -6,42 +6,21 @@
 #include <cmath>
 
 #include "fluid/fluid_solver.hpp"
+#include "tests/verification/fluid/fluid_cases.hpp"
 
 namespace boycott::fluid {
 namespace {
 
 constexpr double kNu = 0.05;  // m^2/s; U = 1 m/s, L = 2 pi m: Re = U L / nu = 126
 
-FluidSettings tg_settings(int n, double dt, double nu = kNu) {
-  FluidSettings s;
-  s.grid.n = {n, 2, n};
-  s.grid.length_m = {2.0 * M_PI, 2.0 * M_PI / n * 2, 2.0 * M_PI};
-  s.grid.periodic = {true, true, true};
-  s.density_kg_m3 = 1.0;
-  s.viscosity_pa_s = nu;
-  s.dt_max_s = dt;
-  s.simple_tolerance = 1e-9;
-  s.simple_max_iterations = 100;
-  return s;
-}
-
-void init_tg(FluidSolver& f) {
-  f.set_velocity(0, [](double x, double, double z) { return std::sin(x) * std::cos(z); });
-  f.set_velocity(1, [](double, double, double) { return 0.0; });
-  f.set_velocity(2, [](double x, double, double z) { return -std::cos(x) * std::sin(z); });
-}
-
-double kinetic(const FluidSolver& f) {
-  double e = 0.0;
-  for (int c = 0; c < 3; c += 2)
-    for (double v : f.gather(c)) e += 0.5 * v * v;
-  return e;
-}
+using testing::init_taylor_green;
+using testing::kinetic_energy;
+FluidSettings tg_settings(int n, double dt, double nu = kNu) { return testing::taylor_green_settings(n, dt, nu); }
 
 /// max |u - u_exact| / U at time t_end.
 double tg_error(int n, double dt, double t_end, double nu) {
   FluidSolver f(tg_settings(n, dt, nu));
-  init_tg(f);
+  init_taylor_green(f);
   while (f.time_s() < t_end - 1e-9) f.step(dt);
   const auto u = f.gather(0);
   const double h = 2.0 * M_PI / n, decay = std::exp(-2.0 * nu * f.time_s());
@@ -57,11 +36,11 @@ double tg_error(int n, double dt, double t_end, double nu) {
 
 TEST(TaylorGreenVortex, DecayRateWithinOnePercent) {
   FluidSolver f(tg_settings(32, 0.02));
-  init_tg(f);
+  init_taylor_green(f);
   f.step(0.02);  // the first step finds the pressure field
-  const double t1 = f.time_s(), e1 = kinetic(f);
+  const double t1 = f.time_s(), e1 = kinetic_energy(f);
   while (f.time_s() < 1.0 - 1e-9) f.step(0.02);
-  const double rate = std::log(e1 / kinetic(f)) / (f.time_s() - t1);
+  const double rate = std::log(e1 / kinetic_energy(f)) / (f.time_s() - t1);
   const double exact = 4.0 * kNu;
   std::printf("energy decay rate %.6f, exact %.6f (rel. error %.3g)\n", rate, exact, rate / exact - 1.0);
   EXPECT_NEAR(rate / exact, 1.0, 0.01);

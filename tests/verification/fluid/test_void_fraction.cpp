@@ -6,32 +6,13 @@
 #include <cmath>
 
 #include "fluid/fluid_solver.hpp"
+#include "tests/verification/fluid/fluid_cases.hpp"
 
 namespace boycott::fluid {
 namespace {
 
-/// A 3-D flow with convection, pressure and walls: Poiseuille-driven channel with a Taylor-Green
-/// type perturbation in the x-z plane.
-FluidSettings wavy_channel() {
-  FluidSettings s;
-  s.grid.n = {8, 6, 8};
-  s.grid.length_m = {2.0, 1.0, 2.0};
-  s.grid.periodic = {true, false, true};
-  s.density_kg_m3 = 1.0;
-  s.viscosity_pa_s = 0.05;
-  s.body_acceleration_m_s2 = {0.0, 0.0, 0.4};
-  s.dt_max_s = 0.01;
-  s.simple_tolerance = 1e-10;
-  s.simple_max_iterations = 100;
-  return s;
-}
-
-void perturb(FluidSolver& f) {
-  f.set_velocity(0, [](double x, double y, double z) { return 0.2 * std::sin(M_PI * x) * std::cos(M_PI * z) * y * (1 - y); });
-  f.set_velocity(2, [](double x, double y, double z) {
-    return y * (1 - y) * (1.0 - 0.2 * std::cos(M_PI * x) * std::sin(M_PI * z));
-  });
-}
+using testing::wavy_channel;
+void perturb(FluidSolver& f) { testing::perturb_wavy_channel(f); }
 
 TEST(VolumeAveragedEquations, UniformFluidFractionGivesTheSameFlow) {
   // Set II with constant alpha_f: every term but the (unchanged) source scales with alpha_f.
