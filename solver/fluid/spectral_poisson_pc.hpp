@@ -37,7 +37,7 @@ class SpectralPoissonPreconditioner {
   std::vector<double> sx_, sz_;  ///< 2 - 2 cos(2 pi k / n) per x and z wavenumber
   double* real_ = nullptr;       ///< ny planes of nz x nx reals (fftw_malloc)
   void* spec_ = nullptr;         ///< ny planes of nz x (nx/2+1) complex (fftw_complex)
-  std::vector<std::complex<double>> col_;
+  std::vector<double> eig_;  ///< one kz row of coefficients in the y eigenbasis: ny x (re, im) x nkx
   void* fwd_ = nullptr;  ///< fftw_plan
   void* bwd_ = nullptr;
 };
