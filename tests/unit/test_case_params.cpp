@@ -83,6 +83,23 @@ TEST(CaseParams, IdIsStableAndDistinguishesParameters) {
   EXPECT_EQ(case_id(case_from_json(to_json(a))), case_id(a));
 }
 
+TEST(CaseParams, KeysAddedLaterKeepEveryExistingIdAtTheirDefaults) {
+  // 34c0cdaa3b877dc1 is the id 30c36a8 (before numerics.pressure_velocity_coupling and
+  // numerics.piso_correctors existed) gave the default case: study databases written then must
+  // find their cases again.
+  CaseParams a;
+  validate(a);
+  EXPECT_EQ(case_id(a), "34c0cdaa3b877dc1");
+  CaseParams b = a;
+  apply_override(b, "numerics.piso_correctors=2");  // the default, written out
+  EXPECT_EQ(case_id(b), case_id(a));
+  apply_override(b, "numerics.pressure_velocity_coupling=\"piso\"");
+  EXPECT_NE(case_id(b), case_id(a));
+  CaseParams c = b;
+  apply_override(c, "numerics.piso_correctors=3");
+  EXPECT_NE(case_id(c), case_id(b));
+}
+
 TEST(CaseParams, OverridesUseTomlSyntax) {
   CaseParams p;
   apply_override(p, "gravity.angle_deg=75");
