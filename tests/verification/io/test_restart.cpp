@@ -100,6 +100,32 @@ TEST(RestartIdentity, StoppedHalfwayAndResumedEqualsTheUninterruptedRunBitwiseWi
   expect_resume_is_bitwise(p, "_piso");
 }
 
+TEST(RunFolder, WrittenBeforeAKeyWasAddedIsResumedButAnotherCaseIsRefused) {
+  // A folder from an older binary: its params.json lacks the keys added since. It is the same
+  // case (case_id() hashes late keys only when set), so the run resumes from its checkpoint.
+  const CaseParams p = small_case();
+  const fs::path d = fs::temp_directory_path() / "boycott_restart_oldkeys";
+  fs::remove_all(d);
+  ASSERT_EQ(run_in(p, d, 0.03), kExitInterrupted);
+  nlohmann::json stored = nlohmann::json::parse(slurp(d / "params.json"));
+  stored["numerics"].erase("pressure_velocity_coupling");
+  stored["numerics"].erase("piso_correctors");
+  std::ofstream(d / "params.json") << stored.dump(2) << "\n";
+  ASSERT_EQ(run_in(p, d), kExitOk);
+  EXPECT_EQ(summary(d)["resumed_from_checkpoint"], true);
+  // Another case in that folder is refused, naming both ids, and nothing is overwritten.
+  CaseParams other = p;
+  apply_override(other, "numerics.pressure_velocity_coupling=\"piso\"");
+  const std::string before = slurp(d / "summary.json");
+  try {
+    run_in(other, d);
+    ADD_FAILURE() << "another case's folder was accepted";
+  } catch (const CheckpointError& e) {
+    EXPECT_NE(std::string(e.what()).find("use another --out folder"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(slurp(d / "summary.json"), before);
+}
+
 TEST(BadCheckpoint, TruncatedFileIsRefusedAndLeftInPlace) {
   const CaseParams p = small_case();
   const fs::path d = fs::temp_directory_path() / "boycott_restart_trunc";
