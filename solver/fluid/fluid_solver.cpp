@@ -1101,7 +1101,10 @@ void FluidSolver::step_piso(double dt, const double c[3], StepReport& rep) {
     }
     rep.continuity_residual = relative_continuity_residual(dt, c, max_abs_velocity_all());
     if (k == 0) assemble_pressure();
-    solve_pressure_correction(rep);
+    // Between correctors nothing reads the ghosts (the sweep works on global vectors and the
+    // continuity residual refreshes u's); after the last one the coupling reads them.
+    const bool last = k + 1 == s_.piso_correctors;
+    solve_pressure_correction(rep, last && !std::isfinite(s_.target_mean_flux_z_m_s));
   }
   // The corrections moved the mean flux a little (mean(a_f D_z dp'/dz) is not zero where alpha_f
   // varies); the controller's response w' = -D_z dG is linear, so one more application holds
@@ -1181,7 +1184,7 @@ void FluidSolver::solve_momentum(int cc, Mat A, StepReport& rep) {
   BC_PETSC(VecCopy(sol_, U_[cc]));
 }
 
-void FluidSolver::solve_pressure_correction(StepReport& rep) {
+void FluidSolver::solve_pressure_correction(StepReport& rep, bool refresh_ghosts) {
   BC_PETSC(VecScale(R_, -1.0));
   BC_PETSC(MatNullSpaceRemove(null_, R_));
   BC_PETSC(VecZeroEntries(pc_));
@@ -1221,7 +1224,7 @@ void FluidSolver::solve_pressure_correction(StepReport& rep) {
   BC_PETSC(KSPGetIterationNumber(used, &its));
   rep.pressure_krylov_iterations += (int)its;
   correct(pc_);
-  update_flow_ghosts();
+  if (refresh_ghosts) update_flow_ghosts();
 }
 
 double FluidSolver::relative_continuity_residual(double dt, const double c[3], double umax) {

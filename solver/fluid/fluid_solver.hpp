@@ -202,8 +202,9 @@ class FluidSolver {
   void step_piso(double dt, const double c[3], StepReport& rep);
   /// U_[cc] = A^-1 rhs_ (from U_[cc]).
   void solve_momentum(int cc, Mat A, StepReport& rep);
-  /// Pressure correction from the continuity residual in R_, then the velocity and pressure update.
-  void solve_pressure_correction(StepReport& rep);
+  /// Pressure correction from the continuity residual in R_, then the velocity and pressure
+  /// update (and their ghosts unless told otherwise).
+  void solve_pressure_correction(StepReport& rep, bool refresh_ghosts = true);
   /// max |d a/dt + div(a u)| h_min / U of U_ (also refreshes the ghosted velocities).
   double relative_continuity_residual(double dt, const double c[3], double umax);
   double max_abs_velocity_all() const;
