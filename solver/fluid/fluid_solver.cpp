@@ -130,62 +130,78 @@ FluidSettings FluidSettings::from_case(const CaseParams& p) {
   return s;
 }
 
-/// The spectral preconditioner as a PETSc PCSHELL. On several ranks every rank applies it to the
-/// whole vector (gathered in natural order; 1 MB on the bench mesh) and keeps its own part: the
-/// FFTs are not distributed, but one application costs a few ms against BoomerAMG's set-up of
-/// ~150 ms per step and ~15 ms per V-cycle.
+/// The spectral preconditioner as a PETSc PCSHELL: one application costs a few ms against
+/// BoomerAMG's set-up of ~150 ms per step and ~15 ms per V-cycle. (Gathering the whole vector to
+/// every rank and transforming it there made an application slower on 2 ranks than on one.)
 struct SpectralPcShell {
-  SpectralPoissonPreconditioner sp;
+  // One rank: the serial transform on the global vector (which is in natural order). Several:
+  // FFTW's MPI transform on slabs of whole z-planes; the natural vector is moved to FFTW's slabs
+  // and back by one scatter each way.
+  std::unique_ptr<SpectralPoissonPreconditioner> serial;
+  std::unique_ptr<DistributedSpectralPoisson> dist;
   DM dm = nullptr;
-  Vec nat = nullptr, all = nullptr;
-  VecScatter to_all = nullptr;
-  std::vector<double> out;
+  Vec nat = nullptr, slab = nullptr, slab_out = nullptr;
+  VecScatter to_slab = nullptr;
 
-  SpectralPcShell(DM da, const GridSpec& g) : sp((int)g.n[0], (int)g.n[1], (int)g.n[2], g.periodic[1]), dm(da) {
+  SpectralPcShell(DM da, const GridSpec& g) : dm(da) {
+    const MPI_Comm comm = PetscObjectComm((PetscObject)da);
     int nranks = 1;
-    MPI_Comm_size(PetscObjectComm((PetscObject)da), &nranks);
-    if (nranks > 1) {
-      BC_PETSC(DMDACreateNaturalVector(dm, &nat));
-      BC_PETSC(VecScatterCreateToAll(nat, &to_all, &all));
-      out.resize(static_cast<std::size_t>(g.cell_count()));
+    MPI_Comm_size(comm, &nranks);
+    const int n[3] = {(int)g.n[0], (int)g.n[1], (int)g.n[2]};
+    if (nranks == 1) {
+      serial = std::make_unique<SpectralPoissonPreconditioner>(n[0], n[1], n[2], g.periodic[1]);
+      return;
     }
+    dist = std::make_unique<DistributedSpectralPoisson>(n[0], n[1], n[2], g.periodic[1], comm);
+    const PetscInt plane = static_cast<PetscInt>(n[0]) * n[1];
+    const PetscInt count = plane * dist->z_count(), first = plane * dist->z_begin();
+    BC_PETSC(DMDACreateNaturalVector(dm, &nat));
+    BC_PETSC(VecCreateMPI(comm, count, PETSC_DETERMINE, &slab));
+    BC_PETSC(VecDuplicate(slab, &slab_out));
+    IS is;
+    BC_PETSC(ISCreateStride(comm, count, first, 1, &is));
+    BC_PETSC(VecScatterCreate(nat, is, slab, is, &to_slab));
+    BC_PETSC(ISDestroy(&is));
   }
   ~SpectralPcShell() {
-    if (to_all) VecScatterDestroy(&to_all);
-    if (all) VecDestroy(&all);
+    if (to_slab) VecScatterDestroy(&to_slab);
+    if (slab) VecDestroy(&slab);
+    if (slab_out) VecDestroy(&slab_out);
     if (nat) VecDestroy(&nat);
   }
   SpectralPcShell(const SpectralPcShell&) = delete;
   SpectralPcShell& operator=(const SpectralPcShell&) = delete;
 
+  void set_coefficients(double cx, double cy, double cz) {
+    if (serial) serial->set_coefficients(cx, cy, cz);
+    if (dist) dist->set_coefficients(cx, cy, cz);
+  }
+
   static PetscErrorCode apply(PC pc, Vec x, Vec y) {
     void* ctx = nullptr;
     PetscCall(PCShellGetContext(pc, &ctx));
     auto& S = *static_cast<SpectralPcShell*>(ctx);
-    if (!S.to_all) {  // one rank: the global vector is the natural one
-      const PetscScalar* xa;
-      PetscScalar* ya;
+    const PetscScalar* xa;
+    PetscScalar* ya;
+    if (S.serial) {  // one rank: the global vector is the natural one
       PetscCall(VecGetArrayRead(x, &xa));
       PetscCall(VecGetArray(y, &ya));
-      S.sp.apply(xa, ya);
+      S.serial->apply(xa, ya);
       PetscCall(VecRestoreArrayRead(x, &xa));
       PetscCall(VecRestoreArray(y, &ya));
       return 0;
     }
     PetscCall(DMDAGlobalToNaturalBegin(S.dm, x, INSERT_VALUES, S.nat));
     PetscCall(DMDAGlobalToNaturalEnd(S.dm, x, INSERT_VALUES, S.nat));
-    PetscCall(VecScatterBegin(S.to_all, S.nat, S.all, INSERT_VALUES, SCATTER_FORWARD));
-    PetscCall(VecScatterEnd(S.to_all, S.nat, S.all, INSERT_VALUES, SCATTER_FORWARD));
-    const PetscScalar* xa;
-    PetscCall(VecGetArrayRead(S.all, &xa));
-    S.sp.apply(xa, S.out.data());
-    PetscCall(VecRestoreArrayRead(S.all, &xa));
-    PetscInt lo, hi;
-    PetscCall(VecGetOwnershipRange(S.nat, &lo, &hi));
-    PetscScalar* na;
-    PetscCall(VecGetArray(S.nat, &na));
-    for (PetscInt q = lo; q < hi; ++q) na[q - lo] = S.out[static_cast<std::size_t>(q)];
-    PetscCall(VecRestoreArray(S.nat, &na));
+    PetscCall(VecScatterBegin(S.to_slab, S.nat, S.slab, INSERT_VALUES, SCATTER_FORWARD));
+    PetscCall(VecScatterEnd(S.to_slab, S.nat, S.slab, INSERT_VALUES, SCATTER_FORWARD));
+    PetscCall(VecGetArrayRead(S.slab, &xa));
+    PetscCall(VecGetArray(S.slab_out, &ya));
+    S.dist->apply(xa, ya);
+    PetscCall(VecRestoreArrayRead(S.slab, &xa));
+    PetscCall(VecRestoreArray(S.slab_out, &ya));
+    PetscCall(VecScatterBegin(S.to_slab, S.slab_out, S.nat, INSERT_VALUES, SCATTER_REVERSE));
+    PetscCall(VecScatterEnd(S.to_slab, S.slab_out, S.nat, INSERT_VALUES, SCATTER_REVERSE));
     PetscCall(DMDANaturalToGlobalBegin(S.dm, S.nat, INSERT_VALUES, y));
     PetscCall(DMDANaturalToGlobalEnd(S.dm, S.nat, INSERT_VALUES, y));
     return 0;
@@ -990,7 +1006,7 @@ void FluidSolver::assemble_pressure() {
     MPI_Allreduce(csum, gsum, 6, MPI_DOUBLE, MPI_SUM, comm_);
     double c[3];
     for (int d = 0; d < 3; ++d) c[d] = gsum[3 + d] > 0.0 ? gsum[d] / gsum[3 + d] : 0.0;
-    spectral_pc_->sp.set_coefficients(c[0], c[1], c[2]);
+    spectral_pc_->set_coefficients(c[0], c[1], c[2]);
   }
   BC_PETSC(KSPSetOperators(ksp_p_, Ap_, Ap_));
 }

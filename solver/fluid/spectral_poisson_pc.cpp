@@ -1,5 +1,6 @@
 #include "fluid/spectral_poisson_pc.hpp"
 
+#include <fftw3-mpi.h>
 #include <fftw3.h>
 
 #include <cmath>
@@ -12,15 +13,17 @@ namespace {
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 }
 
-SpectralPoissonPreconditioner::SpectralPoissonPreconditioner(int nx, int ny, int nz, bool periodic_y)
-    : nx_(nx), ny_(ny), nz_(nz), nkx_(nx / 2 + 1), periodic_y_(periodic_y) {
-  if (nx < 1 || ny < 1 || nz < 1) throw std::invalid_argument("SpectralPoissonPreconditioner: empty grid");
-  // y eigenvectors. Walls (cell-centred Neumann): cos(pi m (j + 1/2) / ny), eigenvalue
-  // 2 - 2 cos(pi m / ny). Periodic: the real Fourier basis, eigenvalue 2 - 2 cos(2 pi m' / ny).
-  qy_.assign(static_cast<std::size_t>(ny) * ny, 0.0);
-  sy_.assign(ny, 0.0);
+namespace {
+
+/// Orthonormal eigenvectors qy[j * ny + m] of the 1-D y operator and their eigenvalues sy[m] for
+/// a unit coefficient (-1 marks an unused mode). Walls (cell-centred Neumann): cos(pi m (j + 1/2)
+/// / ny), eigenvalue 2 - 2 cos(pi m / ny). Periodic: the real Fourier basis, eigenvalue
+/// 2 - 2 cos(2 pi m' / ny). Also 2 - 2 cos(2 pi k / n) per x and z wavenumber.
+void make_bases(int nx, int ny, int nz, bool periodic_y, std::vector<double>& qy, std::vector<double>& sy,
+                std::vector<double>& sx, std::vector<double>& sz) {
+  qy.assign(static_cast<std::size_t>(ny) * ny, 0.0);
+  sy.assign(ny, 0.0);
   for (int m = 0; m < ny; ++m) {
-    double lambda;
     for (int j = 0; j < ny; ++j) {
       double v;
       if (!periodic_y) {
@@ -30,23 +33,31 @@ SpectralPoissonPreconditioner::SpectralPoissonPreconditioner(int nx, int ny, int
         const int w = (m + 1) / 2;
         v = (m % 2 == 1) ? std::cos(kTwoPi * w * j / ny) : (m == 0 ? 1.0 : std::sin(kTwoPi * w * j / ny));
       }
-      qy_[static_cast<std::size_t>(j) * ny + m] = v;
+      qy[static_cast<std::size_t>(j) * ny + m] = v;
     }
-    lambda = periodic_y ? 2.0 - 2.0 * std::cos(kTwoPi * ((m + 1) / 2) / ny) : 2.0 - 2.0 * std::cos(M_PI * m / ny);
-    sy_[m] = lambda;
+    sy[m] = periodic_y ? 2.0 - 2.0 * std::cos(kTwoPi * ((m + 1) / 2) / ny) : 2.0 - 2.0 * std::cos(M_PI * m / ny);
     double nrm = 0.0;
-    for (int j = 0; j < ny; ++j) nrm += qy_[static_cast<std::size_t>(j) * ny + m] * qy_[static_cast<std::size_t>(j) * ny + m];
+    for (int j = 0; j < ny; ++j) nrm += qy[static_cast<std::size_t>(j) * ny + m] * qy[static_cast<std::size_t>(j) * ny + m];
     if (nrm < 1e-12) {  // the sine of the Nyquist wavenumber vanishes on the grid: unused mode
-      sy_[m] = -1.0;
+      sy[m] = -1.0;
       continue;
     }
     nrm = 1.0 / std::sqrt(nrm);
-    for (int j = 0; j < ny; ++j) qy_[static_cast<std::size_t>(j) * ny + m] *= nrm;
+    for (int j = 0; j < ny; ++j) qy[static_cast<std::size_t>(j) * ny + m] *= nrm;
   }
-  sx_.resize(nkx_);
-  for (int k = 0; k < nkx_; ++k) sx_[k] = 2.0 - 2.0 * std::cos(kTwoPi * k / nx);
-  sz_.resize(nz);
-  for (int k = 0; k < nz; ++k) sz_[k] = 2.0 - 2.0 * std::cos(kTwoPi * k / nz);
+  const int nkx = nx / 2 + 1;
+  sx.resize(nkx);
+  for (int k = 0; k < nkx; ++k) sx[k] = 2.0 - 2.0 * std::cos(kTwoPi * k / nx);
+  sz.resize(nz);
+  for (int k = 0; k < nz; ++k) sz[k] = 2.0 - 2.0 * std::cos(kTwoPi * k / nz);
+}
+
+}  // namespace
+
+SpectralPoissonPreconditioner::SpectralPoissonPreconditioner(int nx, int ny, int nz, bool periodic_y)
+    : nx_(nx), ny_(ny), nz_(nz), nkx_(nx / 2 + 1), periodic_y_(periodic_y) {
+  if (nx < 1 || ny < 1 || nz < 1) throw std::invalid_argument("SpectralPoissonPreconditioner: empty grid");
+  make_bases(nx, ny, nz, periodic_y, qy_, sy_, sx_, sz_);
 
   const std::size_t nreal = static_cast<std::size_t>(ny) * nz * nx;
   const std::size_t ncplx = static_cast<std::size_t>(ny) * nz * nkx_;
@@ -124,6 +135,84 @@ void SpectralPoissonPreconditioner::apply(const double* r, double* z) {
     for (int j = 0; j < ny_; ++j)
       std::memcpy(z + static_cast<std::size_t>(nx_) * (j + static_cast<std::size_t>(ny_) * k),
                   real_ + j * plane + static_cast<std::size_t>(k) * nx_, sizeof(double) * nx_);
+}
+
+}  // namespace boycott::fluid
+
+namespace boycott::fluid {
+
+DistributedSpectralPoisson::DistributedSpectralPoisson(int nx, int ny, int nz, bool periodic_y, MPI_Comm comm)
+    : nx_(nx), ny_(ny), nz_(nz), nkx_(nx / 2 + 1) {
+  if (nx < 1 || ny < 1 || nz < 1) throw std::invalid_argument("DistributedSpectralPoisson: empty grid");
+  static const bool initialised = [] {
+    fftw_mpi_init();
+    return true;
+  }();
+  (void)initialised;
+  make_bases(nx, ny, nz, periodic_y, qy_, sy_, sx_, sz_);
+  const ptrdiff_t nc[2] = {nz, nkx_};  // complex extents for the r2c local sizes
+  ptrdiff_t n0, s0, n1, s1;
+  const ptrdiff_t alloc = fftw_mpi_local_size_many_transposed(2, nc, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK,
+                                                              comm, &n0, &s0, &n1, &s1);
+  z0_ = static_cast<int>(s0), nz_local_ = static_cast<int>(n0);
+  kx0_ = static_cast<int>(s1), nkx_local_ = static_cast<int>(n1);
+  real_ = fftw_alloc_real(2 * static_cast<std::size_t>(alloc > 0 ? alloc : 1));
+  auto* spec = fftw_alloc_complex(static_cast<std::size_t>(alloc > 0 ? alloc : 1));
+  spec_ = spec;
+  eig_.resize(2 * static_cast<std::size_t>(ny));
+  const ptrdiff_t nr[2] = {nz, nx};
+  fwd_ = fftw_mpi_plan_many_dft_r2c(2, nr, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, real_, spec, comm,
+                                    FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_OUT);
+  bwd_ = fftw_mpi_plan_many_dft_c2r(2, nr, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, spec, real_, comm,
+                                    FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_IN);
+  if (!fwd_ || !bwd_) throw std::runtime_error("DistributedSpectralPoisson: FFTW MPI plan failed");
+}
+
+DistributedSpectralPoisson::~DistributedSpectralPoisson() {
+  if (fwd_) fftw_destroy_plan(static_cast<fftw_plan>(fwd_));
+  if (bwd_) fftw_destroy_plan(static_cast<fftw_plan>(bwd_));
+  fftw_free(real_);
+  fftw_free(spec_);
+}
+
+void DistributedSpectralPoisson::apply(const double* r, double* z) {
+  const std::size_t nxp = 2 * static_cast<std::size_t>(nkx_);  // padded x extent of the real array
+  // slab [k][j][i] -> real_[(k nxp + i) ny + j]
+  for (int k = 0; k < nz_local_; ++k)
+    for (int j = 0; j < ny_; ++j) {
+      const double* src = r + static_cast<std::size_t>(nx_) * (j + static_cast<std::size_t>(ny_) * k);
+      double* dst = real_ + static_cast<std::size_t>(k) * nxp * ny_ + j;
+      for (int i = 0; i < nx_; ++i) dst[static_cast<std::size_t>(i) * ny_] = src[i];
+    }
+  fftw_execute(static_cast<fftw_plan>(fwd_));
+  auto* spec = reinterpret_cast<std::complex<double>*>(spec_);
+  const double scale = 1.0 / (static_cast<double>(nx_) * nz_);
+  const double tiny = 1e-12 * (c_[0] + c_[1] + c_[2]);
+  auto* e = reinterpret_cast<std::complex<double>*>(eig_.data());
+  for (int a = 0; a < nkx_local_; ++a) {
+    const int kx = kx0_ + a;
+    for (int kz = 0; kz < nz_; ++kz) {
+      std::complex<double>* col = spec + (static_cast<std::size_t>(a) * nz_ + kz) * ny_;  // y innermost
+      for (int m = 0; m < ny_; ++m) {
+        std::complex<double> s = 0.0;
+        for (int j = 0; j < ny_; ++j) s += qy_[static_cast<std::size_t>(j) * ny_ + m] * col[j];
+        const double lam = c_[0] * sx_[kx] + c_[2] * sz_[kz] + c_[1] * sy_[m];
+        e[m] = (sy_[m] < 0.0 || lam <= tiny) ? 0.0 : s * (scale / lam);
+      }
+      for (int j = 0; j < ny_; ++j) {
+        std::complex<double> s = 0.0;
+        for (int m = 0; m < ny_; ++m) s += qy_[static_cast<std::size_t>(j) * ny_ + m] * e[m];
+        col[j] = s;
+      }
+    }
+  }
+  fftw_execute(static_cast<fftw_plan>(bwd_));
+  for (int k = 0; k < nz_local_; ++k)
+    for (int j = 0; j < ny_; ++j) {
+      double* dst = z + static_cast<std::size_t>(nx_) * (j + static_cast<std::size_t>(ny_) * k);
+      const double* src = real_ + static_cast<std::size_t>(k) * nxp * ny_ + j;
+      for (int i = 0; i < nx_; ++i) dst[i] = src[static_cast<std::size_t>(i) * ny_];
+    }
 }
 
 }  // namespace boycott::fluid
