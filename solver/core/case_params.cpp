@@ -116,6 +116,7 @@ void visit_keys(P& p, V&& v) {
   v("ergun.pressure_gradients", p.ergun.pressure_gradients_pa_m, positive("Pa/m"));
   v("sediment.bulk_velocity", p.sediment.bulk_velocity_m_s, any("m/s"));
   v("sediment.bed_height", p.sediment.bed_height_m, optional(positive("m")));
+  v("sediment.initial_flow", p.sediment.initial_flow, choice({"turbulent", "rest"}));
 }
 
 std::string fmt_num(double v) { return fmt::format("{:g}", v); }
@@ -442,6 +443,14 @@ namespace {
 /// written by an older binary resumes without repeating its finished cases. Append every new
 /// key here.
 constexpr const char* kKeysHashedOnlyWhenSet[] = {"numerics.pressure_velocity_coupling", "numerics.piso_correctors"};
+// Keys added later that only one scene reads: hashed for that scene only, so that the ids of
+// every other scene's cases stay as they were. (Its own cases get new ids: their results
+// changed with the key's default.)
+struct SceneOnlyKey {
+  const char* key;
+  const char* scene;
+};
+constexpr SceneOnlyKey kSceneOnlyKeys[] = {{"sediment.initial_flow", "sediment_transport"}};
 }  // namespace
 
 std::string case_id(const CaseParams& p) {
@@ -450,6 +459,10 @@ std::string case_id(const CaseParams& p) {
   for (const char* key : kKeysHashedOnlyWhenSet) {
     const auto ptr = pointer_of(key);
     if (j.at(ptr) == defaults.at(ptr)) j.at(ptr.parent_pointer()).erase(ptr.back());
+  }
+  for (const auto& k : kSceneOnlyKeys) {
+    const auto ptr = pointer_of(k.key);
+    if (p.scene != k.scene) j.at(ptr.parent_pointer()).erase(ptr.back());
   }
   // nlohmann's object keys are sorted (std::map), so dump() is canonical.
   return hex64(fnv1a64(j.dump()));

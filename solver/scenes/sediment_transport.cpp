@@ -24,6 +24,7 @@
 #include "core/constants.hpp"
 #include "core/error.hpp"
 #include "core/statistics.hpp"
+#include "fluid/turbulent_start.hpp"
 #include "io/checkpoint_file.hpp"
 #include "io/state_io.hpp"
 #include "scenes/coupled_run.hpp"
@@ -77,6 +78,10 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
     next_out = r.scalar("stats.next_out");
     settle_s = r.scalar("stats.bed_pouring_time_s");
   });
+  const double A = p.domain.length_x_m * p.domain.height_z_m, H = p.domain.width_y_m;
+  const double d = p.particles.diameter_m, g = p.gravity.magnitude_m_s2;
+  const double rho_p = p.particles.density_kg_m3, rho_f = p.fluid.density_kg_m3;
+  const double q_scale = std::sqrt((rho_p / rho_f - 1.0) * g * d * d * d);
   if (resumed) {
     wall_before = *resumed;
   } else {
@@ -87,19 +92,29 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
       ModelTimers::Scope sc(timers, "bed_pouring");
       settle_s = settle_bed(run.dem(), p);
     }
-    run.start();
   }
-  run.activate_models(timers);
-  timers.activate("flux_controller", fmt::format("G(t) holds mean alpha_f w = {} m/s", p.sediment.bulk_velocity_m_s));
-
-  const double A = p.domain.length_x_m * p.domain.height_z_m, H = p.domain.width_y_m;
-  const double d = p.particles.diameter_m, g = p.gravity.magnitude_m_s2;
-  const double rho_p = p.particles.density_kg_m3, rho_f = p.fluid.density_kg_m3;
-  const double q_scale = std::sqrt((rho_p / rho_f - 1.0) * g * d * d * d);
+  // Particle volume is conserved, so the bed height is the same before pouring and on resume.
   const double h_bed = is_set(p.sediment.bed_height_m) ? p.sediment.bed_height_m
                                                        : run.particle_volume_m3() / (A * kBedPackedFraction);
   if (h_bed >= H)
     throw InputError(fmt::format("bed height {:.4g} m fills the channel: must be < domain.width_y = {} m", h_bed, H));
+  if (!resumed) {
+    run.start();
+    // Fluid started from rest over the bed would stay a laminar Stokes layer for the whole run
+    // (see fluid/turbulent_start.hpp): start it turbulent, with the bed top as the floor and
+    // Nikuradse's k_s = 2.5 d.
+    if (p.sediment.initial_flow == "turbulent") {
+      fluid::TurbulentStartSettings ts;
+      ts.bulk_velocity_m_s = p.sediment.bulk_velocity_m_s;
+      ts.floor_m = h_bed;
+      ts.roughness_m = 2.5 * d;
+      ts.seed = static_cast<std::uint64_t>(p.seed);
+      fluid::start_turbulent_channel(run.fluid(), ts);
+    }
+  }
+  run.activate_models(timers);
+  timers.activate("flux_controller", fmt::format("G(t) holds mean alpha_f w = {} m/s", p.sediment.bulk_velocity_m_s));
+
   auto transport_rate = [&] {
     double q = 0.0;
     for (std::size_t i = 0; i < s.n_local; ++i) q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];

@@ -100,6 +100,23 @@ TEST(CaseParams, KeysAddedLaterKeepEveryExistingIdAtTheirDefaults) {
   EXPECT_NE(case_id(c), case_id(b));
 }
 
+TEST(CaseParams, ASceneOnlyKeyIsHashedForItsSceneOnly) {
+  // sediment.initial_flow came later and only sediment_transport reads it: the other scenes'
+  // ids stay as they were, and a sediment case started from rest is another case.
+  CaseParams a;
+  validate(a);
+  const std::string before = case_id(a);
+  apply_override(a, "sediment.initial_flow=\"rest\"");
+  EXPECT_EQ(case_id(a), before);
+  CaseParams s;
+  apply_override(s, "scene=\"sediment_transport\"");
+  CaseParams r = s;
+  apply_override(r, "sediment.initial_flow=\"rest\"");
+  EXPECT_NE(case_id(r), case_id(s));
+  apply_override(r, "sediment.initial_flow=\"laminar\"");
+  EXPECT_THROW(validate(r), InputError);
+}
+
 TEST(CaseParams, OverridesUseTomlSyntax) {
   CaseParams p;
   apply_override(p, "gravity.angle_deg=75");
