@@ -116,17 +116,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
                 resumed.has_value());
   const double out_every = is_set(p.output.timeseries_every_s) ? p.output.timeseries_every_s : 0.0;
   CheckpointClock checkpoints(p.time.checkpoint_every_s, run.time_s());
-  // Snapshots at output.snapshot_times (sorted); those before a resumed run's time are done.
-  std::vector<double> snaps = p.output.snapshot_times_s;
-  std::sort(snaps.begin(), snaps.end());
-  std::size_t next_snap = 0;
-  while (next_snap < snaps.size() && snaps[next_snap] <= run.time_s() + 1e-12) ++next_snap;
-  if (!snaps.empty()) timers.activate("snapshots", fmt::format("HDF5 + XDMF at {} times", snaps.size()));
-  std::vector<double> images = p.output.image_times_s;
-  std::sort(images.begin(), images.end());
-  std::size_t next_image = 0;
-  while (next_image < images.size() && images[next_image] <= run.time_s() + 1e-12) ++next_image;
-  if (!images.empty()) timers.activate("images", fmt::format("PNG of the x-z plane at {} times", images.size()));
+  OutputTimes snaps(p.output.snapshot_times_s, run.time_s()), images(p.output.image_times_s, run.time_s());
+  if (snaps.size()) timers.activate("snapshots", fmt::format("HDF5 + XDMF at {} times", snaps.size()));
+  if (images.size()) timers.activate("images", fmt::format("PNG of the x-z plane at {} times", images.size()));
   int exit_code = kExitOk;
   SummaryBase sb;
   const double end = p.time.end_s;
@@ -156,18 +148,16 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       next_out = t + out_every;
       if (ctx.progress) ctx.progress(t);
     }
-    while (next_snap < snaps.size() && t >= snaps[next_snap] - 1e-12) {
+    snaps.reached(t, [&](std::size_t index, double) {
       ModelTimers::Scope sc(timers, "snapshots");
-      io::write_snapshot(ctx.out_dir, static_cast<int>(next_snap), run.snapshot(), run.fluid().settings().grid);
-      ++next_snap;
-    }
-    while (next_image < images.size() && t >= images[next_image] - 1e-12) {
+      io::write_snapshot(ctx.out_dir, static_cast<int>(index), run.snapshot(), run.fluid().settings().grid);
+    });
+    images.reached(t, [&](std::size_t, double time) {
       ModelTimers::Scope sc(timers, "images");
       const io::ParticleView view{&s.x, &s.y, &s.z, &s.radius, s.n_local, p.domain.length_x_m, p.domain.width_y_m,
                                   p.domain.height_z_m};
-      io::write_particle_png(ctx.out_dir / fmt::format("particles_t{:.3f}.png", images[next_image]), view);
-      ++next_image;
-    }
+      io::write_particle_png(ctx.out_dir / fmt::format("particles_t{:.3f}.png", time), view);
+    });
     const bool stop = ctx.should_stop();
     // Also at the end: the final state stays inspectable (and comparable across restarts).
     if (checkpoints.due(t, end, stop)) {

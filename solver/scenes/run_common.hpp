@@ -1,4 +1,5 @@
 #pragma once
+#include <algorithm>
 // What every scene writes the same way: summary.json with the common keys of design brief
 // section 7, timeseries.csv, atomic file replacement.
 #include <chrono>
@@ -75,6 +76,26 @@ class CheckpointClock {
  private:
   double following(double t_s) const { return (std::floor(t_s / every_ + 1e-9) + 1.0) * every_; }
   double every_, next_;
+};
+
+/// Output at given simulated times (output.snapshot_times, output.image_times): sorted; on a
+/// resumed run those at or before its time are already written.
+class OutputTimes {
+ public:
+  OutputTimes(std::vector<double> times_s, double now_s) : times_(std::move(times_s)) {
+    std::sort(times_.begin(), times_.end());
+    while (next_ < times_.size() && times_[next_] <= now_s + 1e-12) ++next_;
+  }
+  std::size_t size() const { return times_.size(); }
+  /// Calls write(index, time) for each output time the step that reached t_s passed.
+  template <class Write>
+  void reached(double t_s, Write&& write) {
+    for (; next_ < times_.size() && t_s >= times_[next_] - 1e-12; ++next_) write(next_, times_[next_]);
+  }
+
+ private:
+  std::vector<double> times_;
+  std::size_t next_ = 0;
 };
 
 }  // namespace boycott::scenes

@@ -17,6 +17,9 @@
 // (exit 75); the same command resumes.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <vector>
 #include <cstdio>
 
 #include <fmt/format.h>
@@ -26,6 +29,7 @@
 #include "core/statistics.hpp"
 #include "fluid/turbulent_start.hpp"
 #include "io/checkpoint_file.hpp"
+#include "io/snapshot.hpp"
 #include "io/state_io.hpp"
 #include "scenes/coupled_run.hpp"
 #include "scenes/particle_setup.hpp"
@@ -54,6 +58,47 @@ double settle_bed(particles::DemSystem& dem, const CaseParams& p) {
   return t;
 }
 
+// Time-averaged profiles over y (per fluid cell row) for profiles.csv: the plane mean of the
+// fluid's w, and the particles binned by centre (solid fraction, their mean w, their flux
+// density, whose integral over y is the transport rate q).
+struct Profiles {
+  std::vector<double> fluid_w, solid_volume, particle_flux;  // sums over steps: m/s, m^3, m^4/s
+  double steps = 0.0;
+  explicit Profiles(std::size_t ny) : fluid_w(ny, 0.0), solid_volume(ny, 0.0), particle_flux(ny, 0.0) {}
+  void add(fluid::FluidSolver& f, const particles::ParticleStore& s, double h) {
+    const auto w = f.profile_y(2);
+    for (std::size_t j = 0; j < fluid_w.size(); ++j) fluid_w[j] += w[j];
+    const auto ny = static_cast<std::int64_t>(fluid_w.size());
+    for (std::size_t i = 0; i < s.n_local; ++i) {
+      const auto j = std::clamp(static_cast<std::int64_t>(std::floor(s.y[i] / h)), std::int64_t{0}, ny - 1);
+      const double v = (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i];
+      solid_volume[j] += v;
+      particle_flux[j] += v * s.vz[i];
+    }
+    steps += 1.0;
+  }
+  void save(io::CheckpointWriter& w) const {
+    w.put("stats.profile.fluid_w", fluid_w);
+    w.put("stats.profile.solid_volume", solid_volume);
+    w.put("stats.profile.particle_flux", particle_flux);
+    w.put("stats.profile.steps", steps);
+  }
+  void load(const io::CheckpointReader& r) {
+    fluid_w = r.doubles("stats.profile.fluid_w");
+    solid_volume = r.doubles("stats.profile.solid_volume");
+    particle_flux = r.doubles("stats.profile.particle_flux");
+    steps = r.scalar("stats.profile.steps");
+  }
+  void write(const std::filesystem::path& path, double h, double area) const {
+    CsvWriter csv(path, {"y_m", "fluid_w_m_s", "solid_fraction", "particle_w_m_s", "particle_flux_density_m_s"}, false);
+    for (std::size_t j = 0; j < fluid_w.size(); ++j) {
+      const double n = std::max(steps, 1.0), cell = area * h * n;
+      csv.row({(j + 0.5) * h, fluid_w[j] / n, solid_volume[j] / cell,
+               solid_volume[j] > 0.0 ? particle_flux[j] / solid_volume[j] : 0.0, particle_flux[j] / cell});
+    }
+  }
+};
+
 double wong_parker_q(double tau) { return tau > 0.0495 ? 3.97 * std::pow(tau - 0.0495, 1.5) : 0.0; }
 double nielsen_q(double tau) { return tau > 0.05 ? 12.0 * std::sqrt(tau) * (tau - 0.05) : 0.0; }
 }  // namespace
@@ -68,6 +113,8 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   CoupledRun run(p, opt);
   const auto& s = run.dem().particles();
   BatchMeans q_avg, g_avg, wf_avg, vp_avg;
+  const double h_y = p.domain.width_y_m / static_cast<double>(p.domain.cells[1]);
+  Profiles profiles(static_cast<std::size_t>(p.domain.cells[1]));
   double alpha_min_seen = 1.0, ke_max_seen = 0.0, next_out = 0.0, settle_s = 0.0, wall_before = 0.0;
   timers.activate("bed_pouring", "dry DEM until the bed rests");
   const auto resumed = run.resume(ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) {
@@ -77,6 +124,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
     ke_max_seen = r.scalar("stats.ke_max_seen");
     next_out = r.scalar("stats.next_out");
     settle_s = r.scalar("stats.bed_pouring_time_s");
+    profiles.load(r);
   });
   const double A = p.domain.length_x_m * p.domain.height_z_m, H = p.domain.width_y_m;
   const double d = p.particles.diameter_m, g = p.gravity.magnitude_m_s2;
@@ -132,6 +180,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
       w.put("stats.ke_max_seen", ke_max_seen);
       w.put("stats.next_out", next_out);
       w.put("stats.bed_pouring_time_s", settle_s);
+      profiles.save(w);
     });
   };
   CsvWriter csv(ctx.out_dir / "timeseries.csv",
@@ -140,6 +189,8 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
                 resumed.has_value());
   const double out_every = is_set(p.output.timeseries_every_s) ? p.output.timeseries_every_s : 0.0;
   CheckpointClock checkpoints(p.time.checkpoint_every_s, run.time_s());
+  OutputTimes snaps(p.output.snapshot_times_s, run.time_s());
+  if (snaps.size()) timers.activate("snapshots", fmt::format("HDF5 + XDMF at {} times", snaps.size()));
   SummaryBase sb;
   int exit_code = kExitOk;
   while (run.time_s() < p.time.end_s - 1e-12) {
@@ -154,6 +205,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
       g_avg.add(G);
       wf_avg.add(run.fluid().mean_flux_z());
       vp_avg.add(run.mean_particle_velocity(1));
+      profiles.add(run.fluid(), s, h_y);
     }
     if (t >= next_out - 1e-12 || t >= p.time.end_s - 1e-12) {
       csv.row({t, q, q / q_scale, G, run.fluid().mean_flux_z(), run.mean_particle_velocity(2),
@@ -162,6 +214,10 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
       next_out = t + out_every;
       if (ctx.progress) ctx.progress(t);
     }
+    snaps.reached(t, [&](std::size_t index, double) {
+      ModelTimers::Scope sc(timers, "snapshots");
+      io::write_snapshot(ctx.out_dir, static_cast<int>(index), run.snapshot(), run.fluid().settings().grid);
+    });
     const bool stop = ctx.should_stop();
     if (checkpoints.due(t, p.time.end_s, stop)) {
       csv.flush();
@@ -175,6 +231,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
     }
   }
   csv.flush();
+  profiles.write(ctx.out_dir / "profiles.csv", h_y, A);
   run.report_timers(timers);
 
   sb.simulated_time_s = run.time_s();
