@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -47,6 +49,20 @@ TEST(SedimentTransport, BulkVelocityHeldBedPouredAndTransportDownstream) {
   EXPECT_NEAR(j["bed_height_m"].get<double>(), vp / (0.005 * 0.01 * 0.6), 1e-12);
   EXPECT_NEAR(j["q_star_wong_parker"].get<double>(), 3.97 * std::pow(tau - 0.0495, 1.5), 1e-12);
   EXPECT_NEAR(j["q_star_nielsen"].get<double>(), 12.0 * std::sqrt(tau) * (tau - 0.05), 1e-12);
+
+  // profiles.csv: the flux density integrates over y to the mean transport rate, and the solid
+  // fraction to the particle volume (over the plan area 0.005 x 0.01 m, rows 1 mm high).
+  std::ifstream prof(ctx.out_dir / "profiles.csv");
+  std::string line;
+  std::getline(prof, line);
+  EXPECT_EQ(line, "y_m,fluid_w_m_s,solid_fraction,particle_w_m_s,particle_flux_density_m_s");
+  double q_sum = 0.0, solid = 0.0, y, w, a, wp, f;
+  char c;
+  int rows = 0;
+  while (prof >> y >> c >> w >> c >> a >> c >> wp >> c >> f) q_sum += f * 1e-3, solid += a * 1e-3 * 0.005 * 0.01, ++rows;
+  EXPECT_EQ(rows, 40);
+  EXPECT_NEAR(q_sum, j["transport_rate_m2_s"].get<double>(), 1e-9 * std::abs(q_sum));
+  EXPECT_NEAR(solid, vp, 1e-9 * vp);
 }
 
 TEST(SedimentTransport, StoppedAndResumedRunEqualsTheUninterruptedOneBitwise) {
@@ -83,6 +99,12 @@ TEST(SedimentTransport, StoppedAndResumedRunEqualsTheUninterruptedOneBitwise) {
   for (const char* k : {"q_star", "q_star_stderr", "shields_stress", "mean_flux_z_m_s", "mean_settling_velocity_m_s",
                         "bed_pouring_time_s", "max_kinetic_energy_j"})
     EXPECT_EQ(ja[k].get<double>(), jb[k].get<double>()) << k;
+  auto text = [](const std::filesystem::path& f) {
+    std::ifstream in(f);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(text(a.out_dir / "profiles.csv"), text(b.out_dir / "profiles.csv"));  // its sums are checkpointed
+  EXPECT_FALSE(text(a.out_dir / "profiles.csv").empty());
 }
 
 TEST(SedimentTransport, RefusesAnInclinedOrPeriodicChannel) {
