@@ -158,16 +158,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
                                   p.domain.height_z_m};
       io::write_particle_png(ctx.out_dir / fmt::format("particles_t{:.3f}.png", time), view);
     });
-    const bool stop = ctx.should_stop();
     // Also at the end: the final state stays inspectable (and comparable across restarts).
-    if (checkpoints.due(t, end, stop)) {
-      csv.flush();
-      write_checkpoint();
-    }
-    if (stop) {
-      sb.status = "interrupted";
+    if (checkpoint_or_stop(ctx.should_stop(), ctx.quiet, checkpoints, t, end, csv, write_checkpoint, sb)) {
       exit_code = kExitInterrupted;
-      if (!ctx.quiet) std::fprintf(stderr, "stopped at t = %g s after writing a checkpoint; run again to resume\n", t);
       break;
     }
   }

@@ -78,6 +78,22 @@ class CheckpointClock {
   double every_, next_;
 };
 
+/// End of a step of a checkpointed scene: a checkpoint when one is due (the time series flushed
+/// first, so that a resumed run finds the rows up to it) and, on a stop request, the summary
+/// marked interrupted. Returns true when the scene must leave its loop (exit kExitInterrupted).
+template <class WriteCheckpoint>
+bool checkpoint_or_stop(bool stop_requested, bool quiet, CheckpointClock& clock, double t_s, double end_s,
+                        CsvWriter& csv, WriteCheckpoint&& write_checkpoint, SummaryBase& summary) {
+  if (clock.due(t_s, end_s, stop_requested)) {
+    csv.flush();
+    write_checkpoint();
+  }
+  if (!stop_requested) return false;
+  summary.status = "interrupted";
+  if (!quiet) std::fprintf(stderr, "stopped at t = %g s after writing a checkpoint; run again to resume\n", t_s);
+  return true;
+}
+
 /// Output at given simulated times (output.snapshot_times, output.image_times): sorted; on a
 /// resumed run those at or before its time are already written.
 class OutputTimes {

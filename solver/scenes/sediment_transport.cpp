@@ -13,6 +13,9 @@
 //   Nielsen (1992), Coastal Bottom Boundary Layers and Sediment Transport, World Scientific:
 //   q* = 12 tau*^0.5 (tau* - 0.05), the form Schmeeckle (2014, JGR Earth Surf. 119, 1240) and
 //   Sun & Xiao (2016, Comput. Geosci. 89, 207) compare their CFD-DEM transport rates with.
+// The fluid starts turbulent over the poured bed (sediment.initial_flow, fluid/turbulent_start.hpp):
+// from rest it would stay a laminar Stokes layer, and tau* would be that layer's.
+// Writes profiles.csv (time-averaged rows over y) and snapshots at output.snapshot_times.
 // Checkpoints as inclined_settling: every time.checkpoint_every, at the end, and on SIGINT/SIGTERM
 // (exit 75); the same command resumes.
 #include <algorithm>
@@ -218,15 +221,8 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
       ModelTimers::Scope sc(timers, "snapshots");
       io::write_snapshot(ctx.out_dir, static_cast<int>(index), run.snapshot(), run.fluid().settings().grid);
     });
-    const bool stop = ctx.should_stop();
-    if (checkpoints.due(t, p.time.end_s, stop)) {
-      csv.flush();
-      write_checkpoint();
-    }
-    if (stop) {
-      sb.status = "interrupted";
+    if (checkpoint_or_stop(ctx.should_stop(), ctx.quiet, checkpoints, t, p.time.end_s, csv, write_checkpoint, sb)) {
       exit_code = kExitInterrupted;
-      if (!ctx.quiet) std::fprintf(stderr, "stopped at t = %g s after writing a checkpoint; run again to resume\n", t);
       break;
     }
   }
