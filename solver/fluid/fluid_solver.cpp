@@ -135,13 +135,16 @@ FluidSettings FluidSettings::from_case(const CaseParams& p) {
 /// every rank and transforming it there made an application slower on 2 ranks than on one.)
 struct SpectralPcShell {
   // One rank: the serial transform on the global vector (which is in natural order). Several:
-  // FFTW's MPI transform on slabs of whole z-planes; the natural vector is moved to FFTW's slabs
-  // and back by one scatter each way.
+  // FFTW's MPI transform on slabs of whole z-planes. create_layout cuts the grid into those
+  // slabs, so the global vector is already in slab order ("aligned"); where it could not (a rank
+  // with fewer than 2 planes, or -pressure_pc_type given) the vector is moved to the slabs and
+  // back through the natural ordering.
   std::unique_ptr<SpectralPoissonPreconditioner> serial;
   std::unique_ptr<DistributedSpectralPoisson> dist;
   DM dm = nullptr;
   Vec nat = nullptr, slab = nullptr, slab_out = nullptr;
   VecScatter to_slab = nullptr;
+  bool aligned = false;  ///< the DMDA's global vector is already in FFTW's slabs
 
   SpectralPcShell(DM da, const GridSpec& g) : dm(da) {
     const MPI_Comm comm = PetscObjectComm((PetscObject)da);
@@ -153,6 +156,14 @@ struct SpectralPcShell {
       return;
     }
     dist = std::make_unique<DistributedSpectralPoisson>(n[0], n[1], n[2], g.periodic[1], comm);
+    // Laid out in FFTW's slabs (create_layout): this rank's global block is its slab.
+    PetscInt xs, ys, zs, xm, ym, zm;
+    BC_PETSC(DMDAGetCorners(da, &xs, &ys, &zs, &xm, &ym, &zm));
+    int aligned_here = xm == n[0] && ym == n[1] && zs == dist->z_begin() && zm == dist->z_count();
+    int aligned_all = 0;
+    MPI_Allreduce(&aligned_here, &aligned_all, 1, MPI_INT, MPI_MIN, comm);
+    aligned = aligned_all == 1;
+    if (aligned) return;
     const PetscInt plane = static_cast<PetscInt>(n[0]) * n[1];
     const PetscInt count = plane * dist->z_count(), first = plane * dist->z_begin();
     BC_PETSC(DMDACreateNaturalVector(dm, &nat));
@@ -183,10 +194,13 @@ struct SpectralPcShell {
     auto& S = *static_cast<SpectralPcShell*>(ctx);
     const PetscScalar* xa;
     PetscScalar* ya;
-    if (S.serial) {  // one rank: the global vector is the natural one
+    if (S.serial || S.aligned) {  // one rank, or FFTW's slabs: the global vector is in transform order
       PetscCall(VecGetArrayRead(x, &xa));
       PetscCall(VecGetArray(y, &ya));
-      S.serial->apply(xa, ya);
+      if (S.serial)
+        S.serial->apply(xa, ya);
+      else
+        S.dist->apply(xa, ya);
       PetscCall(VecRestoreArrayRead(x, &xa));
       PetscCall(VecRestoreArray(y, &ya));
       return 0;
@@ -242,9 +256,24 @@ void FluidSolver::create_layout() {
   for (int d = 0; d < 3; ++d)
     if (g.n[d] < 2) throw InputError(fmt::format("fluid grid needs at least 2 cells per direction (got {})", g.n[d]));
   const DMBoundaryType by = g.periodic[1] ? DM_BOUNDARY_PERIODIC : DM_BOUNDARY_NONE;
+  // With the spectral pressure preconditioner on several ranks, the grid is cut into FFTW's
+  // slabs of whole z-planes: the global vectors are then stored in the transform's own order and
+  // an application needs no scatter (with PETSc's own cut it needed four, which made it slower
+  // on 2 ranks than on one). Every rank needs at least the ghost width (2) of planes.
+  int nranks = 1;
+  MPI_Comm_size(comm_, &nranks);
+  PetscBool user_pc = PETSC_FALSE;
+  BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-pressure_pc_type", &user_pc));
+  std::vector<PetscInt> z_slabs;
+  if (nranks > 1 && !user_pc) {
+    for (int c : DistributedSpectralPoisson::z_slab_counts((int)g.n[0], (int)g.n[1], (int)g.n[2], comm_))
+      z_slabs.push_back(c);
+    if (std::any_of(z_slabs.begin(), z_slabs.end(), [](PetscInt c) { return c < 2; })) z_slabs.clear();
+  }
+  const PetscInt pz = z_slabs.empty() ? PETSC_DECIDE : nranks, pxy = z_slabs.empty() ? PETSC_DECIDE : 1;
   BC_PETSC(DMDACreate3d(comm_, DM_BOUNDARY_PERIODIC, by, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_BOX, (PetscInt)g.n[0],
-                        (PetscInt)g.n[1], (PetscInt)g.n[2], PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE, 1, 2, nullptr,
-                        nullptr, nullptr, &da_));
+                        (PetscInt)g.n[1], (PetscInt)g.n[2], pxy, pxy, pz, 1, 2, nullptr, nullptr,
+                        z_slabs.empty() ? nullptr : z_slabs.data(), &da_));
   BC_PETSC(DMSetUp(da_));
   const PetscInt *lx, *ly, *lz;
   PetscInt mx, my, mz;
@@ -308,8 +337,6 @@ void FluidSolver::create_layout() {
   // GMRES, not CG: with a packed bed at a wall (alpha_f ~ 0.45 beside 1) BoomerAMG turned out
   // not symmetric positive enough for CG (KSP_DIVERGED_INDEFINITE_PC in the demo study at 50,
   // 70 and 90 deg); GMRES converges on the same systems.
-  int nranks = 1;
-  MPI_Comm_size(comm_, &nranks);
   BC_PETSC(KSPSetType(ksp_p_, KSPGMRES));
   // 1e-2 relative per SIMPLE iteration: SIMPLE iterates until the continuity residual of the
   // momentum solution is below simple_tolerance, so an exact p' each iteration buys nothing (8.5-8.75
@@ -319,8 +346,6 @@ void FluidSolver::create_layout() {
   {
     PC pc;
     BC_PETSC(KSPGetPC(ksp_p_, &pc));
-    PetscBool user_pc = PETSC_FALSE;
-    BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-pressure_pc_type", &user_pc));
     if (!user_pc) {
       // The spectral preconditioner (spectral_poisson_pc.hpp, SpectralPcShell); AMG is the
       // fallback and what -pressure_pc_type hypre|gamg selects.

@@ -52,6 +52,46 @@ void make_bases(int nx, int ny, int nz, bool periodic_y, std::vector<double>& qy
   for (int k = 0; k < nz; ++k) sz[k] = 2.0 - 2.0 * std::cos(kTwoPi * k / nz);
 }
 
+/// The y part of the inverse on ny rows of n2 doubles (complex values, re and im interleaved; row
+/// j at rows + j * stride): to the y eigenbasis, times scale / lambda, back, where
+/// lambda = base[p] + cy sy[m] for complex entry p (base: the x and z part). The zero eigenvalue
+/// (the constant, the null space of the pure-Neumann/periodic system) and unused modes give 0.
+/// The loops run along the rows (contiguous) and vectorise; each value is summed over j and m in
+/// index order. eig: scratch of ny * n2.
+void solve_y_rows(const std::vector<double>& qy, const std::vector<double>& sy, double* rows, std::size_t stride,
+                  int n2, const double* base, double cy, double scale, double tiny, double* __restrict eig) {
+  const int ny = static_cast<int>(sy.size());
+  for (int m = 0; m < ny; ++m) {
+    double* __restrict e = eig + static_cast<std::size_t>(m) * n2;
+    for (int q = 0; q < n2; ++q) e[q] = 0.0;
+    for (int j = 0; j < ny; ++j) {
+      const double w = qy[static_cast<std::size_t>(j) * ny + m];
+      const double* __restrict row = rows + j * stride;
+#pragma GCC ivdep
+      for (int q = 0; q < n2; ++q) e[q] += w * row[q];
+    }
+    const bool unused = sy[m] < 0.0;
+    const double ly = cy * sy[m];
+#pragma GCC ivdep
+    for (int p = 0; p < n2 / 2; ++p) {
+      const double lam = base[p] + ly;
+      const double f = (unused || lam <= tiny) ? 0.0 : scale / lam;
+      e[2 * p] *= f;
+      e[2 * p + 1] *= f;
+    }
+  }
+  for (int j = 0; j < ny; ++j) {
+    double* __restrict row = rows + j * stride;
+    for (int q = 0; q < n2; ++q) row[q] = 0.0;
+    for (int m = 0; m < ny; ++m) {
+      const double w = qy[static_cast<std::size_t>(j) * ny + m];
+      const double* __restrict e = eig + static_cast<std::size_t>(m) * n2;
+#pragma GCC ivdep
+      for (int q = 0; q < n2; ++q) row[q] += w * e[q];
+    }
+  }
+}
+
 }  // namespace
 
 SpectralPoissonPreconditioner::SpectralPoissonPreconditioner(int nx, int ny, int nz, bool periodic_y)
@@ -65,6 +105,7 @@ SpectralPoissonPreconditioner::SpectralPoissonPreconditioner(int nx, int ny, int
   auto* spec = fftw_alloc_complex(ncplx);
   spec_ = spec;
   eig_.resize(static_cast<std::size_t>(ny) * 2 * nkx_);
+  base_.resize(nkx_);
   int n[2] = {nz, nx};
   // FFTW_ESTIMATE: plans in microseconds; MEASURE would time candidate plans at every start.
   fwd_ = fftw_plan_many_dft_r2c(2, n, ny, real_, nullptr, 1, nz * nx, spec, nullptr, 1, nz * nkx_, FFTW_ESTIMATE);
@@ -91,44 +132,15 @@ void SpectralPoissonPreconditioner::apply(const double* r, double* z) {
   fftw_execute(static_cast<fftw_plan>(fwd_));
   auto* spec = reinterpret_cast<std::complex<double>*>(spec_);
   const std::size_t cplane = static_cast<std::size_t>(nz_) * nkx_;
-  // Per (kz, kx): to the y eigenbasis, divide by the eigenvalue, back. The zero eigenvalue (the
-  // constant) is dropped: that is the null space of the pure-Neumann/periodic pressure system.
-  // Done for a whole kx row at a time (re and im interleaved, contiguous), so the loops over kx
-  // vectorise; each value is summed in the same order as one (kz, kx) at a time.
+  // Per (kz, kx): to the y eigenbasis, divide by the eigenvalue, back; a whole kx row at a time.
   const double scale = 1.0 / (static_cast<double>(nx_) * nz_);
-  const int n2 = 2 * nkx_;
+  const double tiny = 1e-12 * (c_[0] + c_[1] + c_[2]);
   auto* sp = reinterpret_cast<double*>(spec);
-  double* __restrict eig = eig_.data();  // ny rows of 2 nkx
   for (int kz = 0; kz < nz_; ++kz) {
-    for (int m = 0; m < ny_; ++m) {
-      double* __restrict e = eig + static_cast<std::size_t>(m) * n2;
-      for (int q = 0; q < n2; ++q) e[q] = 0.0;
-      for (int j = 0; j < ny_; ++j) {
-        const double w = qy_[static_cast<std::size_t>(j) * ny_ + m];
-        const double* __restrict row = sp + 2 * (j * cplane + static_cast<std::size_t>(kz) * nkx_);
-#pragma GCC ivdep
-        for (int q = 0; q < n2; ++q) e[q] += w * row[q];
-      }
-      const bool unused = sy_[m] < 0.0;
-      const double lyz = c_[2] * sz_[kz], tiny = 1e-12 * (c_[0] + c_[1] + c_[2]);
-#pragma GCC ivdep
-      for (int kx = 0; kx < nkx_; ++kx) {
-        const double lam = c_[0] * sx_[kx] + lyz + c_[1] * sy_[m];
-        const double f = (unused || lam <= tiny) ? 0.0 : scale / lam;
-        e[2 * kx] *= f;
-        e[2 * kx + 1] *= f;
-      }
-    }
-    for (int j = 0; j < ny_; ++j) {
-      double* __restrict row = sp + 2 * (j * cplane + static_cast<std::size_t>(kz) * nkx_);
-      for (int q = 0; q < n2; ++q) row[q] = 0.0;
-      for (int m = 0; m < ny_; ++m) {
-        const double w = qy_[static_cast<std::size_t>(j) * ny_ + m];
-        const double* __restrict e = eig + static_cast<std::size_t>(m) * n2;
-#pragma GCC ivdep
-        for (int q = 0; q < n2; ++q) row[q] += w * e[q];
-      }
-    }
+    const double lz = c_[2] * sz_[kz];
+    for (int kx = 0; kx < nkx_; ++kx) base_[kx] = c_[0] * sx_[kx] + lz;
+    solve_y_rows(qy_, sy_, sp + 2 * static_cast<std::size_t>(kz) * nkx_, 2 * cplane, 2 * nkx_, base_.data(), c_[1],
+                 scale, tiny, eig_.data());
   }
   fftw_execute(static_cast<fftw_plan>(bwd_));
   for (int k = 0; k < nz_; ++k)
@@ -141,14 +153,34 @@ void SpectralPoissonPreconditioner::apply(const double* r, double* z) {
 
 namespace boycott::fluid {
 
-DistributedSpectralPoisson::DistributedSpectralPoisson(int nx, int ny, int nz, bool periodic_y, MPI_Comm comm)
-    : nx_(nx), ny_(ny), nz_(nz), nkx_(nx / 2 + 1) {
-  if (nx < 1 || ny < 1 || nz < 1) throw std::invalid_argument("DistributedSpectralPoisson: empty grid");
+namespace {
+void init_fftw_mpi() {
   static const bool initialised = [] {
     fftw_mpi_init();
     return true;
   }();
   (void)initialised;
+}
+}  // namespace
+
+std::vector<int> DistributedSpectralPoisson::z_slab_counts(int nx, int ny, int nz, MPI_Comm comm) {
+  init_fftw_mpi();
+  const ptrdiff_t nc[2] = {nz, nx / 2 + 1};
+  ptrdiff_t n0, s0, n1, s1;
+  fftw_mpi_local_size_many_transposed(2, nc, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, comm, &n0, &s0, &n1,
+                                      &s1);
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  std::vector<int> counts(static_cast<std::size_t>(size));
+  const int mine = static_cast<int>(n0);
+  MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  return counts;
+}
+
+DistributedSpectralPoisson::DistributedSpectralPoisson(int nx, int ny, int nz, bool periodic_y, MPI_Comm comm)
+    : nx_(nx), ny_(ny), nz_(nz), nkx_(nx / 2 + 1) {
+  if (nx < 1 || ny < 1 || nz < 1) throw std::invalid_argument("DistributedSpectralPoisson: empty grid");
+  init_fftw_mpi();
   make_bases(nx, ny, nz, periodic_y, qy_, sy_, sx_, sz_);
   const ptrdiff_t nc[2] = {nz, nkx_};  // complex extents for the r2c local sizes
   ptrdiff_t n0, s0, n1, s1;
@@ -159,7 +191,9 @@ DistributedSpectralPoisson::DistributedSpectralPoisson(int nx, int ny, int nz, b
   real_ = fftw_alloc_real(2 * static_cast<std::size_t>(alloc > 0 ? alloc : 1));
   auto* spec = fftw_alloc_complex(static_cast<std::size_t>(alloc > 0 ? alloc : 1));
   spec_ = spec;
-  eig_.resize(2 * static_cast<std::size_t>(ny));
+  eig_.resize(static_cast<std::size_t>(ny) * 2 * nz);
+  rows_.resize(static_cast<std::size_t>(ny) * 2 * nz);
+  base_.resize(nz);
   const ptrdiff_t nr[2] = {nz, nx};
   fwd_ = fftw_mpi_plan_many_dft_r2c(2, nr, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, real_, spec, comm,
                                     FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_OUT);
@@ -185,26 +219,30 @@ void DistributedSpectralPoisson::apply(const double* r, double* z) {
       for (int i = 0; i < nx_; ++i) dst[static_cast<std::size_t>(i) * ny_] = src[i];
     }
   fftw_execute(static_cast<fftw_plan>(fwd_));
-  auto* spec = reinterpret_cast<std::complex<double>*>(spec_);
+  // FFTW's transposed output holds, per local kx, nz columns of ny (y innermost): move each kx
+  // block to ny rows over kz, so that the y solve runs along contiguous rows as in the serial
+  // preconditioner (same arithmetic, same order), and back.
+  auto* sp = reinterpret_cast<double*>(spec_);
   const double scale = 1.0 / (static_cast<double>(nx_) * nz_);
   const double tiny = 1e-12 * (c_[0] + c_[1] + c_[2]);
-  auto* e = reinterpret_cast<std::complex<double>*>(eig_.data());
+  const std::size_t n2 = 2 * static_cast<std::size_t>(nz_);
+  double* __restrict rows = rows_.data();
   for (int a = 0; a < nkx_local_; ++a) {
     const int kx = kx0_ + a;
-    for (int kz = 0; kz < nz_; ++kz) {
-      std::complex<double>* col = spec + (static_cast<std::size_t>(a) * nz_ + kz) * ny_;  // y innermost
-      for (int m = 0; m < ny_; ++m) {
-        std::complex<double> s = 0.0;
-        for (int j = 0; j < ny_; ++j) s += qy_[static_cast<std::size_t>(j) * ny_ + m] * col[j];
-        const double lam = c_[0] * sx_[kx] + c_[2] * sz_[kz] + c_[1] * sy_[m];
-        e[m] = (sy_[m] < 0.0 || lam <= tiny) ? 0.0 : s * (scale / lam);
-      }
+    double* block = sp + static_cast<std::size_t>(a) * n2 * ny_;  // [kz][j] complex
+    for (int kz = 0; kz < nz_; ++kz)
       for (int j = 0; j < ny_; ++j) {
-        std::complex<double> s = 0.0;
-        for (int m = 0; m < ny_; ++m) s += qy_[static_cast<std::size_t>(j) * ny_ + m] * e[m];
-        col[j] = s;
+        rows[j * n2 + 2 * kz] = block[(static_cast<std::size_t>(kz) * ny_ + j) * 2];
+        rows[j * n2 + 2 * kz + 1] = block[(static_cast<std::size_t>(kz) * ny_ + j) * 2 + 1];
       }
-    }
+    const double lx = c_[0] * sx_[kx];
+    for (int kz = 0; kz < nz_; ++kz) base_[kz] = lx + c_[2] * sz_[kz];
+    solve_y_rows(qy_, sy_, rows, n2, static_cast<int>(n2), base_.data(), c_[1], scale, tiny, eig_.data());
+    for (int kz = 0; kz < nz_; ++kz)
+      for (int j = 0; j < ny_; ++j) {
+        block[(static_cast<std::size_t>(kz) * ny_ + j) * 2] = rows[j * n2 + 2 * kz];
+        block[(static_cast<std::size_t>(kz) * ny_ + j) * 2 + 1] = rows[j * n2 + 2 * kz + 1];
+      }
   }
   fftw_execute(static_cast<fftw_plan>(bwd_));
   for (int k = 0; k < nz_local_; ++k)

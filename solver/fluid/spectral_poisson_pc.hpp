@@ -40,6 +40,7 @@ class SpectralPoissonPreconditioner {
   double* real_ = nullptr;       ///< ny planes of nz x nx reals (fftw_malloc)
   void* spec_ = nullptr;         ///< ny planes of nz x (nx/2+1) complex (fftw_complex)
   std::vector<double> eig_;  ///< one kz row of coefficients in the y eigenbasis: ny x (re, im) x nkx
+  std::vector<double> base_;  ///< x and z part of the eigenvalues along that row
   void* fwd_ = nullptr;  ///< fftw_plan
   void* bwd_ = nullptr;
 };
@@ -57,6 +58,10 @@ class DistributedSpectralPoisson {
 
   int z_begin() const { return z0_; }
   int z_count() const { return nz_local_; }
+  /// The z-planes each rank of `comm` holds in FFTW's slabs for this grid (collective): a DMDA
+  /// laid out with these z ownership ranges, undivided in x and y, stores its global vector in
+  /// exactly this class's slab order, so the preconditioner needs no scatter.
+  static std::vector<int> z_slab_counts(int nx, int ny, int nz, MPI_Comm comm);
   void set_coefficients(double cx, double cy, double cz) { c_ = {cx, cy, cz}; }
   /// z = M^+ r on this rank's slab (collective).
   void apply(const double* r_slab, double* z_slab);
@@ -68,7 +73,9 @@ class DistributedSpectralPoisson {
   std::vector<double> qy_, sy_, sx_, sz_;
   double* real_ = nullptr;  ///< [z local][2 nkx][ny] (FFTW MPI layout, y innermost)
   void* spec_ = nullptr;    ///< transposed: [kx local][nz][ny] complex
-  std::vector<double> eig_;  ///< one (kx, kz) column in the y eigenbasis: ny x (re, im)
+  std::vector<double> eig_;   ///< one kx block in the y eigenbasis: ny x (re, im) x nz
+  std::vector<double> rows_;  ///< that block moved to ny rows over kz
+  std::vector<double> base_;  ///< x and z part of the eigenvalues along a row
   void* fwd_ = nullptr;
   void* bwd_ = nullptr;
 };
