@@ -54,12 +54,14 @@ void make_bases(int nx, int ny, int nz, bool periodic_y, std::vector<double>& qy
 
 /// The y part of the inverse on ny rows of n2 doubles (complex values, re and im interleaved; row
 /// j at rows + j * stride): to the y eigenbasis, times scale / lambda, back, where
-/// lambda = base[p] + cy sy[m] for complex entry p (base: the x and z part). The zero eigenvalue
+/// lambda = ca sa[p] + kb + cy sy[m] for complex entry p (the x or z part varying along the row,
+/// the other one constant). The zero eigenvalue
 /// (the constant, the null space of the pure-Neumann/periodic system) and unused modes give 0.
 /// The loops run along the rows (contiguous) and vectorise; each value is summed over j and m in
 /// index order. eig: scratch of ny * n2.
 void solve_y_rows(const std::vector<double>& qy, const std::vector<double>& sy, double* rows, std::size_t stride,
-                  int n2, const double* base, double cy, double scale, double tiny, double* __restrict eig) {
+                  int n2, double ca, const double* sa, double kb, double cy, double scale, double tiny,
+                  double* __restrict eig) {
   const int ny = static_cast<int>(sy.size());
   for (int m = 0; m < ny; ++m) {
     double* __restrict e = eig + static_cast<std::size_t>(m) * n2;
@@ -71,10 +73,12 @@ void solve_y_rows(const std::vector<double>& qy, const std::vector<double>& sy, 
       for (int q = 0; q < n2; ++q) e[q] += w * row[q];
     }
     const bool unused = sy[m] < 0.0;
-    const double ly = cy * sy[m];
 #pragma GCC ivdep
     for (int p = 0; p < n2 / 2; ++p) {
-      const double lam = base[p] + ly;
+      // Explicit fused multiply-adds: what GCC made of this sum before the kernel was shared
+      // (contracted, with cy sy[m] kept in the loop). Here it would hoist cy sy[m] and round it
+      // separately, and one rank's results would change in the last bit.
+      const double lam = std::fma(cy, sy[m], std::fma(ca, sa[p], kb));
       const double f = (unused || lam <= tiny) ? 0.0 : scale / lam;
       e[2 * p] *= f;
       e[2 * p + 1] *= f;
@@ -105,7 +109,6 @@ SpectralPoissonPreconditioner::SpectralPoissonPreconditioner(int nx, int ny, int
   auto* spec = fftw_alloc_complex(ncplx);
   spec_ = spec;
   eig_.resize(static_cast<std::size_t>(ny) * 2 * nkx_);
-  base_.resize(nkx_);
   int n[2] = {nz, nx};
   // FFTW_ESTIMATE: plans in microseconds; MEASURE would time candidate plans at every start.
   fwd_ = fftw_plan_many_dft_r2c(2, n, ny, real_, nullptr, 1, nz * nx, spec, nullptr, 1, nz * nkx_, FFTW_ESTIMATE);
@@ -137,10 +140,8 @@ void SpectralPoissonPreconditioner::apply(const double* r, double* z) {
   const double tiny = 1e-12 * (c_[0] + c_[1] + c_[2]);
   auto* sp = reinterpret_cast<double*>(spec);
   for (int kz = 0; kz < nz_; ++kz) {
-    const double lz = c_[2] * sz_[kz];
-    for (int kx = 0; kx < nkx_; ++kx) base_[kx] = c_[0] * sx_[kx] + lz;
-    solve_y_rows(qy_, sy_, sp + 2 * static_cast<std::size_t>(kz) * nkx_, 2 * cplane, 2 * nkx_, base_.data(), c_[1],
-                 scale, tiny, eig_.data());
+    solve_y_rows(qy_, sy_, sp + 2 * static_cast<std::size_t>(kz) * nkx_, 2 * cplane, 2 * nkx_, c_[0], sx_.data(),
+                 c_[2] * sz_[kz], c_[1], scale, tiny, eig_.data());
   }
   fftw_execute(static_cast<fftw_plan>(bwd_));
   for (int k = 0; k < nz_; ++k)
@@ -193,7 +194,6 @@ DistributedSpectralPoisson::DistributedSpectralPoisson(int nx, int ny, int nz, b
   spec_ = spec;
   eig_.resize(static_cast<std::size_t>(ny) * 2 * nz);
   rows_.resize(static_cast<std::size_t>(ny) * 2 * nz);
-  base_.resize(nz);
   const ptrdiff_t nr[2] = {nz, nx};
   fwd_ = fftw_mpi_plan_many_dft_r2c(2, nr, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, real_, spec, comm,
                                     FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_OUT);
@@ -235,9 +235,8 @@ void DistributedSpectralPoisson::apply(const double* r, double* z) {
         rows[j * n2 + 2 * kz] = block[(static_cast<std::size_t>(kz) * ny_ + j) * 2];
         rows[j * n2 + 2 * kz + 1] = block[(static_cast<std::size_t>(kz) * ny_ + j) * 2 + 1];
       }
-    const double lx = c_[0] * sx_[kx];
-    for (int kz = 0; kz < nz_; ++kz) base_[kz] = lx + c_[2] * sz_[kz];
-    solve_y_rows(qy_, sy_, rows, n2, static_cast<int>(n2), base_.data(), c_[1], scale, tiny, eig_.data());
+    solve_y_rows(qy_, sy_, rows, n2, static_cast<int>(n2), c_[2], sz_.data(), c_[0] * sx_[kx], c_[1], scale, tiny,
+                 eig_.data());
     for (int kz = 0; kz < nz_; ++kz)
       for (int j = 0; j < ny_; ++j) {
         block[(static_cast<std::size_t>(kz) * ny_ + j) * 2] = rows[j * n2 + 2 * kz];

@@ -40,7 +40,6 @@ class SpectralPoissonPreconditioner {
   double* real_ = nullptr;       ///< ny planes of nz x nx reals (fftw_malloc)
   void* spec_ = nullptr;         ///< ny planes of nz x (nx/2+1) complex (fftw_complex)
   std::vector<double> eig_;  ///< one kz row of coefficients in the y eigenbasis: ny x (re, im) x nkx
-  std::vector<double> base_;  ///< x and z part of the eigenvalues along that row
   void* fwd_ = nullptr;  ///< fftw_plan
   void* bwd_ = nullptr;
 };
@@ -75,7 +74,6 @@ class DistributedSpectralPoisson {
   void* spec_ = nullptr;    ///< transposed: [kx local][nz][ny] complex
   std::vector<double> eig_;   ///< one kx block in the y eigenbasis: ny x (re, im) x nz
   std::vector<double> rows_;  ///< that block moved to ny rows over kz
-  std::vector<double> base_;  ///< x and z part of the eigenvalues along a row
   void* fwd_ = nullptr;
   void* bwd_ = nullptr;
 };
