@@ -116,9 +116,10 @@ struct SedimentParams {
   double bulk_velocity_m_s = 0.8;  ///< target z-averaged bulk velocity
   double bed_height_m = kUnset;    ///< unset: from the particle count
   /// Fluid at t = 0: "turbulent", a log-law profile over the bed top at the bulk velocity with
-  /// large-scale random perturbations of 10 % of it (the flow is turbulent within ~0.5 s); or
-  /// "rest", an impulsive start from still fluid, which on this scene's time scale stays a
-  /// laminar Stokes layer (bed shear falling as t^-1/2; see the README).
+  /// large-scale random perturbations of 5 % of it per mode (the flow is turbulent within
+  /// ~0.5 s); or "rest", an impulsive start from still fluid, whose first step kicks the bed with
+  /// the whole acceleration (see the README: the flow then relaminarises or the bed is blown
+  /// into suspension, depending on the plan).
   std::string initial_flow = "turbulent";
 };
 

@@ -13,8 +13,10 @@
 //   Nielsen (1992), Coastal Bottom Boundary Layers and Sediment Transport, World Scientific:
 //   q* = 12 tau*^0.5 (tau* - 0.05), the form Schmeeckle (2014, JGR Earth Surf. 119, 1240) and
 //   Sun & Xiao (2016, Comput. Geosci. 89, 207) compare their CFD-DEM transport rates with.
-// The fluid starts turbulent over the poured bed (sediment.initial_flow, fluid/turbulent_start.hpp):
-// from rest it would stay a laminar Stokes layer, and tau* would be that layer's.
+// The fluid starts turbulent over the poured bed (sediment.initial_flow, fluid/turbulent_start.hpp).
+// From rest, the flux controller's first step kicks the bed with a gradient of ~-2e6 Pa/m; the
+// bed is then eroded and the flow relaminarises (5 x 10 mm plan) or it is blown into suspension,
+// which trips the turbulence (10 x 20 mm). Started turbulent, the flow needs neither.
 // Writes profiles.csv (time-averaged rows over y) and snapshots at output.snapshot_times.
 // Checkpoints as inclined_settling: every time.checkpoint_every, at the end, and on SIGINT/SIGTERM
 // (exit 75); the same command resumes.
@@ -151,8 +153,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
     throw InputError(fmt::format("bed height {:.4g} m fills the channel: must be < domain.width_y = {} m", h_bed, H));
   if (!resumed) {
     run.start();
-    // Fluid started from rest over the bed would stay a laminar Stokes layer for the whole run
-    // (see fluid/turbulent_start.hpp): start it turbulent, with the bed top as the floor and
+    // Start the flow turbulent (see the top of this file), with the bed top as the floor and
     // Nikuradse's k_s = 2.5 d.
     if (p.sediment.initial_flow == "turbulent") {
       fluid::TurbulentStartSettings ts;
