@@ -1,12 +1,13 @@
 #pragma once
-#include <algorithm>
 // What every scene writes the same way: summary.json with the common keys of design brief
 // section 7, timeseries.csv, atomic file replacement.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>

@@ -23,9 +23,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <vector>
-#include <cstdio>
 
 #include <fmt/format.h>
 
