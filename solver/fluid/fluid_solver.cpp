@@ -15,6 +15,7 @@
 #include "fluid/petsc_check.hpp"
 #include "fluid/spectral_poisson_pc.hpp"
 #include "fluid/stencil_matrix.hpp"
+#include "fluid/stencil_operator.hpp"
 #include "fluid/vreman.hpp"
 
 namespace boycott::fluid {
@@ -241,12 +242,13 @@ FluidSolver::~FluidSolver() {
   if (ksp_p_fallback_) KSPDestroy(&ksp_p_fallback_);
   if (A_) MatDestroy(&A_);
   for (int c = 0; c < 3; ++c) {
-    if (Am_[c]) MatDestroy(&Am_[c]);
+    opm_[c].reset();
     vd(bm_[c]);
-    vd(aPm_[c]);
   }
   vd(P_asm_);
   if (Ap_) MatDestroy(&Ap_);
+  opA_.reset();
+  opP_.reset();
   if (dam_) DMDestroy(&dam_);
   if (da_) DMDestroy(&da_);
 }
@@ -284,16 +286,14 @@ void FluidSolver::create_layout() {
   BC_PETSC(DMDACreate3d(comm_, DM_BOUNDARY_PERIODIC, by, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR, (PetscInt)g.n[0],
                         (PetscInt)g.n[1], (PetscInt)g.n[2], mx, my, mz, 1, 1, lx, ly, lz, &dam_));
   BC_PETSC(DMSetUp(dam_));
-  BC_PETSC(DMCreateMatrix(dam_, &A_));
-  BC_PETSC(DMCreateMatrix(dam_, &Ap_));
-  // Every rank writes only its own rows (StencilMatrixWriter): without this, each assembly of
-  // an MPIAIJ matrix still set up the communication of off-process entries (~3 ms per PISO step
-  // on 2 ranks of the bench mesh).
-  for (Mat M : {A_, Ap_}) {
-    BC_PETSC(MatSetOption(M, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
-    BC_PETSC(MatSetOption(M, MAT_NO_OFF_PROC_ENTRIES, PETSC_TRUE));
-  }
-  writer_ = std::make_unique<StencilMatrixWriter>(dam_, A_);
+  // Both systems are applied matrix-free (stencil_operator.hpp); an AIJ copy is made only for a
+  // preconditioner that needs the entries.
+  opA_ = std::make_unique<StencilOperator>(dam_);
+  opP_ = std::make_unique<StencilOperator>(dam_);
+  PetscBool user_momentum_pc = PETSC_FALSE;
+  BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-momentum_pc_type", &user_momentum_pc));
+  momentum_aij_ = user_momentum_pc;
+  pressure_aij_ = user_pc;
 
   auto gv = [&](Vec* v) { BC_PETSC(DMCreateGlobalVector(da_, v)); };
   auto lv = [&](Vec* v) { BC_PETSC(DMCreateLocalVector(da_, v)); };
@@ -364,8 +364,22 @@ void FluidSolver::create_layout() {
   BC_PETSC(KSPSetFromOptions(ksp_p_));
   // Periodic x, z and walls (or periodicity) in y: pure Neumann, the constant is the null space.
   BC_PETSC(MatNullSpaceCreate(comm_, PETSC_TRUE, 0, nullptr, &null_));
-  BC_PETSC(MatSetNullSpace(Ap_, null_));
+  BC_PETSC(MatSetNullSpace(opP_->mat(), null_));
   update_ghosts();
+}
+
+Mat FluidSolver::aij_copy(const StencilOperator& op, Mat* M) {
+  if (!*M) {
+    BC_PETSC(DMCreateMatrix(dam_, M));
+    // Every rank writes only its own rows (StencilMatrixWriter): without this, each assembly of
+    // an MPIAIJ matrix still set up the communication of off-process entries.
+    BC_PETSC(MatSetOption(*M, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+    BC_PETSC(MatSetOption(*M, MAT_NO_OFF_PROC_ENTRIES, PETSC_TRUE));
+    if (M == &Ap_) BC_PETSC(MatSetNullSpace(*M, null_));
+    if (!writer_) writer_ = std::make_unique<StencilMatrixWriter>(dam_, *M);
+  }
+  op.copy_to(*M, *writer_);
+  return *M;
 }
 
 OwnedBox FluidSolver::owned_box() const {
@@ -659,15 +673,14 @@ void FluidSolver::compute_effective_viscosity() {
   BC_PETSC(VecShift(nuel_, s_.viscosity_pa_s / s_.density_kg_m3));
 }
 
-void FluidSolver::assemble_momentum(int c, double dt, double c0, double c1, double c2, bool first_iteration, Mat A,
-                                    Vec aP_out) {
+void FluidSolver::assemble_momentum(int c, double dt, double c0, double c1, double c2, bool first_iteration,
+                                    StencilOperator& A) {
   const LogScope log_scope(fluid_events().momentum_assembly);
   // The component, the wall flag and QUICK as compile-time constants: the row loop's branches
   // on them fold away and the neighbour loops unroll (same arithmetic, same bits).
   const bool wall = !s_.grid.periodic[1];
   const auto run = [&](auto C, auto W, auto Q) {
-    assemble_momentum_t<decltype(C)::value, decltype(W)::value, decltype(Q)::value>(dt, c0, c1, c2, first_iteration, A,
-                                                                                     aP_out);
+    assemble_momentum_t<decltype(C)::value, decltype(W)::value, decltype(Q)::value>(dt, c0, c1, c2, first_iteration, A);
   };
   const auto by_flags = [&](auto C) {
     if (wall && s_.quick) run(C, std::true_type{}, std::true_type{});
@@ -684,10 +697,10 @@ void FluidSolver::assemble_momentum(int c, double dt, double c0, double c1, doub
 // six neighbour terms is a pass over i that GCC vectorises, because every branch of the old
 // per-cell code depends on j only (walls) and becomes a row constant, and QUICK's upwind choice
 // becomes a select between loads at fixed offsets. Each coefficient is summed in the same order
-// as before. The coefficients go to row buffers and from there into the matrix's value slots.
+// as before. The coefficients go to row buffers and from there into the operator's arrays.
 template <int c, bool wall, bool use_quick>
-void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2, bool first_iteration, Mat A,
-                                      Vec aP_out) {
+void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2, bool first_iteration,
+                                      StencilOperator& A) {
   const auto& g = s_.grid;
   const int n1 = (int)g.n[1];
   const double h[3] = {g.dx(0), g.dx(1), g.dx(2)};
@@ -700,7 +713,7 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
   const std::int64_t off[3] = {1, gb.size[0], gb.size[0] * gb.size[1]};
   const std::int64_t oc = off[c];
   const double *u[3], *al[3], *p, *nue, *Fd[3], *un, *unm1, *S, *K, *KU;
-  double *rhs, *Dv, *prev, *aPo = nullptr, *idg;
+  double *rhs, *Dv, *prev, *idg;
   for (int d = 0; d < 3; ++d) BC_PETSC(VecGetArrayRead(Ul_[d], &u[d]));
   for (int d = 0; d < 3; ++d) BC_PETSC(VecGetArrayRead(Fl_[d], &Fd[d]));
   for (int l = 0; l < 3; ++l) BC_PETSC(VecGetArrayRead(alphal_[l], &al[l]));
@@ -714,10 +727,9 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
   BC_PETSC(VecGetArray(rhs_, &rhs));
   BC_PETSC(VecGetArray(D_[c], &Dv));
   BC_PETSC(VecGetArray(Ustar_prev_[c], &prev));
-  if (aP_out) BC_PETSC(VecGetArray(aP_out, &aPo));
   BC_PETSC(VecGetArray(inv_diag_[c], &idg));
-  StencilMatrixWriter& W = *writer_;
-  W.begin(A);
+  double* Ae[7];
+  for (int e = 0; e < 7; ++e) Ae[e] = A.coef(e);
 
   const double* __restrict uc = u[c];
   const double* __restrict nu = nue;
@@ -750,11 +762,10 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
     for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j, o0 += nx) {
       const std::int64_t P0 = (k - gb.lo[2]) * off[2] + (j - gb.lo[1]) * off[1] + (b.lo[0] - gb.lo[0]);
       if (c == 1 && wall && j == 0) {  // v = 0 on the wall itself: an identity row
+        for (int e = 0; e < 7; ++e) std::fill(Ae[e] + o0, Ae[e] + o0 + nx, e == 0 ? 1.0 : 0.0);
         #pragma GCC ivdep
         for (int i = 0; i < nx; ++i) {
-          W.add(o0 + i, 0, 1.0);
           idg[o0 + i] = 1.0;
-          if (aPo) aPo[o0 + i] = 1.0;
           rhs[o0 + i] = 0.0;
           if (first_iteration) Dv[o0 + i] = 0.0;
           prev[o0 + i] = 0.0;
@@ -889,17 +900,15 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
         if (first_iteration)
           #pragma GCC ivdep
           for (int i = 0; i < nx; ++i) Dd[i] = a1v[i] / (rho * (simplec ? aP[i] - snb[i] : aP[i]));
-        if (aPo) std::copy(aP, aP + nx, aPo + o0);
         double* __restrict id = idg + o0;
 #pragma GCC ivdep
         for (int i = 0; i < nx; ++i) id[i] = 1.0 / aP[i];
       }
-      #pragma GCC ivdep
-      for (int i = 0; i < nx; ++i) {
-        W.add(o0 + i, 0, aP[i]);
-        for (int e = 1; e < 7; ++e)
-          if (present >> e & 1u) W.add(o0 + i, e, anb[e][i]);
-      }
+      // entries of known zeros (wall values v = 0, no-slip faces) are stored as 0
+      std::copy(aP, aP + nx, Ae[0] + o0);
+      for (int e = 1; e < 7; ++e)
+        if (present >> e & 1u) std::copy(anb[e], anb[e] + nx, Ae[e] + o0);
+        else std::fill(Ae[e] + o0, Ae[e] + o0 + nx, 0.0);
     }
 
   for (int d = 0; d < 3; ++d) BC_PETSC(VecRestoreArrayRead(Ul_[d], &u[d]));
@@ -915,9 +924,7 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
   BC_PETSC(VecRestoreArray(rhs_, &rhs));
   BC_PETSC(VecRestoreArray(D_[c], &Dv));
   BC_PETSC(VecRestoreArray(Ustar_prev_[c], &prev));
-  if (aP_out) BC_PETSC(VecRestoreArray(aP_out, &aPo));
   BC_PETSC(VecRestoreArray(inv_diag_[c], &idg));
-  W.end(A);
 }
 
 void FluidSolver::apply_flux_controller() {
@@ -995,8 +1002,8 @@ void FluidSolver::assemble_pressure() {
   PetscScalar** *D[3], ***al;
   for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecGetArray(da_, Dl_[d], &D[d]));
   BC_PETSC(DMDAVecGetArray(da_, alphal_[0], &al));
-  StencilMatrixWriter& W = *writer_;
-  W.begin(Ap_);
+  double* Ae[7];
+  for (int e = 0; e < 7; ++e) Ae[e] = opP_->coef(e);
   // coefficient a_f D / h^2 of the lower d-face of cell Q (0 on walls)
   auto coef = [&](int d, int qi, int qj, int qk) -> double {
     if (wall && d == 1 && (qj <= 0 || qj >= n1)) return 0.0;
@@ -1018,14 +1025,13 @@ void FluidSolver::assemble_pressure() {
             csum[3 + d] += 1.0;
           }
           diag += cm + cp;
-          if (cm != 0.0) W.add(o, 1 + 2 * d, -cm);
-          if (cp != 0.0) W.add(o, 2 + 2 * d, -cp);
+          Ae[1 + 2 * d][o] = -cm;
+          Ae[2 + 2 * d][o] = -cp;
         }
-        W.add(o, 0, diag);
+        Ae[0][o] = diag;
       }
   for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecRestoreArray(da_, Dl_[d], &D[d]));
   BC_PETSC(DMDAVecRestoreArray(da_, alphal_[0], &al));
-  W.end(Ap_);
   if (spectral_pc_) {
     double gsum[6];
     MPI_Allreduce(csum, gsum, 6, MPI_DOUBLE, MPI_SUM, comm_);
@@ -1033,7 +1039,8 @@ void FluidSolver::assemble_pressure() {
     for (int d = 0; d < 3; ++d) c[d] = gsum[3 + d] > 0.0 ? gsum[d] / gsum[3 + d] : 0.0;
     spectral_pc_->set_coefficients(c[0], c[1], c[2]);
   }
-  BC_PETSC(KSPSetOperators(ksp_p_, Ap_, Ap_));
+  const Mat A = pressure_aij_ ? aij_copy(*opP_, &Ap_) : opP_->mat();
+  BC_PETSC(KSPSetOperators(ksp_p_, A, A));
 }
 
 void FluidSolver::correct(Vec pcorr) {
@@ -1071,8 +1078,8 @@ void FluidSolver::step_simple(double dt, const double c[3], StepReport& rep) {
     double du = 0.0, umax = 0.0;
     compute_face_fluxes();
     for (int cc = 0; cc < 3; ++cc) {
-      assemble_momentum(cc, dt, c[0], c[1], c[2], first, A_, nullptr);
-      solve_momentum(cc, A_, rep);
+      assemble_momentum(cc, dt, c[0], c[1], c[2], first, *opA_);
+      solve_momentum(cc, *opA_, rep);
       PetscReal nrm, mx;
       BC_PETSC(VecAXPY(Ustar_prev_[cc], -1.0, U_[cc]));
       BC_PETSC(VecNorm(Ustar_prev_[cc], NORM_INFINITY, &nrm));
@@ -1109,12 +1116,10 @@ void FluidSolver::step_simple(double dt, const double c[3], StepReport& rep) {
 // tolerance: the step costs one momentum round and `piso_correctors` pressure solves instead of
 // ~5 of each, and its difference from SIMPLE is what tests and the work-precision study report.
 void FluidSolver::step_piso(double dt, const double c[3], StepReport& rep) {
-  if (!Am_[0]) {
+  if (!opm_[0]) {
     for (int cc = 0; cc < 3; ++cc) {
-      BC_PETSC(MatDuplicate(A_, MAT_DO_NOT_COPY_VALUES, &Am_[cc]));
-      BC_PETSC(MatSetOption(Am_[cc], MAT_NO_OFF_PROC_ENTRIES, PETSC_TRUE));
+      opm_[cc] = std::make_unique<StencilOperator>(dam_);
       BC_PETSC(DMCreateGlobalVector(da_, &bm_[cc]));
-      BC_PETSC(DMCreateGlobalVector(da_, &aPm_[cc]));
     }
     BC_PETSC(DMCreateGlobalVector(da_, &P_asm_));
   }
@@ -1130,9 +1135,9 @@ void FluidSolver::step_piso(double dt, const double c[3], StepReport& rep) {
   BC_PETSC(VecCopy(P_, P_asm_));
   const double G_asm = G_;
   for (int cc = 0; cc < 3; ++cc) {
-    assemble_momentum(cc, dt, c[0], c[1], c[2], true, Am_[cc], aPm_[cc]);
+    assemble_momentum(cc, dt, c[0], c[1], c[2], true, *opm_[cc]);
     BC_PETSC(VecCopy(rhs_, bm_[cc]));
-    solve_momentum(cc, Am_[cc], rep);
+    solve_momentum(cc, *opm_[cc], rep);
   }
   if (std::isfinite(s_.target_mean_flux_z_m_s)) apply_flux_controller();
   for (int k = 0; k < s_.piso_correctors; ++k) {
@@ -1173,12 +1178,12 @@ void FluidSolver::momentum_sweep(double G_asm) {
   BC_PETSC(VecGetArrayRead(alphal_[0], &al));
   BC_PETSC(VecGetArrayRead(pcl_, &dp));
   for (int cc = 0; cc < 3; ++cc) {
-    BC_PETSC(MatMult(Am_[cc], U_[cc], sol_));  // A u
+    opm_[cc]->apply(U_[cc], sol_);  // A u
     const double *Au, *bv, *aP;
     double* u;
     BC_PETSC(VecGetArrayRead(sol_, &Au));
     BC_PETSC(VecGetArrayRead(bm_[cc], &bv));
-    BC_PETSC(VecGetArrayRead(aPm_[cc], &aP));
+    aP = opm_[cc]->coef(0);
     BC_PETSC(VecGetArray(U_[cc], &u));
     const std::int64_t oc = off[cc];
     const double igrad = inv_rho / g.dx(cc);
@@ -1204,15 +1209,15 @@ void FluidSolver::momentum_sweep(double G_asm) {
       }
     BC_PETSC(VecRestoreArrayRead(sol_, &Au));
     BC_PETSC(VecRestoreArrayRead(bm_[cc], &bv));
-    BC_PETSC(VecRestoreArrayRead(aPm_[cc], &aP));
     BC_PETSC(VecRestoreArray(U_[cc], &u));
   }
   BC_PETSC(VecRestoreArrayRead(alphal_[0], &al));
   BC_PETSC(VecRestoreArrayRead(pcl_, &dp));
 }
 
-void FluidSolver::solve_momentum(int cc, Mat A, StepReport& rep) {
+void FluidSolver::solve_momentum(int cc, const StencilOperator& op, StepReport& rep) {
   jacobi_inv_diag_ = inv_diag_[cc];
+  const Mat A = momentum_aij_ ? aij_copy(op, &A_) : op.mat();
   BC_PETSC(KSPSetOperators(ksp_m_, A, A));
   BC_PETSC(VecCopy(U_[cc], sol_));
   BC_PETSC(KSPSolve(ksp_m_, rhs_, sol_));
@@ -1253,7 +1258,8 @@ void FluidSolver::solve_pressure_correction(StepReport& rep, bool refresh_ghosts
       set_pressure_amg(pcf, nranks != 1);
       BC_PETSC(KSPSetFromOptions(ksp_p_fallback_));
     }
-    BC_PETSC(KSPSetOperators(ksp_p_fallback_, Ap_, Ap_));
+    const Mat A = aij_copy(*opP_, &Ap_);
+    BC_PETSC(KSPSetOperators(ksp_p_fallback_, A, A));
     BC_PETSC(VecZeroEntries(pc_));
     BC_PETSC(KSPSolve(ksp_p_fallback_, R_, pc_));
     BC_PETSC(KSPGetConvergedReason(ksp_p_fallback_, &reason));

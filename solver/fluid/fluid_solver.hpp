@@ -40,6 +40,7 @@ struct CaseParams;
 namespace boycott::fluid {
 
 class StencilMatrixWriter;
+class StencilOperator;
 class SpectralPoissonPreconditioner;
 struct SpectralPcShell;
 
@@ -192,16 +193,17 @@ class FluidSolver {
   void compute_subgrid_viscosity();
   void compute_face_fluxes();
   void compute_effective_viscosity();
-  /// Assembles component c's momentum equations into A and rhs_ (and their diagonal into aP_out
-  /// unless null); D_[c] on the first iteration of a step.
-  void assemble_momentum(int c, double dt, double c0, double c1, double c2, bool first_iteration, Mat A,
-                         Vec aP_out);
+  /// Assembles component c's momentum equations into A and rhs_; D_[c] on the first iteration of
+  /// a step.
+  void assemble_momentum(int c, double dt, double c0, double c1, double c2, bool first_iteration, StencilOperator& A);
   template <int c, bool wall, bool use_quick>
-  void assemble_momentum_t(double dt, double c0, double c1, double c2, bool first_iteration, Mat A, Vec aP_out);
+  void assemble_momentum_t(double dt, double c0, double c1, double c2, bool first_iteration, StencilOperator& A);
   void step_simple(double dt, const double c[3], StepReport& rep);
   void step_piso(double dt, const double c[3], StepReport& rep);
   /// U_[cc] = A^-1 rhs_ (from U_[cc]).
-  void solve_momentum(int cc, Mat A, StepReport& rep);
+  void solve_momentum(int cc, const StencilOperator& A, StepReport& rep);
+  /// The AIJ copy of op in *M (created on first use), for preconditioners that need entries.
+  Mat aij_copy(const StencilOperator& op, Mat* M);
   /// Pressure correction from the continuity residual in R_, then the velocity and pressure
   /// update (and their ghosts unless told otherwise).
   void solve_pressure_correction(StepReport& rep, bool refresh_ghosts = true);
@@ -219,13 +221,17 @@ class FluidSolver {
   MPI_Comm comm_;
   DM da_ = nullptr;    // box stencil, width 2: ghosted fields
   DM dam_ = nullptr;   // star stencil, width 1, same ownership: matrices
-  Mat A_ = nullptr;    // momentum matrix (one component at a time)
-  // PISO: each component's matrix, right-hand side and diagonal, kept for the corrector sweeps,
-  // and the pressure they were assembled with
-  Mat Am_[3]{};
-  Vec bm_[3]{}, aPm_[3]{}, P_asm_ = nullptr;
-  std::unique_ptr<StencilMatrixWriter> writer_;  // value slots of A_ and Ap_ (same pattern)
-  Mat Ap_ = nullptr;   // pressure-correction matrix
+  std::unique_ptr<StencilOperator> opA_;  // momentum operator (one component at a time)
+  std::unique_ptr<StencilOperator> opP_;  // pressure-correction operator
+  // PISO: each component's operator and right-hand side, kept for the corrector sweeps, and the
+  // pressure they were assembled with
+  std::unique_ptr<StencilOperator> opm_[3];
+  Vec bm_[3]{}, P_asm_ = nullptr;
+  // AIJ copies of the operators, made only for preconditioners that need the entries
+  // (-momentum_pc_type, -pressure_pc_type, the pressure fallback); the writer knows their slots
+  bool momentum_aij_ = false, pressure_aij_ = false;
+  Mat A_ = nullptr, Ap_ = nullptr;
+  std::unique_ptr<StencilMatrixWriter> writer_;
   KSP ksp_m_ = nullptr, ksp_p_ = nullptr;
   KSP ksp_p_fallback_ = nullptr;  // GAMG, created on the first failed pressure solve
   // The pressure preconditioner on one rank unless the user picks another (-pressure_pc_type).

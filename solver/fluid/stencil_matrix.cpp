@@ -12,8 +12,6 @@ namespace {
 
 constexpr auto check = petsc_check;
 
-constexpr std::int64_t kMissing = INT64_MIN;
-
 /// Diagonal and off-diagonal blocks (the off-diagonal one null on one rank, with its map from
 /// compressed to global columns).
 void blocks(Mat M, Mat* Ad, Mat* Ao, const PetscInt** garray) {

@@ -31,10 +31,13 @@ class StencilMatrixWriter {
     else
       offd_[-s - 1] += v;
   }
+  /// Entry e of owned row o exists in the pattern (not beyond a non-periodic boundary).
+  bool has(std::int64_t o, int e) const { return slots_[7 * o + e] != kMissing; }
   /// Restores the arrays and assembles M (nothing moves between ranks: all rows are owned).
   void end(Mat M);
 
  private:
+  static constexpr std::int64_t kMissing = INT64_MIN;
   std::vector<std::int64_t> slots_;  // >= 0: index into the diagonal block's values; < 0: off-diagonal block
   PetscInt nnz_diag_ = 0, nnz_offd_ = 0;  // stored values of the two blocks
   Mat Ad_ = nullptr, Ao_ = nullptr;  // blocks of the matrix between begin and end
