@@ -15,10 +15,12 @@
 // y-face j = 0 is the wall y = 0 (v = 0 kept there) and the top wall face j = ny is implicit.
 // Discretisation: finite volume, BDF2 (variable step) in time, QUICK convection by deferred
 // correction on implicit upwind, central diffusion and pressure gradient, SIMPLE(C) with optional
-// under-relaxation; linear systems by PETSc KSP with prefixes "momentum_" and "pressure_"
-// (defaults: BiCGStab + Jacobi; GMRES + BoomerAMG (HMIS, ext+i) on one rank, GMRES + GAMG on
-// several, to 1e-2 relative per SIMPLE iteration, constant null space removed; the other AMG,
-// prefix "pressure_fallback_", redoes a failed pressure solve).
+// under-relaxation; linear systems by PETSc KSP with prefixes "momentum_" and "pressure_", their
+// operators applied matrix-free (stencil_operator.hpp). Defaults: BiCGStab + point Jacobi;
+// FGMRES + the spectral constant-coefficient preconditioner (spectral_poisson_pc.hpp) to 1e-3
+// relative per SIMPLE iteration, constant null space removed. `-pressure_pc_type` selects
+// another (GMRES then; BoomerAMG (HMIS, ext+i) on one rank, GAMG on several), and AMG, prefix
+// "pressure_fallback_", redoes a failed pressure solve.
 #include <mpi.h>
 #include <petscdmda.h>
 #include <petscksp.h>
