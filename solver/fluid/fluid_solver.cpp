@@ -12,6 +12,7 @@
 
 #include "core/case_params.hpp"
 #include "core/error.hpp"
+#include "fluid/halo_exchange.hpp"
 #include "fluid/petsc_check.hpp"
 #include "fluid/spectral_poisson_pc.hpp"
 #include "fluid/stencil_matrix.hpp"
@@ -249,6 +250,7 @@ FluidSolver::~FluidSolver() {
   if (Ap_) MatDestroy(&Ap_);
   opA_.reset();
   opP_.reset();
+  halo_.reset();
   if (dam_) DMDestroy(&dam_);
   if (da_) DMDestroy(&da_);
 }
@@ -277,6 +279,7 @@ void FluidSolver::create_layout() {
                         (PetscInt)g.n[1], (PetscInt)g.n[2], pxy, pxy, pz, 1, 2, nullptr, nullptr,
                         z_slabs.empty() ? nullptr : z_slabs.data(), &da_));
   BC_PETSC(DMSetUp(da_));
+  halo_ = std::make_unique<HaloExchange>(da_);
   const PetscInt *lx, *ly, *lz;
   PetscInt mx, my, mz;
   BC_PETSC(DMDAGetInfo(da_, nullptr, nullptr, nullptr, nullptr, &mx, &my, &mz, nullptr, nullptr, nullptr, nullptr,
@@ -401,16 +404,16 @@ GhostBox FluidSolver::ghost_box() const {
 }
 
 void FluidSolver::update_ghosts() {
-  for (int c = 0; c < 3; ++c) BC_PETSC(DMGlobalToLocal(da_, alpha_[c], INSERT_VALUES, alphal_[c]));
-  BC_PETSC(DMGlobalToLocal(da_, nut_, INSERT_VALUES, nutl_));
+  for (int c = 0; c < 3; ++c) halo_->fill(alpha_[c], alphal_[c]);
+  halo_->fill(nut_, nutl_);
   update_flow_ghosts();
 }
 
 // Within a step alpha_f and nu_t are fixed; only u and p change (each DMGlobalToLocal of the
 // bench mesh costs ~0.3 ms, and a SIMPLE step did ~90 of them).
 void FluidSolver::update_flow_ghosts() {
-  for (int c = 0; c < 3; ++c) BC_PETSC(DMGlobalToLocal(da_, U_[c], INSERT_VALUES, Ul_[c]));
-  BC_PETSC(DMGlobalToLocal(da_, P_, INSERT_VALUES, Pl_));
+  for (int c = 0; c < 3; ++c) halo_->fill(U_[c], Ul_[c]);
+  halo_->fill(P_, Pl_);
 }
 
 void FluidSolver::set_velocity(int c, const std::function<double(double, double, double)>& f) {
@@ -430,7 +433,7 @@ void FluidSolver::set_velocity(int c, const std::function<double(double, double,
   BC_PETSC(DMDAVecRestoreArray(da_, U_[c], &u));
   BC_PETSC(VecCopy(U_[c], Un_[c]));
   BC_PETSC(VecCopy(U_[c], Unm1_[c]));
-  BC_PETSC(DMGlobalToLocal(da_, U_[c], INSERT_VALUES, Ul_[c]));
+  halo_->fill(U_[c], Ul_[c]);
 }
 
 void FluidSolver::set_fluid_fraction(const std::function<double(double, double, double)>& f) {
@@ -454,7 +457,7 @@ void FluidSolver::set_fluid_fraction(const std::function<double(double, double, 
     BC_PETSC(VecCopy(alpha_[0], alpha_[2]));
   }
   alpha_initialised_ = true;
-  for (int l = 0; l < 3; ++l) BC_PETSC(DMGlobalToLocal(da_, alpha_[l], INSERT_VALUES, alphal_[l]));
+  for (int l = 0; l < 3; ++l) halo_->fill(alpha_[l], alphal_[l]);
 }
 
 // ---------------------------------------------------------------- coupling interface
@@ -504,7 +507,7 @@ void FluidSolver::end_deposition() {
     BC_PETSC(VecCopy(alpha_[0], alpha_[2]));
   }
   alpha_initialised_ = true;
-  for (int l = 0; l < 3; ++l) BC_PETSC(DMGlobalToLocal(da_, alpha_[l], INSERT_VALUES, alphal_[l]));
+  for (int l = 0; l < 3; ++l) halo_->fill(alpha_[l], alphal_[l]);
   for (int c = 0; c < 3; ++c) {
     BC_PETSC(VecZeroEntries(S_[c]));
     BC_PETSC(VecZeroEntries(K_[c]));
@@ -552,7 +555,7 @@ void FluidSolver::compute_subgrid_viscosity() {
   const LogScope log_scope(fluid_events().subgrid);
   if (!s_.vreman) {
     BC_PETSC(VecZeroEntries(nut_));
-    BC_PETSC(DMGlobalToLocal(da_, nut_, INSERT_VALUES, nutl_));
+    halo_->fill(nut_, nutl_);
     return;
   }
   const auto& g = s_.grid;
@@ -637,7 +640,7 @@ void FluidSolver::compute_subgrid_viscosity() {
     }
   for (int c = 0; c < 3; ++c) BC_PETSC(VecRestoreArrayRead(Ul_[c], &u[c]));
   BC_PETSC(VecRestoreArray(nut_, &nt));
-  BC_PETSC(DMGlobalToLocal(da_, nut_, INSERT_VALUES, nutl_));
+  halo_->fill(nut_, nutl_);
 }
 
 // The momentum rows read each face flux and each viscosity several times (two cells share a
@@ -1004,7 +1007,7 @@ void FluidSolver::assemble_pressure() {
   const double h[3] = {g.dx(0), g.dx(1), g.dx(2)};
   const bool wall = !g.periodic[1];
   const OwnedBox b = owned_box();
-  for (int d = 0; d < 3; ++d) BC_PETSC(DMGlobalToLocal(da_, D_[d], INSERT_VALUES, Dl_[d]));
+  for (int d = 0; d < 3; ++d) halo_->fill(D_[d], Dl_[d]);
   PetscScalar** *D[3], ***al;
   for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecGetArray(da_, Dl_[d], &D[d]));
   BC_PETSC(DMDAVecGetArray(da_, alphal_[0], &al));
@@ -1055,7 +1058,7 @@ void FluidSolver::correct(Vec pcorr) {
   const double h[3] = {g.dx(0), g.dx(1), g.dx(2)};
   const bool wall = !g.periodic[1];
   const OwnedBox b = owned_box();
-  BC_PETSC(DMGlobalToLocal(da_, pcorr, INSERT_VALUES, pcl_));
+  halo_->fill(pcorr, pcl_);
   PetscScalar ***pc, ***U[3], ***D[3];
   BC_PETSC(DMDAVecGetArray(da_, pcl_, &pc));
   for (int d = 0; d < 3; ++d) {
@@ -1173,7 +1176,7 @@ void FluidSolver::momentum_sweep(double G_asm) {
   const LogScope log_scope(fluid_events().momentum_sweep);
   // p - p_asm, ghosted: the pressure the frozen right-hand sides b were assembled with
   BC_PETSC(VecWAXPY(pc_, -1.0, P_asm_, P_));
-  BC_PETSC(DMGlobalToLocal(da_, pc_, INSERT_VALUES, pcl_));
+  halo_->fill(pc_, pcl_);
   const auto& g = s_.grid;
   const bool wall = !g.periodic[1];
   const OwnedBox b = owned_box();
@@ -1283,7 +1286,7 @@ void FluidSolver::solve_pressure_correction(StepReport& rep, bool refresh_ghosts
 double FluidSolver::relative_continuity_residual(double dt, const double c[3], double umax) {
   const auto& g = s_.grid;
   const double hmin = std::min({g.dx(0), g.dx(1), g.dx(2)});
-  for (int cc = 0; cc < 3; ++cc) BC_PETSC(DMGlobalToLocal(da_, U_[cc], INSERT_VALUES, Ul_[cc]));
+  for (int cc = 0; cc < 3; ++cc) halo_->fill(U_[cc], Ul_[cc]);
   const double rmax = continuity_residual(dt, c[0], c[1], c[2], R_);
   const double uref = std::max({umax, std::abs(std::isfinite(s_.target_mean_flux_z_m_s) ? s_.target_mean_flux_z_m_s : 0.0),
                                 1e-30});
@@ -1305,7 +1308,7 @@ StepReport FluidSolver::step(double dt) {
   rep.dt_s = dt;
   double c[3];
   bdf_weights(dt, steps_ > 0 ? dt_prev_ : 0.0, c);
-  for (int l = 0; l < 3; ++l) BC_PETSC(DMGlobalToLocal(da_, alpha_[l], INSERT_VALUES, alphal_[l]));
+  for (int l = 0; l < 3; ++l) halo_->fill(alpha_[l], alphal_[l]);
   compute_subgrid_viscosity();  // also refreshes nu_t's ghosts
   compute_effective_viscosity();
   update_flow_ghosts();
@@ -1326,7 +1329,7 @@ StepReport FluidSolver::step(double dt) {
   }
   BC_PETSC(VecCopy(alpha_[1], alpha_[2]));
   BC_PETSC(VecCopy(alpha_[0], alpha_[1]));
-  for (int l = 1; l < 3; ++l) BC_PETSC(DMGlobalToLocal(da_, alpha_[l], INSERT_VALUES, alphal_[l]));
+  for (int l = 1; l < 3; ++l) halo_->fill(alpha_[l], alphal_[l]);
   time_ += dt;
   dt_prev_ = dt;
   ++steps_;
@@ -1444,8 +1447,8 @@ void FluidSolver::import_state(const FluidState& st) {
   steps_ = st.steps;
   G_ = st.mean_pressure_gradient_pa_m;
   alpha_initialised_ = true;
-  for (int l = 0; l < 3; ++l) BC_PETSC(DMGlobalToLocal(da_, alpha_[l], INSERT_VALUES, alphal_[l]));
-  BC_PETSC(DMGlobalToLocal(da_, nut_, INSERT_VALUES, nutl_));
+  for (int l = 0; l < 3; ++l) halo_->fill(alpha_[l], alphal_[l]);
+  halo_->fill(nut_, nutl_);
   update_ghosts();
 }
 

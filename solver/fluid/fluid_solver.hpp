@@ -43,6 +43,7 @@ namespace boycott::fluid {
 
 class StencilMatrixWriter;
 class StencilOperator;
+class HaloExchange;
 class SpectralPoissonPreconditioner;
 struct SpectralPcShell;
 
@@ -223,6 +224,7 @@ class FluidSolver {
   MPI_Comm comm_;
   DM da_ = nullptr;    // box stencil, width 2: ghosted fields
   DM dam_ = nullptr;   // star stencil, width 1, same ownership: matrices
+  std::unique_ptr<HaloExchange> halo_;  // ghost fills of da_'s local vectors
   std::unique_ptr<StencilOperator> opA_;  // momentum operator (one component at a time)
   std::unique_ptr<StencilOperator> opP_;  // pressure-correction operator
   // PISO: each component's operator and right-hand side, kept for the corrector sweeps, and the

@@ -56,7 +56,7 @@ inline void row_product(const double* const* c, const double* __restrict x, doub
 
 }  // namespace
 
-StencilOperator::StencilOperator(DM dm) : dm_(dm) {
+StencilOperator::StencilOperator(DM dm) : dm_(dm), halo_(dm) {
   PetscInt xs, ys, zs, xm, ym, zm, gxs, gys, gzs, gxm, gym, gzm, my;
   DMBoundaryType bx, by, bz;
   check(DMDAGetCorners(dm, &xs, &ys, &zs, &xm, &ym, &zm), "DMDAGetCorners");
@@ -93,7 +93,7 @@ StencilOperator::~StencilOperator() {
 }
 
 void StencilOperator::apply(Vec x, Vec y) const {
-  check(DMGlobalToLocal(dm_, x, INSERT_VALUES, xl_), "DMGlobalToLocal");
+  halo_.fill(x, xl_);
   const double* xa;
   double* ya;
   check(VecGetArrayRead(xl_, &xa), "VecGetArrayRead");

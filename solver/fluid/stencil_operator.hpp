@@ -17,6 +17,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "fluid/halo_exchange.hpp"
+
 namespace boycott::fluid {
 
 class StencilMatrixWriter;
@@ -41,6 +43,7 @@ class StencilOperator {
 
  private:
   DM dm_;
+  HaloExchange halo_;
   Vec xl_ = nullptr;  // ghosted work vector
   Mat shell_ = nullptr;
   std::array<std::vector<double>, 7> coef_;
