@@ -1084,18 +1084,34 @@ void FluidSolver::step_simple(double dt, const double c[3], StepReport& rep) {
   const double tol = s_.simple_tolerance;
   for (int it = 0; it < s_.simple_max_iterations; ++it) {
     const bool first = it == 0;
-    double du = 0.0, umax = 0.0;
+    // max |u* - u| and max |u*| over the components: one pass each and one reduction for all
+    double loc[2] = {0.0, 0.0};
     compute_face_fluxes();
     for (int cc = 0; cc < 3; ++cc) {
       assemble_momentum(cc, dt, c[0], c[1], c[2], first, *opA_);
       solve_momentum(cc, *opA_, rep);
-      PetscReal nrm, mx;
-      BC_PETSC(VecAXPY(Ustar_prev_[cc], -1.0, U_[cc]));
-      BC_PETSC(VecNorm(Ustar_prev_[cc], NORM_INFINITY, &nrm));
-      BC_PETSC(VecNorm(U_[cc], NORM_INFINITY, &mx));
-      du = std::max(du, (double)nrm);
-      umax = std::max(umax, (double)mx);
+      const double *u, *prev;
+      PetscInt n;
+      BC_PETSC(VecGetLocalSize(U_[cc], &n));
+      BC_PETSC(VecGetArrayRead(U_[cc], &u));
+      BC_PETSC(VecGetArrayRead(Ustar_prev_[cc], &prev));
+      double d = loc[0], m = loc[1];
+      bool nan = false;
+      for (PetscInt q = 0; q < n; ++q) {
+        d = std::max(d, std::abs(u[q] - prev[q]));
+        m = std::max(m, std::abs(u[q]));
+        nan |= std::isnan(u[q]);
+      }
+      // std::max drops a NaN (and MPI's MAX need not keep one): a NaN velocity counts as +inf,
+      // which the continuity check below reports
+      const double inf = std::numeric_limits<double>::infinity();
+      loc[0] = nan ? inf : d, loc[1] = nan ? inf : m;
+      BC_PETSC(VecRestoreArrayRead(U_[cc], &u));
+      BC_PETSC(VecRestoreArrayRead(Ustar_prev_[cc], &prev));
     }
+    double glob[2];
+    MPI_Allreduce(loc, glob, 2, MPI_DOUBLE, MPI_MAX, comm_);
+    const double du = glob[0], umax = glob[1];
     double flux_err = 0.0;
     if (std::isfinite(s_.target_mean_flux_z_m_s)) {
       const double q0 = mean_flux_z();
