@@ -846,6 +846,9 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
           const double sh = s * 0.5;
           const double ihd = ih[d], ih2d = ih2[d], ihc = ih[c];
           if (!nb_known_zero) present |= 1u << e;
+          // a weight, not a select on nb_known_zero: GCC 12 does not vectorise a select on a
+          // loop-invariant bool, which left v's neighbour passes scalar (3x u's assembly time)
+          const double w_nb = nb_known_zero ? 0.0 : 1.0;
           const auto tail = [&](int i, double F, double nuf, double tT) {
             ts[i] += s * tT * ih[d];
             const double dcoef = a1v[i] * nuf * ih2d;
@@ -853,7 +856,7 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
             aP[i] += dcoef + std::max(conv, 0.0);
             const double a = -dcoef + std::min(conv, 0.0);
             ae[i] = a;
-            snb[i] += nb_known_zero ? 0.0 : std::abs(a);
+            snb[i] += w_nb * std::abs(a);
             if constexpr (use_quick) {
               // rhs -= F (phi_QUICK - phi_upwind) / h, deferred correction
               const double vP = zP * uP_[i], vN = zN * uP_[i + oN];
