@@ -409,8 +409,8 @@ void FluidSolver::update_ghosts() {
   update_flow_ghosts();
 }
 
-// Within a step alpha_f and nu_t are fixed; only u and p change (each DMGlobalToLocal of the
-// bench mesh costs ~0.3 ms, and a SIMPLE step did ~90 of them).
+// Within a step alpha_f and nu_t are fixed; only u and p change (a ghost fill of the bench mesh
+// cost ~0.3 ms with DMGlobalToLocal then, and a SIMPLE step did ~90 of them).
 void FluidSolver::update_flow_ghosts() {
   for (int c = 0; c < 3; ++c) halo_->fill(U_[c], Ul_[c]);
   halo_->fill(P_, Pl_);

@@ -1,6 +1,7 @@
 #pragma once
 // Writes the values of a 7-point star matrix made by DMCreateMatrix on a DMDA straight into its
-// AIJ value arrays. MatSetValuesStencil costs ~350 ns per row (stencil to local to global index
+// AIJ value arrays. The fluid applies its operators matrix-free (stencil_operator.hpp) and uses
+// this only for the AIJ copies that a user-chosen preconditioner or the AMG fallback needs. MatSetValuesStencil costs ~350 ns per row (stencil to local to global index
 // mapping, then a column search per entry), which made it ~70 % of the momentum assembly on the
 // 200 x 6 x 100 bench mesh; the nonzero pattern of these matrices never changes, so the position
 // of each row's seven entries is looked up once, here, and reused for every assembly.
