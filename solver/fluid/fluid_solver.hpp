@@ -241,6 +241,10 @@ class FluidSolver {
   // The pressure preconditioner on one rank unless the user picks another (-pressure_pc_type).
   std::unique_ptr<SpectralPcShell> spectral_pc_;
   int pressure_fallbacks_ = 0;
+  // Absolute tolerance of the pressure solves (1/s), from the last continuity test's scale;
+  // a user's -pressure_ksp_atol replaces it.
+  double pressure_abs_tol_ = 0.0;
+  PetscBool user_pressure_atol_ = PETSC_FALSE;
   MatNullSpace null_ = nullptr;
 
   // global vectors
