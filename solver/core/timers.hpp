@@ -9,6 +9,11 @@
 
 namespace boycott {
 
+/// Wall time since t0, s (the engines' own phase timers).
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 class ModelTimers {
  public:
   /// Marks a model active; `detail` names the variant (e.g. drag law "difelice_paper").

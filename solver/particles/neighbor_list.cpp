@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "particles/min_image.hpp"
+
 namespace boycott::particles {
 
 namespace {
@@ -103,9 +105,9 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
           for (std::uint32_t q = q0; q < cell_start_[nb + 1]; ++q) {
             const std::uint32_t j = cell_items_[q];
             if (j <= i) continue;
-            const double dx = min_image(s.x[i] - s.x[j], g.len[0], g.periodic[0]);
-            const double dy = min_image(s.y[i] - s.y[j], g.len[1], g.periodic[1]);
-            const double dz = min_image(s.z[i] - s.z[j], g.len[2], g.periodic[2]);
+            const double dx = min_image(s.x[i] - s.x[j], g.period(0), g.inv_len(0));
+            const double dy = min_image(s.y[i] - s.y[j], g.period(1), g.inv_len(1));
+            const double dz = min_image(s.z[i] - s.z[j], g.period(2), g.inv_len(2));
             if (dx * dx + dy * dy + dz * dz < cut2) neighbors.push_back(j);
           }
         }

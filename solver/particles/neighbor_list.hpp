@@ -16,6 +16,9 @@ struct BoxGeometry {
   std::array<double, 3> lo = {0.0, 0.0, 0.0};   ///< m
   std::array<double, 3> len = {1.0, 1.0, 1.0};  ///< m
   std::array<bool, 3> periodic = {true, false, true};
+  /// Period of direction d for min_image (m): its length, or 0 where it is not periodic.
+  double period(int d) const { return periodic[d] ? len[d] : 0.0; }
+  double inv_len(int d) const { return 1.0 / len[d]; }
 };
 
 class NeighborList {
@@ -39,17 +42,5 @@ class NeighborList {
   std::vector<int> cell_of_;
   std::vector<std::uint32_t> cell_start_, cell_items_;
 };
-
-/// Minimum-image difference in one periodic direction, or the plain difference. Valid for
-/// |d| < 1.5 len, which holds because coordinates are wrapped into the box at every list rebuild
-/// and move less than half the skin between rebuilds. (Compare-and-shift instead of rounding:
-/// std::nearbyint is a library call without SSE4.1, and this runs three times per pair.)
-inline double min_image(double d, double len, bool periodic) {
-  if (periodic) {
-    if (d > 0.5 * len) d -= len;
-    else if (d < -0.5 * len) d += len;
-  }
-  return d;
-}
 
 }  // namespace boycott::particles

@@ -1,0 +1,266 @@
+// The contact forces of one DEM step: which listed pairs overlap (a branch-free first pass),
+// then each contact's force and torques through the stateless kernels of contact_kernels.hpp,
+// then the walls. Contact histories are kept by contact_history.cpp.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <type_traits>
+
+#include "core/timers.hpp"
+#include "particles/contact_kernels.hpp"
+#include "particles/dem_system.hpp"
+#include "particles/min_image.hpp"
+
+namespace boycott::particles {
+
+namespace {
+/// First pass of the force loop: appends (i, list slot) of each overlapping list pair to ci, cp
+/// and returns their number. The test runs over the flat pair arrays (pair_i, nb) so that it
+/// vectorises (gathers) into a byte per pair; the append is a second, branch-free scalar pass.
+/// The periodic directions are template flags so that the loop body has no branch at all.
+template <bool PX, bool PY, bool PZ>
+std::size_t find_contacts(std::size_t np, const std::uint32_t* __restrict pair_i, const std::uint32_t* __restrict nb,
+                          const double* __restrict x, const double* __restrict y, const double* __restrict z,
+                          const double* __restrict rad, const std::array<double, 3>& len, std::uint8_t* __restrict flag,
+                          std::uint32_t* __restrict ci, std::uint32_t* __restrict cp) {
+  const double Lx = len[0], Ly = len[1], Lz = len[2];
+  const double iLx = 1.0 / Lx, iLy = 1.0 / Ly, iLz = 1.0 / Lz;
+  for (std::size_t p = 0; p < np; ++p) {
+    const std::uint32_t i = pair_i[p], j = nb[p];
+    double dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
+    if constexpr (PX) dx = min_image(dx, Lx, iLx);
+    if constexpr (PY) dy = min_image(dy, Ly, iLy);
+    if constexpr (PZ) dz = min_image(dz, Lz, iLz);
+    const double rsum = rad[i] + rad[j];
+    flag[p] = dx * dx + dy * dy + dz * dz < rsum * rsum;
+  }
+  std::size_t nc = 0;
+  for (std::size_t p = 0; p < np; ++p) {
+    ci[nc] = pair_i[p];
+    cp[nc] = static_cast<std::uint32_t>(p);
+    nc += flag[p];
+  }
+  return nc;
+}
+
+using FindContactsFn = std::size_t (*)(std::size_t, const std::uint32_t*, const std::uint32_t*, const double*,
+                                       const double*, const double*, const double*, const std::array<double, 3>&,
+                                       std::uint8_t*, std::uint32_t*, std::uint32_t*);
+// Indexed by periodic x | y << 1 | z << 2.
+constexpr FindContactsFn kFindContacts[8] = {
+    find_contacts<false, false, false>, find_contacts<true, false, false>, find_contacts<false, true, false>,
+    find_contacts<true, true, false>,   find_contacts<false, false, true>, find_contacts<true, false, true>,
+    find_contacts<false, true, true>,   find_contacts<true, true, true>};
+}  // namespace
+
+template <class Rolling>
+void DemSystem::compute_forces_impl(const Rolling& rolling) {
+  const std::size_t n = s_.size();
+  std::fill(s_.fx.begin(), s_.fx.end(), 0.0);
+  std::fill(s_.fy.begin(), s_.fy.end(), 0.0);
+  std::fill(s_.fz.begin(), s_.fz.end(), 0.0);
+  std::fill(s_.tx.begin(), s_.tx.end(), 0.0);
+  std::fill(s_.ty.begin(), s_.ty.end(), 0.0);
+  std::fill(s_.tz.begin(), s_.tz.end(), 0.0);
+  const LinearSpringDashpot& cm = cfg_.contact;
+  const double kn = cm.kn_n_m, dt = cfg_.dt_s;
+  const double Lx = cfg_.box.len[0], Ly = cfg_.box.len[1], Lz = cfg_.box.len[2];
+  const bool px = cfg_.box.periodic[0], py = cfg_.box.periodic[1], pz = cfg_.box.periodic[2];
+  double* __restrict fx = s_.fx.data();
+  double* __restrict fy = s_.fy.data();
+  double* __restrict fz = s_.fz.data();
+  double* __restrict tx = s_.tx.data();
+  double* __restrict ty = s_.ty.data();
+  double* __restrict tz = s_.tz.data();
+  const double* __restrict x = s_.x.data();
+  const double* __restrict y = s_.y.data();
+  const double* __restrict z = s_.z.data();
+  // Velocities at the force time (see predict_velocities), not the half-step ones.
+  const double* __restrict vx = pred_[0].data();
+  const double* __restrict vy = pred_[1].data();
+  const double* __restrict vz = pred_[2].data();
+  const double* __restrict wx = pred_[3].data();
+  const double* __restrict wy = pred_[4].data();
+  const double* __restrict wz = pred_[5].data();
+  // Rolling resistance acts on the actual half-step spin, which the coming kicks update.
+  const double* __restrict spx = s_.wx.data();
+  const double* __restrict spy = s_.wy.data();
+  const double* __restrict spz = s_.wz.data();
+  const double inv_dt = 1.0 / dt;
+  const double* __restrict rad = s_.radius.data();
+  const double* __restrict mass = s_.mass.data();
+  const double* __restrict inertia = s_.inertia.data();
+  std::int64_t contacts = 0;
+  const bool uniform = uniform_mass_kg_ > 0.0;
+  const double gn_pair = cm.gamma_n(0.5 * uniform_mass_kg_), gn_wall = cm.gamma_n(uniform_mass_kg_);
+
+  // Pass 1: which list pairs overlap. In a suspension most list pairs (8 in 9 on the LIGGGHTS
+  // bench) are apart, so this is a short branch-free loop that only appends the pair to the
+  // contact list; the contact work below then runs without mispredicted branches.
+  const std::uint32_t* __restrict nb = nl_.neighbors.data();
+  const std::size_t np = nl_.pair_count();
+  contact_i_.resize(np);
+  contact_p_.resize(np);
+  std::uint32_t* __restrict ci = contact_i_.data();
+  std::uint32_t* __restrict cp = contact_p_.data();
+  const int periodic_bits = (px ? 1 : 0) | (py ? 2 : 0) | (pz ? 4 : 0);
+  pair_flag_.resize(np);
+  const std::size_t nc =
+      kFindContacts[periodic_bits](np, pair_i_.data(), nb, x, y, z, rad, cfg_.box.len, pair_flag_.data(), ci, cp);
+  forget_separated_pairs(nc);
+  contacts = static_cast<std::int64_t>(nc);
+
+  // Pass 2a: each contact's force and torques, written per contact. Contacts touch distinct
+  // list slots (their histories do not alias) and nothing is accumulated per particle here, so
+  // the loop has no dependence between iterations and vectorises over contacts (gathers).
+  contact_out_.resize(9 * np);
+  double* __restrict oFx = contact_out_.data();
+  double* __restrict oFy = oFx + np;
+  double* __restrict oFz = oFy + np;
+  double* __restrict oTix = oFz + np;
+  double* __restrict oTiy = oTix + np;
+  double* __restrict oTiz = oTiy + np;
+  double* __restrict oTjx = oTiz + np;
+  double* __restrict oTjy = oTjx + np;
+  double* __restrict oTjz = oTjy + np;
+  double* __restrict hist = h_.data();
+  const double iLx = 1.0 / Lx, iLy = 1.0 / Ly, iLz = 1.0 / Lz;
+  // The period of each direction, 0 where it is not periodic (min_image then leaves d as it is):
+  // a select on the loop-invariant flag would keep the loop from vectorising.
+  const double Pxl = px ? Lx : 0.0, Pyl = py ? Ly : 0.0, Pzl = pz ? Lz : 0.0;
+  const double damping_factor = cm.damping_factor;
+  // Equal masses (the usual case) and mixed ones are separate loops: a select between them would
+  // turn the mass loads into masked gathers, which do not vectorise.
+  auto contact_loop = [&](auto uniform_masses) {
+#pragma GCC ivdep
+    for (std::size_t k = 0; k < nc; ++k) {
+      const std::uint32_t i = ci[k], p = cp[k], j = nb[p];
+      const double ri = rad[i], rj = rad[j], mi = mass[i], mj = mass[j];
+      double dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
+      dx = min_image(dx, Pxl, iLx);
+      dy = min_image(dy, Pyl, iLy);
+      dz = min_image(dz, Pzl, iLz);
+      const double rsum = ri + rj;
+      const double r = std::sqrt(dx * dx + dy * dy + dz * dz);
+      const double inv = 1.0 / r;
+      const double nx = dx * inv, ny = dy * inv, nz = dz * inv;
+      // (R_i w_i + R_j w_j) x n: surface velocities of the two spheres at the contact point.
+      const double cx = ri * wx[i] + rj * wx[j], cy = ri * wy[i] + rj * wy[j], cz = ri * wz[i] + rj * wz[j];
+      const double vrx = vx[i] - vx[j] - (cy * nz - cz * ny);
+      const double vry = vy[i] - vy[j] - (cz * nx - cx * nz);
+      const double vrz = vz[i] - vz[j] - (cx * ny - cy * nx);
+      // gamma_n needs sqrt(m_eff k_n): a constant when all masses are equal (the usual case).
+      double gn = gn_pair;
+      if constexpr (!decltype(uniform_masses)::value) gn = damping_factor * std::sqrt(mi * mj / (mi + mj) * kn);
+      double ftx, fty, ftz;
+      const double fn = spring_dashpot(cm, dt, nx, ny, nz, rsum - r, vrx, vry, vrz, gn, hist[3 * p], hist[3 * p + 1],
+                                       hist[3 * p + 2], ftx, fty, ftz);
+      oFx[k] = fn * nx + ftx;
+      oFy[k] = fn * ny + fty;
+      oFz[k] = fn * nz + ftz;
+      // Torque -R n x F_t on both spheres (the arm of j is +R_j n, its force -F_t).
+      const double mx = ny * ftz - nz * fty, my = nz * ftx - nx * ftz, mz = nx * fty - ny * ftx;
+      double rtx = 0.0, rty = 0.0, rtz = 0.0;
+      if constexpr (Rolling::enabled) {
+        rolling_resistance(spx[i] - spx[j], spy[i] - spy[j], spz[i] - spz[j], nx, ny, nz, mx, my, mz, ri / inertia[i],
+                           rj / inertia[j], inv_dt, rolling.mu_r * std::abs(fn), rtx, rty, rtz);
+      }
+      oTix[k] = -ri * mx - ri * rtx;
+      oTiy[k] = -ri * my - ri * rty;
+      oTiz[k] = -ri * mz - ri * rtz;
+      oTjx[k] = -rj * mx + rj * rtx;
+      oTjy[k] = -rj * my + rj * rty;
+      oTjz[k] = -rj * mz + rj * rtz;
+    }
+  };
+  if (uniform) contact_loop(std::true_type{});
+  else contact_loop(std::false_type{});
+  // Pass 2b: add them to the particles, in contact order.
+  for (std::size_t k = 0; k < nc; ++k) {
+    const std::uint32_t i = ci[k], j = nb[cp[k]];
+    fx[i] += oFx[k];
+    fy[i] += oFy[k];
+    fz[i] += oFz[k];
+    fx[j] -= oFx[k];
+    fy[j] -= oFy[k];
+    fz[j] -= oFz[k];
+    tx[i] += oTix[k];
+    ty[i] += oTiy[k];
+    tz[i] += oTiz[k];
+    tx[j] += oTjx[k];
+    ty[j] += oTjy[k];
+    tz[j] += oTjz[k];
+  }
+
+  // Walls: a sphere of infinite mass at rest; history per particle and wall. As for pairs: find
+  // the particles that touch the wall, reset the springs of those that have left it, then a
+  // vectorisable loop over the touching ones (each particle once per wall: no conflicts).
+  wall_contact_.resize(n);
+  prev_wall_contacts_.resize(cfg_.walls.size());
+  std::uint32_t* __restrict wc = wall_contact_.data();
+  for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
+    const PlaneWall& W = cfg_.walls[w];
+    const double nx = W.nx, ny = W.ny, nz = W.nz, wpx = W.px, wpy = W.py, wpz = W.pz;
+    double* __restrict whx = whx_[w].data();
+    double* __restrict why = why_[w].data();
+    double* __restrict whz = whz_[w].data();
+    std::size_t nw = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double dist = (x[i] - wpx) * nx + (y[i] - wpy) * ny + (z[i] - wpz) * nz;
+      wc[nw] = static_cast<std::uint32_t>(i);
+      nw += dist < rad[i];
+    }
+    for (std::uint32_t i : prev_wall_contacts_[w]) {
+      const double dist = (x[i] - wpx) * nx + (y[i] - wpy) * ny + (z[i] - wpz) * nz;
+      if (dist >= rad[i]) whx[i] = why[i] = whz[i] = 0.0;
+    }
+    prev_wall_contacts_[w].assign(wc, wc + nw);
+    contacts += static_cast<std::int64_t>(nw);
+    auto wall_loop = [&](auto uniform_masses) {
+#pragma GCC ivdep
+      for (std::size_t k = 0; k < nw; ++k) {
+        const std::uint32_t i = wc[k];
+        const double ri = rad[i], mi = mass[i];
+        const double dist = (x[i] - wpx) * nx + (y[i] - wpy) * ny + (z[i] - wpz) * nz;
+        const double cx = ri * wx[i], cy = ri * wy[i], cz = ri * wz[i];
+        const double vrx = vx[i] - (cy * nz - cz * ny);
+        const double vry = vy[i] - (cz * nx - cx * nz);
+        const double vrz = vz[i] - (cx * ny - cy * nx);
+        double gn = gn_wall;
+        if constexpr (!decltype(uniform_masses)::value) gn = damping_factor * std::sqrt(mi * kn);
+        double ftx, fty, ftz;
+        const double fn = spring_dashpot(cm, dt, nx, ny, nz, ri - dist, vrx, vry, vrz, gn, whx[i], why[i], whz[i], ftx,
+                                         fty, ftz);
+        fx[i] += fn * nx + ftx;
+        fy[i] += fn * ny + fty;
+        fz[i] += fn * nz + ftz;
+        const double mx = ny * ftz - nz * fty, my = nz * ftx - nx * ftz, mz = nx * fty - ny * ftx;
+        double rtx = 0.0, rty = 0.0, rtz = 0.0;
+        if constexpr (Rolling::enabled) {
+          // The wall is a sphere of infinite inertia at rest (a_j = 0).
+          const double on = spx[i] * nx + spy[i] * ny + spz[i] * nz;
+          const double ia = inertia[i] / ri;
+          const double qx = (spx[i] - on * nx) * inv_dt * ia - mx;
+          const double qy = (spy[i] - on * ny) * inv_dt * ia - my;
+          const double qz = (spz[i] - on * nz) * inv_dt * ia - mz;
+          cap_rolling(qx, qy, qz, rolling.mu_r * std::abs(fn), rtx, rty, rtz);
+        }
+        tx[i] += -ri * (mx + rtx);
+        ty[i] += -ri * (my + rty);
+        tz[i] += -ri * (mz + rtz);
+      }
+    };
+    if (uniform) wall_loop(std::true_type{});
+    else wall_loop(std::false_type{});
+  }
+  contacts_ = contacts;
+}
+
+void DemSystem::compute_forces() {
+  auto t0 = std::chrono::steady_clock::now();
+  if (cfg_.rolling_model == "none" || cfg_.rolling_friction == 0.0) compute_forces_impl(RollingNone{});
+  else compute_forces_impl(RollingConstantDirectional{cfg_.rolling_friction});
+  seconds_force += seconds_since(t0);
+}
+
+}  // namespace boycott::particles

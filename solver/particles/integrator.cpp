@@ -1,0 +1,160 @@
+// Velocity Verlet (paper Eqs. 4-6) with the coupling hook: drag implicit in the half kicks,
+// added mass in the mass matrix, and the predicted velocities the contact forces see.
+#include <array>
+#include <chrono>
+#include <vector>
+
+#include "core/timers.hpp"
+#include "particles/dem_system.hpp"
+
+namespace boycott::particles {
+
+namespace {
+/// The half kick (see DemSystem::kick), all components in one pass so that m, m_add and beta are
+/// read once and (M + h beta) is inverted once per particle; restrict-qualified parameters let
+/// GCC vectorise it. Predict: also write 2 v_new - v_old to p; Track: accumulate the drag
+/// impulse in J; Wet: read the fluid arrays (F_ext, u_f, m_add), which a dry kick leaves out.
+template <bool Predict, bool Track, bool Wet>
+void kick_loop(std::size_t n, double h, double gx, double gy, double gz, const double* __restrict m,
+                   const double* __restrict ma, const double* __restrict b, const double* __restrict fx,
+                   const double* __restrict fy, const double* __restrict fz, const double* __restrict ex,
+                   const double* __restrict ey, const double* __restrict ez, const double* __restrict ux,
+                   const double* __restrict uy, const double* __restrict uz, double* __restrict vx, double* __restrict vy,
+                   double* __restrict vz, double* __restrict Jx, double* __restrict Jy, double* __restrict Jz,
+                   double* __restrict px, double* __restrict py, double* __restrict pz) {
+  for (std::size_t i = 0; i < n; ++i) {
+    // Dry (!Wet): F_ext, u_f and m_add are zero and not read (DemConfig::dry).
+    const double M = Wet ? m[i] + ma[i] : m[i], bi = b[i], inv_D = 1.0 / (M + h * bi);
+    const double v0x = vx[i], v0y = vy[i], v0z = vz[i];
+    double ax = fx[i], ay = fy[i], az = fz[i];
+    if constexpr (Wet) {
+      ax += ex[i];
+      ay += ey[i];
+      az += ez[i];
+    }
+    ax += m[i] * gx;
+    ay += m[i] * gy;
+    az += m[i] * gz;
+    if constexpr (Wet) {
+      ax += bi * ux[i];
+      ay += bi * uy[i];
+      az += bi * uz[i];
+    }
+    const double v1x = (M * v0x + h * ax) * inv_D;
+    const double v1y = (M * v0y + h * ay) * inv_D;
+    const double v1z = (M * v0z + h * az) * inv_D;
+    vx[i] = v1x;
+    vy[i] = v1y;
+    vz[i] = v1z;
+    if constexpr (Track) {
+      Jx[i] += h * bi * (ux[i] - v1x);
+      Jy[i] += h * bi * (uy[i] - v1y);
+      Jz[i] += h * bi * (uz[i] - v1z);
+    }
+    if constexpr (Predict) {
+      px[i] = 2.0 * v1x - v0x;
+      py[i] = 2.0 * v1y - v0y;
+      pz[i] = 2.0 * v1z - v0z;
+    }
+  }
+}
+
+/// Spin half kick, w += h T / I, with the prediction as above.
+template <bool Predict>
+void kick_spin(std::size_t n, double h, const double* __restrict I, const double* __restrict tx,
+               const double* __restrict ty, const double* __restrict tz, double* __restrict wx, double* __restrict wy,
+               double* __restrict wz, double* __restrict px, double* __restrict py, double* __restrict pz) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const double h_I = h / I[i];
+    const double w0x = wx[i], w0y = wy[i], w0z = wz[i];
+    const double w1x = w0x + h_I * tx[i], w1y = w0y + h_I * ty[i], w1z = w0z + h_I * tz[i];
+    wx[i] = w1x;
+    wy[i] = w1y;
+    wz[i] = w1z;
+    if constexpr (Predict) {
+      px[i] = 2.0 * w1x - w0x;
+      py[i] = 2.0 * w1y - w0y;
+      pz[i] = 2.0 * w1z - w0z;
+    }
+  }
+}
+
+template <bool Predict, bool Track, bool Wet>
+void kick_all(std::size_t n, double h, const std::array<double, 3>& g, ParticleStore& s, std::vector<double>* pred) {
+  double* p[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+  if constexpr (Predict)
+    for (int c = 0; c < 6; ++c) p[c] = pred[c].data();
+  kick_loop<Predict, Track, Wet>(n, h, g[0], g[1], g[2], s.mass.data(), s.madd.data(), s.beta.data(), s.fx.data(),
+                                s.fy.data(), s.fz.data(), s.ext_x.data(), s.ext_y.data(), s.ext_z.data(), s.ufx.data(),
+                                s.ufy.data(), s.ufz.data(), s.vx.data(), s.vy.data(), s.vz.data(), s.drag_jx.data(),
+                                s.drag_jy.data(), s.drag_jz.data(), p[0], p[1], p[2]);
+  kick_spin<Predict>(n, h, s.inertia.data(), s.tx.data(), s.ty.data(), s.tz.data(), s.wx.data(), s.wy.data(),
+                     s.wz.data(), p[3], p[4], p[5]);
+}
+}  // namespace
+
+
+void DemSystem::kick(double h, bool predict) {
+  // Half kick of velocity Verlet with the drag implicit (backward Euler over the half step):
+  //   (M + h beta) v_new = M v + h (F + F_ext + m g + beta u_f),  M = m + m_add.
+  // beta -> infinity gives v = u_f + F/beta: stable for any particle response time.
+  // With `predict` (the step's first kick) it also writes the velocities the coming forces see
+  // (see predict_velocities), 2 v(n+1/2) - v(n), while v(n) is at hand: one pass over the
+  // arrays instead of a copy of v(n), the kick and a prediction pass (~8 % of a DEM step).
+  const std::size_t n = s_.n_local;
+  if (predict)
+    for (int c = 0; c < 6; ++c) pred_[c].resize(s_.size());
+  const bool track = cfg_.track_drag_impulse;
+  // Dry only without drag tracking (tracking is for the coupling, which has fluid).
+  const bool wet = !cfg_.dry || track;
+  auto& g = cfg_.gravity_m_s2;
+  if (predict && track) kick_all<true, true, true>(n, h, g, s_, pred_);
+  else if (track) kick_all<false, true, true>(n, h, g, s_, pred_);
+  else if (predict && wet) kick_all<true, false, true>(n, h, g, s_, pred_);
+  else if (wet) kick_all<false, false, true>(n, h, g, s_, pred_);
+  else if (predict) kick_all<true, false, false>(n, h, g, s_, pred_);
+  else kick_all<false, false, false>(n, h, g, s_, pred_);
+  if (predict) {
+    // Ghost copies are not integrated here: they see the velocities their owner sent.
+    const std::vector<double>* cur[6] = {&s_.vx, &s_.vy, &s_.vz, &s_.wx, &s_.wy, &s_.wz};
+    for (int c = 0; c < 6; ++c)
+      for (std::size_t i = n; i < s_.size(); ++i) pred_[c][i] = (*cur[c])[i];
+  }
+}
+
+void DemSystem::drift() {
+  const std::size_t n = s_.n_local;
+  const double dt = cfg_.dt_s;
+  for (int c = 0; c < 3; ++c) {
+    double* __restrict x = (c == 0 ? s_.x : c == 1 ? s_.y : s_.z).data();
+    const double* __restrict v = (c == 0 ? s_.vx : c == 1 ? s_.vy : s_.vz).data();
+    for (std::size_t i = 0; i < n; ++i) x[i] += dt * v[i];
+  }
+}
+
+void DemSystem::predict_velocities() {
+  // Velocity Verlet evaluates forces at x(n+1) but only knows v(n+1/2); a dashpot fed with that
+  // half-step-old velocity under-damps by O(gamma dt / m) (restitution 4 % low for e = 0.1 at
+  // 100 steps per contact). The forces therefore see v(n+1) predicted to second order,
+  // v(n+1/2) + (dt/2) a(n) = 2 v(n+1/2) - v(n), written by the step's first kick; at t = 0
+  // (here) they see v(0).
+  const std::vector<double>* cur[6] = {&s_.vx, &s_.vy, &s_.vz, &s_.wx, &s_.wy, &s_.wz};
+  for (int c = 0; c < 6; ++c) pred_[c] = *cur[c];
+}
+
+void DemSystem::step() {
+  if (!initialized_) initialize();
+  auto t0 = std::chrono::steady_clock::now();
+  kick(0.5 * cfg_.dt_s, true);
+  drift();
+  seconds_integrate += seconds_since(t0);
+  if (needs_rebuild()) rebuild();
+  compute_forces();
+  t0 = std::chrono::steady_clock::now();
+  kick(0.5 * cfg_.dt_s, false);
+  seconds_integrate += seconds_since(t0);
+  time_ += cfg_.dt_s;
+  ++steps_;
+}
+
+}  // namespace boycott::particles
