@@ -16,11 +16,16 @@
 // Discretisation: finite volume, BDF2 (variable step) in time, QUICK convection by deferred
 // correction on implicit upwind, central diffusion and pressure gradient, SIMPLE(C) with optional
 // under-relaxation; linear systems by PETSc KSP with prefixes "momentum_" and "pressure_", their
-// operators applied matrix-free (stencil_operator.hpp). Defaults: BiCGStab + point Jacobi;
-// FGMRES + the spectral constant-coefficient preconditioner (spectral_poisson_pc.hpp) to 1e-3
-// relative per SIMPLE iteration, constant null space removed. `-pressure_pc_type` selects
-// another (GMRES then; BoomerAMG (HMIS, ext+i) on one rank, GAMG on several), and AMG, prefix
-// "pressure_fallback_", redoes a failed pressure solve.
+// operators applied matrix-free (stencil_operator.hpp); the solvers are set up in
+// linear_solvers.hpp. Defaults: BiCGStab + point Jacobi; FGMRES + the spectral
+// constant-coefficient preconditioner (spectral_poisson_pc.hpp) to 1e-3 relative per SIMPLE
+// iteration, constant null space removed. `-pressure_pc_type` selects another (GMRES then), and
+// BoomerAMG, prefix "pressure_fallback_", redoes a failed pressure solve.
+//
+// The class's members are defined by concern: fluid_solver.cpp (layout, solvers, ghosts),
+// simple_piso.cpp (the step), momentum_assembly.cpp, pressure_correction.cpp,
+// flux_controller.cpp, subgrid_stencil.cpp, deposition_interface.cpp and fluid_state.cpp
+// (given fields, diagnostics, checkpoint state).
 #include <mpi.h>
 #include <petscdmda.h>
 #include <petscksp.h>
@@ -34,10 +39,7 @@
 #include <vector>
 
 #include "core/grid_spec.hpp"
-
-namespace boycott {
-struct CaseParams;
-}
+#include "fluid/fluid_settings.hpp"
 
 namespace boycott::fluid {
 
@@ -46,40 +48,6 @@ class StencilOperator;
 class HaloExchange;
 class SpectralPoissonPreconditioner;
 struct SpectralPcShell;
-
-struct FluidSettings {
-  GridSpec grid;
-  double density_kg_m3 = 1000.0;
-  double viscosity_pa_s = 1.0e-3;  ///< dynamic
-  bool vreman = false;             ///< Vreman subgrid viscosity on/off
-  double vreman_constant = 0.07;
-  bool top_slip = false;  ///< y = W is a slip (mirror) wall instead of no-slip
-  std::array<double, 3> body_acceleration_m_s2 = {0.0, 0.0, 0.0};
-  /// Flux controller target for the volume mean of alpha_f w (m/s); NaN = controller off.
-  double target_mean_flux_z_m_s = std::numeric_limits<double>::quiet_NaN();
-  int simple_max_iterations = 30;
-  double simple_tolerance = 1.0e-6;
-  double velocity_relaxation = 1.0;  ///< see CaseParams::Numerics
-  double pressure_relaxation = 0.5;  ///< used by plain SIMPLE; SIMPLEC corrects p fully
-  /// SIMPLEC correction coefficient a/(rho (a_P - sum a_nb)) instead of SIMPLE's a/(rho a_P):
-  /// plain SIMPLE diverges for diffusion-dominated cells of high aspect ratio (nu dt/h_y^2 >> 1
-  /// with h_x >> h_y, as on the paper's 1 x 1 x 1 mm grid with 6 cells across a 6 mm gap).
-  bool simplec = true;
-  double cfl_max = 0.5;
-  double dt_max_s = 1.0e-3;
-  bool quick = true;  ///< false: first-order upwind convection (for comparisons)
-  /// PISO instead of SIMPLE (numerics.pressure_velocity_coupling): one momentum solve and
-  /// piso_correctors pressure corrections per step, no convergence test.
-  bool piso = false;
-  int piso_correctors = 2;
-  /// Builds the settings of a case: grid, fluid, numerics, `[flow]` forcing.
-  static FluidSettings from_case(const CaseParams& p);
-  /// Pressure-velocity coupling in words ("SIMPLEC", "SIMPLE" or "PISO, 2 correctors").
-  std::string coupling_name() const {
-    if (piso) return "PISO, " + std::to_string(piso_correctors) + " correctors";
-    return simplec ? "SIMPLEC" : "SIMPLE";
-  }
-};
 
 /// What one step did.
 struct StepReport {
@@ -168,7 +136,7 @@ class FluidSolver {
   StepReport step(double dt_s);
   double time_s() const { return time_; }
   int steps_done() const { return steps_; }
-  /// Pressure solves that failed with the default solver and were redone with GAMG.
+  /// Pressure solves that failed with the default solver and were redone by the fallback.
   int pressure_fallbacks() const { return pressure_fallbacks_; }
 
   // ---- diagnostics ----
@@ -237,7 +205,7 @@ class FluidSolver {
   Mat A_ = nullptr, Ap_ = nullptr;
   std::unique_ptr<StencilMatrixWriter> writer_;
   KSP ksp_m_ = nullptr, ksp_p_ = nullptr;
-  KSP ksp_p_fallback_ = nullptr;  // GAMG, created on the first failed pressure solve
+  KSP ksp_p_fallback_ = nullptr;  // BoomerAMG, created on the first failed pressure solve
   // The pressure preconditioner on one rank unless the user picks another (-pressure_pc_type).
   std::unique_ptr<SpectralPcShell> spectral_pc_;
   int pressure_fallbacks_ = 0;

@@ -13,3 +13,6 @@ inline void petsc_check(PetscErrorCode ierr, const char* what) {
 }
 
 }  // namespace boycott::fluid
+
+/// Checks a PETSc call, naming it in the exception.
+#define BC_PETSC(call) ::boycott::fluid::petsc_check((call), #call)

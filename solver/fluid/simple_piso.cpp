@@ -1,0 +1,262 @@
+// One fluid time step: BDF2 weights, the CFL limit, and the two pressure-velocity couplings,
+// SIMPLE(C) iterated to its tolerance and PISO with its correctors.
+#include "fluid/fluid_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "fluid/halo_exchange.hpp"
+#include "fluid/log_events.hpp"
+#include "fluid/petsc_check.hpp"
+#include "fluid/stencil_operator.hpp"
+
+namespace boycott::fluid {
+
+namespace {
+
+/// Variable-step BDF2 weights: (c0 y^{n+1} - c1 y^n + c2 y^{n-1}) / dt with w = dt/dt_prev,
+/// c0 = (1 + 2w)/(1 + w), c1 = 1 + w, c2 = w^2/(1 + w); BDF1 when there is no previous step.
+void bdf_weights(double dt, double dt_prev, double c[3]) {
+  if (dt_prev <= 0.0) {
+    c[0] = 1.0, c[1] = 1.0, c[2] = 0.0;
+    return;
+  }
+  const double w = dt / dt_prev;
+  c[0] = (1.0 + 2.0 * w) / (1.0 + w);
+  c[1] = 1.0 + w;
+  c[2] = w * w / (1.0 + w);
+}
+
+}  // namespace
+
+double FluidSolver::stable_dt() const {
+  double rate = 0.0;  // max_c |u_c| / h_c, 1/s
+  for (int c = 0; c < 3; ++c) rate = std::max(rate, max_abs_velocity(c) / s_.grid.dx(c));
+  if (rate <= 0.0) return s_.dt_max_s;
+  return std::min(s_.dt_max_s, s_.cfl_max / rate);
+}
+
+void FluidSolver::step_simple(double dt, const double c[3], StepReport& rep) {
+  const double tol = s_.simple_tolerance;
+  for (int it = 0; it < s_.simple_max_iterations; ++it) {
+    const bool first = it == 0;
+    // max |u* - u| and max |u*| over the components: one pass each and one reduction for all
+    double loc[2] = {0.0, 0.0};
+    compute_face_fluxes();
+    for (int cc = 0; cc < 3; ++cc) {
+      assemble_momentum(cc, dt, c[0], c[1], c[2], first, *opA_);
+      solve_momentum(cc, *opA_, rep);
+      const double *u, *prev;
+      PetscInt n;
+      BC_PETSC(VecGetLocalSize(U_[cc], &n));
+      BC_PETSC(VecGetArrayRead(U_[cc], &u));
+      BC_PETSC(VecGetArrayRead(Ustar_prev_[cc], &prev));
+      double d = loc[0], m = loc[1];
+      bool nan = false;
+      for (PetscInt q = 0; q < n; ++q) {
+        d = std::max(d, std::abs(u[q] - prev[q]));
+        m = std::max(m, std::abs(u[q]));
+        nan |= std::isnan(u[q]);
+      }
+      // std::max drops a NaN (and MPI's MAX need not keep one): a NaN velocity counts as +inf,
+      // which the continuity check below reports
+      const double inf = std::numeric_limits<double>::infinity();
+      loc[0] = nan ? inf : d, loc[1] = nan ? inf : m;
+      BC_PETSC(VecRestoreArrayRead(U_[cc], &u));
+      BC_PETSC(VecRestoreArrayRead(Ustar_prev_[cc], &prev));
+    }
+    double glob[2];
+    MPI_Allreduce(loc, glob, 2, MPI_DOUBLE, MPI_MAX, comm_);
+    const double du = glob[0], umax = glob[1];
+    double flux_err = 0.0;
+    if (std::isfinite(s_.target_mean_flux_z_m_s)) {
+      const double q0 = mean_flux_z();
+      flux_err = std::abs(q0 - s_.target_mean_flux_z_m_s) /
+                 std::max({std::abs(s_.target_mean_flux_z_m_s), umax, 1e-30});
+      apply_flux_controller();
+    }
+    rep.continuity_residual = relative_continuity_residual(dt, c, umax);
+    const double uref = std::max({umax, std::abs(std::isfinite(s_.target_mean_flux_z_m_s) ? s_.target_mean_flux_z_m_s : 0.0),
+                                  1e-30});
+    const double dvel = du / uref;
+    if (first) assemble_pressure();
+    solve_pressure_correction(rep);
+    rep.simple_iterations = it + 1;
+    if (rep.continuity_residual < tol && dvel < tol && flux_err < tol) {
+      rep.converged = true;
+      break;
+    }
+  }
+}
+
+// PISO (Issa 1986) beside SIMPLE: one momentum solve per component with the face fluxes of the
+// last step, then `piso_correctors` pressure corrections without re-assembly. Corrector k > 1
+// first moves the velocity by one Jacobi sweep of the frozen momentum equations at the corrected
+// pressure (u += (b(p) - A u) / a_P, which is Issa's neighbour term sum a_nb u'_nb / a_P), then
+// corrects it with the same (SIMPLEC) coefficient D as SIMPLE. Nothing is iterated to a
+// tolerance: the step costs one momentum round and `piso_correctors` pressure solves instead of
+// ~5 of each, and its difference from SIMPLE is what tests and the work-precision study report.
+void FluidSolver::step_piso(double dt, const double c[3], StepReport& rep) {
+  if (!opm_[0]) {
+    for (int cc = 0; cc < 3; ++cc) {
+      opm_[cc] = std::make_unique<StencilOperator>(dam_);
+      BC_PETSC(DMCreateGlobalVector(da_, &bm_[cc]));
+    }
+    BC_PETSC(DMCreateGlobalVector(da_, &P_asm_));
+  }
+  // The equations are linearised once, about u^n + (dt/dt_prev)(u^n - u^(n-1)): the face fluxes,
+  // QUICK's deferred correction and the transposed stress are then O(dt^2) from their values
+  // at u^(n+1), which keeps the step second order in time (about u^n it would be first order).
+  if (steps_ > 0) {
+    const double r = dt / dt_prev_;
+    for (int cc = 0; cc < 3; ++cc) BC_PETSC(VecAXPBYPCZ(U_[cc], 1.0 + r, -r, 0.0, Un_[cc], Unm1_[cc]));
+    update_flow_ghosts();
+  }
+  compute_face_fluxes();
+  BC_PETSC(VecCopy(P_, P_asm_));
+  const double G_asm = G_;
+  for (int cc = 0; cc < 3; ++cc) {
+    assemble_momentum(cc, dt, c[0], c[1], c[2], true, *opm_[cc]);
+    BC_PETSC(VecCopy(rhs_, bm_[cc]));
+    solve_momentum(cc, *opm_[cc], rep);
+  }
+  if (std::isfinite(s_.target_mean_flux_z_m_s)) apply_flux_controller();
+  for (int k = 0; k < s_.piso_correctors; ++k) {
+    if (k > 0) {
+      momentum_sweep(G_asm);
+      if (std::isfinite(s_.target_mean_flux_z_m_s)) apply_flux_controller();
+    }
+    rep.continuity_residual = relative_continuity_residual(dt, c, max_abs_velocity_all());
+    if (k == 0) assemble_pressure();
+    // Between correctors nothing reads the ghosts (the sweep works on global vectors and the
+    // continuity residual refreshes u's); after the last one the coupling reads them.
+    const bool last = k + 1 == s_.piso_correctors;
+    solve_pressure_correction(rep, last && !std::isfinite(s_.target_mean_flux_z_m_s));
+  }
+  // The corrections moved the mean flux a little (mean(a_f D_z dp'/dz) is not zero where alpha_f
+  // varies); the controller's response w' = -D_z dG is linear, so one more application holds
+  // the target exactly, at the cost of a continuity defect of order dG d(a_f D_z)/dz.
+  if (std::isfinite(s_.target_mean_flux_z_m_s)) {
+    apply_flux_controller();
+    update_flow_ghosts();
+  }
+  rep.simple_iterations = s_.piso_correctors;
+  rep.converged = true;
+}
+
+void FluidSolver::momentum_sweep(double G_asm) {
+  const LogScope log_scope(fluid_events().momentum_sweep);
+  // p - p_asm, ghosted: the pressure the frozen right-hand sides b were assembled with
+  BC_PETSC(VecWAXPY(pc_, -1.0, P_asm_, P_));
+  halo_->fill(pc_, pcl_);
+  const auto& g = s_.grid;
+  const bool wall = !g.periodic[1];
+  const OwnedBox b = owned_box();
+  const GhostBox gb = ghost_box();
+  const std::int64_t off[3] = {1, gb.size[0], gb.size[0] * gb.size[1]};
+  const double inv_rho = 1.0 / s_.density_kg_m3;
+  const double *al, *dp;
+  BC_PETSC(VecGetArrayRead(alphal_[0], &al));
+  BC_PETSC(VecGetArrayRead(pcl_, &dp));
+  for (int cc = 0; cc < 3; ++cc) {
+    opm_[cc]->apply(U_[cc], sol_);  // A u
+    const double *Au, *bv, *aP;
+    double* u;
+    BC_PETSC(VecGetArrayRead(sol_, &Au));
+    BC_PETSC(VecGetArrayRead(bm_[cc], &bv));
+    aP = opm_[cc]->coef(0);
+    BC_PETSC(VecGetArray(U_[cc], &u));
+    const std::int64_t oc = off[cc];
+    const double igrad = inv_rho / g.dx(cc);
+    // the mean gradient G acts like a pressure gradient on w: its change since the assembly too
+    const double dbody = cc == 2 ? -(G_ - G_asm) * inv_rho : 0.0;
+    std::int64_t o = 0;
+    for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
+      for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j) {
+        const std::int64_t P0 = (k - gb.lo[2]) * off[2] + (j - gb.lo[1]) * off[1] + (b.lo[0] - gb.lo[0]);
+        const int nx = (int)b.size[0];
+        if (cc == 1 && wall && j == 0) {  // identity rows: v = 0 on the wall
+          o += nx;
+          continue;
+        }
+#pragma GCC ivdep
+        for (int i = 0; i < nx; ++i) {
+          const std::int64_t P = P0 + i;
+          const double a1 = 0.5 * (al[P] + al[P - oc]);
+          const double r = bv[o + i] - Au[o + i] + a1 * (dbody - (dp[P] - dp[P - oc]) * igrad);
+          u[o + i] += r / aP[o + i];
+        }
+        o += nx;
+      }
+    BC_PETSC(VecRestoreArrayRead(sol_, &Au));
+    BC_PETSC(VecRestoreArrayRead(bm_[cc], &bv));
+    BC_PETSC(VecRestoreArray(U_[cc], &u));
+  }
+  BC_PETSC(VecRestoreArrayRead(alphal_[0], &al));
+  BC_PETSC(VecRestoreArrayRead(pcl_, &dp));
+}
+
+void FluidSolver::solve_momentum(int cc, const StencilOperator& op, StepReport& rep) {
+  jacobi_inv_diag_ = inv_diag_[cc];
+  const Mat A = momentum_aij_ ? aij_copy(op, &A_) : op.mat();
+  BC_PETSC(KSPSetOperators(ksp_m_, A, A));
+  BC_PETSC(VecCopy(U_[cc], sol_));
+  BC_PETSC(KSPSolve(ksp_m_, rhs_, sol_));
+  KSPConvergedReason reason;
+  BC_PETSC(KSPGetConvergedReason(ksp_m_, &reason));
+  if (reason < 0) throw PhysicsError(fmt::format("momentum solve (component {}) diverged: reason {}", cc, (int)reason));
+  PetscInt its;
+  BC_PETSC(KSPGetIterationNumber(ksp_m_, &its));
+  rep.momentum_krylov_iterations += (int)its;
+  BC_PETSC(VecCopy(sol_, U_[cc]));
+}
+
+double FluidSolver::max_abs_velocity_all() const {
+  double umax = 0.0;
+  for (int cc = 0; cc < 3; ++cc) umax = std::max(umax, max_abs_velocity(cc));
+  return umax;
+}
+
+StepReport FluidSolver::step(double dt) {
+  if (deposition_open_) throw std::logic_error("step() inside begin/end_deposition");
+  if (!(dt > 0.0)) throw std::invalid_argument("step: dt must be > 0");
+  StepReport rep;
+  rep.dt_s = dt;
+  double c[3];
+  bdf_weights(dt, steps_ > 0 ? dt_prev_ : 0.0, c);
+  for (int l = 0; l < 3; ++l) halo_->fill(alpha_[l], alphal_[l]);
+  compute_subgrid_viscosity();  // also refreshes nu_t's ghosts
+  compute_effective_viscosity();
+  update_flow_ghosts();
+  if (s_.piso) {
+    step_piso(dt, c, rep);
+  } else {
+    step_simple(dt, c, rep);
+  }
+  rep.mean_pressure_gradient_pa_m = G_;
+  // continuity defect of the accepted fields (for diagnostics and tests)
+  last_c_[0] = c[0], last_c_[1] = c[1], last_c_[2] = c[2];
+  last_dt_ = dt;
+  last_defect_ = continuity_residual(dt, c[0], c[1], c[2], R_);
+  // rotate time levels
+  for (int cc = 0; cc < 3; ++cc) {
+    BC_PETSC(VecCopy(Un_[cc], Unm1_[cc]));
+    BC_PETSC(VecCopy(U_[cc], Un_[cc]));
+  }
+  BC_PETSC(VecCopy(alpha_[1], alpha_[2]));
+  BC_PETSC(VecCopy(alpha_[0], alpha_[1]));
+  for (int l = 1; l < 3; ++l) halo_->fill(alpha_[l], alphal_[l]);
+  time_ += dt;
+  dt_prev_ = dt;
+  ++steps_;
+  return rep;
+}
+
+}  // namespace boycott::fluid
