@@ -13,7 +13,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
-#include "scenes/coupled_run.hpp"
+#include "coupling/coupled_system.hpp"
 #include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scenes_list.hpp"
@@ -24,7 +24,7 @@ namespace {
 
 /// Steps the frozen-bed flow until U changes by less than `tol` relative per step (at least
 /// `min_steps`, at most `max_steps`). Returns the number of steps.
-int run_to_steady(CoupledRun& run, double tol, int min_steps, int max_steps, const RunContext& ctx) {
+int run_to_steady(coupling::CoupledSystem& run, double tol, int min_steps, int max_steps, const RunContext& ctx) {
   double u_old = run.fluid().mean_flux_z();
   for (int k = 1; k <= max_steps; ++k) {
     run.step();
@@ -44,7 +44,7 @@ int run_ergun(const CaseParams& p, RunContext& ctx) {
   ModelTimers timers;
   CaseParams q = p;
   q.gravity.magnitude_m_s2 = 0.0;
-  CoupledRun run(q, CoupledOptions{false, false});
+  coupling::CoupledSystem run(q, coupling::CoupledOptions{false, false});
   {
     ModelTimers::Scope pack(timers, "packing");
     insert_case_particles(run.dem(), q);

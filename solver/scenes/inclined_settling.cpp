@@ -14,11 +14,10 @@
 #include "core/statistics.hpp"
 #include "core/version.hpp"
 #include "io/checkpoint_file.hpp"
-#include "io/png_image.hpp"
-#include "io/snapshot.hpp"
 #include "io/state_io.hpp"
 #include "coupling/drag_laws.hpp"
-#include "scenes/coupled_run.hpp"
+#include "scenes/coupled_checkpoint.hpp"
+#include "scenes/coupled_output.hpp"
 #include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scenes_list.hpp"
@@ -55,7 +54,7 @@ void write_pdf(const std::filesystem::path& path, const std::string& column, con
 int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   WallClock clock;
   ModelTimers timers;
-  CoupledRun run(p, CoupledOptions{true, true});
+  coupling::CoupledSystem run(p, coupling::CoupledOptions{true, true});
   const auto& s = run.dem().particles();
   const double vt = isolated_terminal_speed(p);
   const double W = p.domain.width_y_m;
@@ -65,12 +64,12 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   const double wrange = std::max(8.0 * vt, 0.05);
   Histogram pdf_w(-wrange, 0.5 * wrange, bins);
   BatchMeans wp_avg, wf_avg, slurry_avg;
-  double slurry_max = 0.0, next_out = 0.0, wall_before = 0.0;
+  double slurry_max = 0.0, next_out = 0.0, wall_before = 0.0;  // next_out: the resumed output's, s
   // Stability record over the whole run (issue 7): alpha_f range and the largest kinetic energy.
   double alpha_min_seen = 1.0, alpha_max_seen = 0.0, ke_max_seen = 0.0;
 
   // Resume from the newest checkpoint, or start.
-  const auto resumed = run.resume(ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) {
+  const auto resumed = resume_coupled(run, ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) {
     io::load(r, "stats.wp.", wp_avg);
     io::load(r, "stats.wf.", wf_avg);
     io::load(r, "stats.slurry.", slurry_avg);
@@ -91,39 +90,30 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     run.start();
   }
   run.activate_models(timers);
-  timers.activate("checkpoints", fmt::format("HDF5 every {} s, newest {} kept", p.time.checkpoint_every_s,
-                                             p.output.keep_checkpoints));
-
+  CoupledSceneOutput out(run, ctx, timers,
+                         {"time_s", "mean_wp_m_s", "mean_wf_m_s", "slurry_velocity_m_s", "mean_up_m_s", "mean_vp_m_s",
+                          "driving_gradient_pa_m", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
+                         resumed.has_value(), next_out);
   auto write_checkpoint = [&] {
     ModelTimers::Scope sc(timers, "checkpoints");
-    run.checkpoint(ctx.out_dir, wall_before + clock.seconds(), [&](io::CheckpointWriter& w) {
+    checkpoint_coupled(run, ctx.out_dir, wall_before + clock.seconds(), [&](io::CheckpointWriter& w) {
       io::save(w, "stats.wp.", wp_avg);
       io::save(w, "stats.wf.", wf_avg);
       io::save(w, "stats.slurry.", slurry_avg);
       io::save(w, "stats.pdf_y.", pdf_y);
       io::save(w, "stats.pdf_w.", pdf_w);
       w.put("stats.slurry_max", slurry_max);
-      w.put("stats.next_out", next_out);
+      w.put("stats.next_out", out.next_out_s());
       w.put("stats.alpha_min_seen", alpha_min_seen);
       w.put("stats.alpha_max_seen", alpha_max_seen);
       w.put("stats.ke_max_seen", ke_max_seen);
     });
   };
-
-  CsvWriter csv(ctx.out_dir / "timeseries.csv",
-                {"time_s", "mean_wp_m_s", "mean_wf_m_s", "slurry_velocity_m_s", "mean_up_m_s", "mean_vp_m_s",
-                 "driving_gradient_pa_m", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
-                resumed.has_value());
-  const double out_every = is_set(p.output.timeseries_every_s) ? p.output.timeseries_every_s : 0.0;
-  CheckpointClock checkpoints(p.time.checkpoint_every_s, run.time_s());
-  OutputTimes snaps(p.output.snapshot_times_s, run.time_s()), images(p.output.image_times_s, run.time_s());
-  if (snaps.size()) timers.activate("snapshots", fmt::format("HDF5 + XDMF at {} times", snaps.size()));
-  if (images.size()) timers.activate("images", fmt::format("PNG of the x-z plane at {} times", images.size()));
   int exit_code = kExitOk;
   SummaryBase sb;
   const double end = p.time.end_s;
   while (run.time_s() < end - 1e-12) {
-    const CoupledStep st = run.step();
+    const coupling::CoupledStep st = run.step();
     const double t = run.time_s();
     const double wp = run.mean_particle_velocity(2);
     const double wf = run.mean_fluid_velocity_z();
@@ -141,30 +131,17 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
         pdf_w.add(s.vz[i]);
       }
     }
-    if (t >= next_out - 1e-12 || t >= end - 1e-12) {
-      csv.row({t, wp, wf, slurry, run.mean_particle_velocity(0), run.mean_particle_velocity(1),
-               run.fluid().mean_pressure_gradient_pa_m(), st.dt_s, static_cast<double>(st.fluid.simple_iterations),
-               run.coupler().totals().min_alpha_f, run.dem().kinetic_energy_j()});
-      next_out = t + out_every;
-      if (ctx.progress) ctx.progress(t);
-    }
-    snaps.reached(t, [&](std::size_t index, double) {
-      ModelTimers::Scope sc(timers, "snapshots");
-      io::write_snapshot(ctx.out_dir, static_cast<int>(index), run.snapshot(), run.fluid().settings().grid);
-    });
-    images.reached(t, [&](std::size_t, double time) {
-      ModelTimers::Scope sc(timers, "images");
-      const io::ParticleView view{&s.x, &s.y, &s.z, &s.radius, s.n_local, p.domain.length_x_m, p.domain.width_y_m,
-                                  p.domain.height_z_m};
-      io::write_particle_png(ctx.out_dir / fmt::format("particles_t{:.3f}.png", time), view);
-    });
-    // Also at the end: the final state stays inspectable (and comparable across restarts).
-    if (checkpoint_or_stop(ctx.should_stop(), ctx.quiet, checkpoints, t, end, csv, write_checkpoint, sb)) {
+    const auto row = [&]() -> std::vector<double> {
+      return {t, wp, wf, slurry, run.mean_particle_velocity(0), run.mean_particle_velocity(1),
+              run.fluid().mean_pressure_gradient_pa_m(), st.dt_s, static_cast<double>(st.fluid.simple_iterations),
+              run.coupler().totals().min_alpha_f, run.dem().kinetic_energy_j()};
+    };
+    if (out.after_step(row, write_checkpoint, sb)) {
       exit_code = kExitInterrupted;
       break;
     }
   }
-  csv.flush();
+  out.flush();
   run.report_timers(timers);
   if (wp_avg.count()) {
     write_pdf(ctx.out_dir / "pdf_y.csv", "y_m", pdf_y);

@@ -34,9 +34,9 @@
 #include "core/statistics.hpp"
 #include "fluid/turbulent_start.hpp"
 #include "io/checkpoint_file.hpp"
-#include "io/snapshot.hpp"
 #include "io/state_io.hpp"
-#include "scenes/coupled_run.hpp"
+#include "scenes/coupled_checkpoint.hpp"
+#include "scenes/coupled_output.hpp"
 #include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scenes_list.hpp"
@@ -112,17 +112,18 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   // The geometry (theta = 0, walls in y) is checked by the pre-flight report, before any output.
   WallClock clock;
   ModelTimers timers;
-  CoupledOptions opt;
+  coupling::CoupledOptions opt;
   opt.zero_slurry_flux = false;
   opt.target_mean_flux_z_m_s = p.sediment.bulk_velocity_m_s;
-  CoupledRun run(p, opt);
+  coupling::CoupledSystem run(p, opt);
   const auto& s = run.dem().particles();
   BatchMeans q_avg, g_avg, wf_avg, vp_avg;
   const double h_y = p.domain.width_y_m / static_cast<double>(p.domain.cells[1]);
   Profiles profiles(static_cast<std::size_t>(p.domain.cells[1]));
-  double alpha_min_seen = 1.0, ke_max_seen = 0.0, next_out = 0.0, settle_s = 0.0, wall_before = 0.0;
+  double alpha_min_seen = 1.0, ke_max_seen = 0.0, settle_s = 0.0, wall_before = 0.0;
+  double next_out = 0.0;  // the resumed output's, s
   timers.activate("bed_pouring", "dry DEM until the bed rests");
-  const auto resumed = run.resume(ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) {
+  const auto resumed = resume_coupled(run, ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) {
     for (auto [name, b] : {std::pair{"q", &q_avg}, {"g", &g_avg}, {"wf", &wf_avg}, {"vp", &vp_avg}})
       io::load(r, fmt::format("stats.{}.", name), *b);
     alpha_min_seen = r.scalar("stats.alpha_min_seen");
@@ -173,32 +174,26 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
     return q / A;  // m^2/s
   };
 
-  timers.activate("checkpoints", fmt::format("HDF5 every {} s, newest {} kept", p.time.checkpoint_every_s,
-                                             p.output.keep_checkpoints));
+  CoupledSceneOutput out(run, ctx, timers,
+                         {"time_s", "q_m2_s", "q_star", "driving_gradient_pa_m", "mean_flux_z_m_s", "mean_up_z_m_s",
+                          "mean_vp_m_s", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
+                         resumed.has_value(), next_out);
   auto write_checkpoint = [&] {
     ModelTimers::Scope sc(timers, "checkpoints");
-    run.checkpoint(ctx.out_dir, wall_before + clock.seconds(), [&](io::CheckpointWriter& w) {
+    checkpoint_coupled(run, ctx.out_dir, wall_before + clock.seconds(), [&](io::CheckpointWriter& w) {
       for (auto [name, b] : {std::pair{"q", &q_avg}, {"g", &g_avg}, {"wf", &wf_avg}, {"vp", &vp_avg}})
         io::save(w, fmt::format("stats.{}.", name), *b);
       w.put("stats.alpha_min_seen", alpha_min_seen);
       w.put("stats.ke_max_seen", ke_max_seen);
-      w.put("stats.next_out", next_out);
+      w.put("stats.next_out", out.next_out_s());
       w.put("stats.bed_pouring_time_s", settle_s);
       profiles.save(w);
     });
   };
-  CsvWriter csv(ctx.out_dir / "timeseries.csv",
-                {"time_s", "q_m2_s", "q_star", "driving_gradient_pa_m", "mean_flux_z_m_s", "mean_up_z_m_s",
-                 "mean_vp_m_s", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
-                resumed.has_value());
-  const double out_every = is_set(p.output.timeseries_every_s) ? p.output.timeseries_every_s : 0.0;
-  CheckpointClock checkpoints(p.time.checkpoint_every_s, run.time_s());
-  OutputTimes snaps(p.output.snapshot_times_s, run.time_s());
-  if (snaps.size()) timers.activate("snapshots", fmt::format("HDF5 + XDMF at {} times", snaps.size()));
   SummaryBase sb;
   int exit_code = kExitOk;
   while (run.time_s() < p.time.end_s - 1e-12) {
-    const CoupledStep st = run.step();
+    const coupling::CoupledStep st = run.step();
     const double t = run.time_s();
     const double q = transport_rate();
     const double G = run.fluid().mean_pressure_gradient_pa_m();
@@ -211,23 +206,17 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
       vp_avg.add(run.mean_particle_velocity(1));
       profiles.add(run.fluid(), s, h_y);
     }
-    if (t >= next_out - 1e-12 || t >= p.time.end_s - 1e-12) {
-      csv.row({t, q, q / q_scale, G, run.fluid().mean_flux_z(), run.mean_particle_velocity(2),
-               run.mean_particle_velocity(1), st.dt_s, static_cast<double>(st.fluid.simple_iterations),
-               run.coupler().totals().min_alpha_f, run.dem().kinetic_energy_j()});
-      next_out = t + out_every;
-      if (ctx.progress) ctx.progress(t);
-    }
-    snaps.reached(t, [&](std::size_t index, double) {
-      ModelTimers::Scope sc(timers, "snapshots");
-      io::write_snapshot(ctx.out_dir, static_cast<int>(index), run.snapshot(), run.fluid().settings().grid);
-    });
-    if (checkpoint_or_stop(ctx.should_stop(), ctx.quiet, checkpoints, t, p.time.end_s, csv, write_checkpoint, sb)) {
+    const auto row = [&]() -> std::vector<double> {
+      return {t, q, q / q_scale, G, run.fluid().mean_flux_z(), run.mean_particle_velocity(2),
+              run.mean_particle_velocity(1), st.dt_s, static_cast<double>(st.fluid.simple_iterations),
+              run.coupler().totals().min_alpha_f, run.dem().kinetic_energy_j()};
+    };
+    if (out.after_step(row, write_checkpoint, sb)) {
       exit_code = kExitInterrupted;
       break;
     }
   }
-  csv.flush();
+  out.flush();
   profiles.write(ctx.out_dir / "profiles.csv", h_y, A);
   run.report_timers(timers);
 

@@ -18,7 +18,7 @@
 #include "core/error.hpp"
 #include "core/statistics.hpp"
 #include "coupling/drag_laws.hpp"
-#include "scenes/coupled_run.hpp"
+#include "coupling/coupled_system.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scenes_list.hpp"
 
@@ -27,7 +27,7 @@ namespace boycott::scenes {
 int run_single_particle(const CaseParams& p, RunContext& ctx) {
   WallClock clock;
   ModelTimers timers;
-  CoupledRun run(p, CoupledOptions{true, true});
+  coupling::CoupledSystem run(p, coupling::CoupledOptions{true, true});
   const auto& box = run.dem().config().box;
   run.dem().add_particle(0, box.lo[0] + 0.5 * box.len[0], box.lo[1] + 0.5 * box.len[1], box.lo[2] + 0.5 * box.len[2],
                          0.5 * p.particles.diameter_m, p.particles.density_kg_m3);
@@ -58,7 +58,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   const double end = p.time.end_s;
   const double d = p.particles.diameter_m, nu = p.fluid.viscosity_pa_s / rf;
   while (run.time_s() < end - 1e-12) {
-    const CoupledStep st = run.step();
+    const coupling::CoupledStep st = run.step();
     const double t = run.time_s();
     if (run.steps() == 1) acc0 = s.vz[0] / st.dt_s;
     if (t > p.time.average_from_s + 1e-12) wp_avg.add(s.vz[0]);

@@ -11,7 +11,7 @@
 #include "core/constants.hpp"
 #include "coupling/coupler.hpp"
 #include "fluid/fluid_solver.hpp"
-#include "scenes/coupled_run.hpp"
+#include "coupling/coupled_system.hpp"
 
 namespace boycott {
 namespace {
@@ -41,7 +41,7 @@ count = 6
   for (const char* kernel : {"cell", "trilinear", "trilinear_smoothed"}) {
     CaseParams q = p;
     q.numerics.void_fraction_kernel = kernel;
-    scenes::CoupledRun run(q, scenes::CoupledOptions{});
+    coupling::CoupledSystem run(q, coupling::CoupledOptions{});
     const double r = 0.3e-3;
     const double pos[6][3] = {{0.0001, 0.003, 0.004},  {0.0079, 0.0031, 0.0079}, {0.004, 0.0003, 0.00001},
                               {0.004, 0.0057, 0.004}, {0.00005, 0.0003, 0.00795}, {0.006, 0.0045, 0.002}};
@@ -77,7 +77,7 @@ viscous = false
 added_mass = false
 saffman_lift = true
 )");
-  scenes::CoupledRun run(p, scenes::CoupledOptions{true, false});
+  coupling::CoupledSystem run(p, coupling::CoupledOptions{true, false});
   const double shear = 20.0, W = 0.006, yp = 0.5 * W + 0.4e-3;
   run.dem().add_particle(0, 0.005, yp, 0.005, 0.3e-3, 2650.0);
   run.start();
@@ -117,7 +117,7 @@ angle_deg = 90.0
 simple_tolerance = 1e-10
 simple_max_iterations = 200
 )");
-  scenes::CoupledRun run(p, scenes::CoupledOptions{true, true});
+  coupling::CoupledSystem run(p, coupling::CoupledOptions{true, true});
   const auto& b = run.dem().config().box;
   run.dem().insert_random(200, 0.3e-3, 2650.0, b.lo, {b.lo[0] + b.len[0], b.lo[1] + b.len[1], b.lo[2] + b.len[2]}, 7);
   run.start();
@@ -196,7 +196,7 @@ magnitude = 0.0
 saffman_lift = false
 added_mass = false
 )");
-  scenes::CoupledRun run(p, scenes::CoupledOptions{false, false});
+  coupling::CoupledSystem run(p, coupling::CoupledOptions{false, false});
   std::int64_t id = 0;
   auto lattice = [&](int n, double z0) {
     const double a = 0.02 / n;

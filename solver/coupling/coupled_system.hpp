@@ -1,27 +1,24 @@
 #pragma once
-// The coupled CFD-DEM time loop shared by the fluid-particle scenes (paper Fig. 2): per CFD step
+// The coupled CFD-DEM time step shared by the fluid-particle scenes (paper Fig. 2): per CFD step
 // sample the fluid at the particles, sub-cycle the DEM, deposit volume and forces, set the
 // driving force, solve the fluid. Scenes choose what runs: frozen particles (no DEM), the
-// zero-slurry-velocity forcing of Eq. 25, which forces are on.
-#include <filesystem>
-#include <functional>
+// zero-slurry-velocity forcing of Eq. 25, which forces are on. Checkpoints, snapshots and the
+// per-step output are the scenes' (scenes/coupled_checkpoint.hpp, scenes/coupled_output.hpp).
+#include <cstdint>
 #include <limits>
 #include <memory>
-#include <optional>
 
 #include "core/case_params.hpp"
 #include "core/timers.hpp"
 #include "coupling/coupler.hpp"
 #include "fluid/fluid_solver.hpp"
-#include "io/checkpoint_file.hpp"
-#include "io/snapshot.hpp"
 #include "particles/dem_system.hpp"
 
-namespace boycott::scenes {
+namespace boycott::coupling {
 
 struct CoupledOptions {
-  bool move_particles = true;   ///< false: frozen bed (ergun), no DEM steps
-  bool zero_slurry_flux = true; ///< Eq. 25: hold alpha_f <w_f> + alpha_p <w_p> = 0 through G(t)
+  bool move_particles = true;    ///< false: frozen bed (ergun), no DEM steps
+  bool zero_slurry_flux = true;  ///< Eq. 25: hold alpha_f <w_f> + alpha_p <w_p> = 0 through G(t)
   /// Instead of Eq. 25: hold the box mean of alpha_f w at this value (m/s) through G(t), e.g. the
   /// bulk velocity of sediment transport; NaN = off.
   double target_mean_flux_z_m_s = std::numeric_limits<double>::quiet_NaN();
@@ -33,13 +30,25 @@ struct CoupledStep {
   fluid::StepReport fluid;
 };
 
-class CoupledRun {
+/// The run-level counters a checkpoint carries beside the engines' own states.
+struct CoupledCounters {
+  double time_s = 0.0, dt_prev_s = 0.0;
+  std::int64_t steps = 0;
+  std::int64_t unconverged_fluid_steps = 0;  ///< over the whole run, resumes included
+  std::int64_t pressure_fallbacks = 0;       ///< over the whole run, resumes included
+};
+
+class CoupledSystem {
  public:
-  CoupledRun(const CaseParams& p, const CoupledOptions& opt);
+  CoupledSystem(const CaseParams& p, const CoupledOptions& opt);
 
   particles::DemSystem& dem() { return *dem_; }
+  const particles::DemSystem& dem() const { return *dem_; }
   fluid::FluidSolver& fluid() { return *fluid_; }
-  coupling::Coupler& coupler() { return *coupler_; }
+  const fluid::FluidSolver& fluid() const { return *fluid_; }
+  Coupler& coupler() { return *coupler_; }
+  const Coupler& coupler() const { return *coupler_; }
+  const CaseParams& params() const { return p_; }
 
   /// After the particles are placed: builds DEM forces, deposits alpha_f, sets the initial G to
   /// the weight of the suspended mixture (so the first step does not start from free fall).
@@ -54,29 +63,14 @@ class CoupledRun {
   std::int64_t pressure_fallbacks() const { return fallbacks_before_ + fluid_->pressure_fallbacks(); }
 
   // Measurements (Eqs. 28, 25).
-  double mean_particle_velocity(int c) const;   ///< <u_p,c>, m/s
-  double mean_fluid_velocity_z() const;         ///< <w_f> = mean(alpha_f w) / mean(alpha_f), m/s
-  double slurry_velocity_z() const;             ///< alpha_f <w_f> + alpha_p <w_p> over the box, m/s
+  double mean_particle_velocity(int c) const;  ///< <u_p,c>, m/s
+  double mean_fluid_velocity_z() const;        ///< <w_f> = mean(alpha_f w) / mean(alpha_f), m/s
+  double slurry_velocity_z() const;            ///< alpha_f <w_f> + alpha_p <w_p> over the box, m/s
   double particle_volume_m3() const;
 
-  /// Everything the next step depends on, under prefixes run., dem., fluid., coupler. (start()
-  /// is not called again on a resumed run).
-  void save(io::CheckpointWriter& w) const;
-  void load(const io::CheckpointReader& r);
-
-  /// Resumes from the newest checkpoint in `run_dir`, if any: refuses one of another case
-  /// (CheckpointError, the file left in place), loads this run's state, lets the scene load its
-  /// own running sums, and cuts the time series back to the checkpoint's time. Returns the wall
-  /// time the run had already spent (s), or nothing when there is no checkpoint to resume.
-  std::optional<double> resume(const std::filesystem::path& run_dir, bool quiet,
-                               const std::function<void(const io::CheckpointReader&)>& load_scene);
-  /// Writes a checkpoint of this run and the scene's running sums (atomically; the newest
-  /// output.keep_checkpoints are kept), recording the wall time spent so far (s).
-  void checkpoint(const std::filesystem::path& run_dir, double wall_time_s,
-                  const std::function<void(io::CheckpointWriter&)>& save_scene) const;
-
-  /// Particles and cell-centred fluid fields (alpha_f, p, u, v, w) now, for io::write_snapshot.
-  io::SnapshotData snapshot() const;
+  CoupledCounters counters() const;
+  /// Restores the counters of a checkpoint (the engines' states are imported separately).
+  void restore_counters(const CoupledCounters& c);
 
   /// Adds the wall time of each part to the timers (call once at the end).
   void report_timers(ModelTimers& t) const;
@@ -88,11 +82,11 @@ class CoupledRun {
   CoupledOptions opt_;
   std::unique_ptr<particles::DemSystem> dem_;
   std::unique_ptr<fluid::FluidSolver> fluid_;
-  std::unique_ptr<coupling::Coupler> coupler_;
+  std::unique_ptr<Coupler> coupler_;
   double time_ = 0.0, dt_prev_ = 0.0;
   std::int64_t steps_ = 0;
   std::int64_t unconverged_ = 0, fallbacks_before_ = 0;  // counts before this process: from the checkpoint
   double seconds_fluid_ = 0.0;
 };
 
-}  // namespace boycott::scenes
+}  // namespace boycott::coupling

@@ -1,20 +1,16 @@
-#include "scenes/coupled_run.hpp"
+#include "coupling/coupled_system.hpp"
 
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 
 #include <fmt/format.h>
 
 #include "core/constants.hpp"
 #include "core/error.hpp"
-#include "core/version.hpp"
-#include "io/state_io.hpp"
-#include "scenes/run_common.hpp"
 
-namespace boycott::scenes {
+namespace boycott::coupling {
 
-CoupledRun::CoupledRun(const CaseParams& p, const CoupledOptions& opt) : p_(p), opt_(opt) {
+CoupledSystem::CoupledSystem(const CaseParams& p, const CoupledOptions& opt) : p_(p), opt_(opt) {
   auto dc = particles::DemConfig::from_case(p);
   dc.track_drag_impulse = true;
   dem_ = std::make_unique<particles::DemSystem>(dc);
@@ -23,17 +19,17 @@ CoupledRun::CoupledRun(const CaseParams& p, const CoupledOptions& opt) : p_(p), 
   fs.body_acceleration_m_s2 = p.gravity_vector();
   if (std::isfinite(opt.target_mean_flux_z_m_s)) fs.target_mean_flux_z_m_s = opt.target_mean_flux_z_m_s;
   fluid_ = std::make_unique<fluid::FluidSolver>(fs);
-  coupler_ = std::make_unique<coupling::Coupler>(coupling::CouplingSettings::from_case(p), fs.grid);
+  coupler_ = std::make_unique<Coupler>(CouplingSettings::from_case(p), fs.grid);
 }
 
-double CoupledRun::particle_volume_m3() const {
+double CoupledSystem::particle_volume_m3() const {
   const auto& s = dem_->particles();
   double v = 0.0;
   for (std::size_t i = 0; i < s.n_local; ++i) v += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i];
   return v;
 }
 
-void CoupledRun::start() {
+void CoupledSystem::start() {
   dem_->initialize();
   coupler_->deposit(*dem_, *fluid_, 0.0);
   if (opt_.zero_slurry_flux) {
@@ -45,7 +41,7 @@ void CoupledRun::start() {
   }
 }
 
-CoupledStep CoupledRun::step() {
+CoupledStep CoupledSystem::step() {
   CoupledStep st;
   const double dt_dem = p_.time.dt_dem_s;
   double dt = std::min(p_.time.dt_cfd_s, fluid_->stable_dt());
@@ -100,100 +96,7 @@ CoupledStep CoupledRun::step() {
   return st;
 }
 
-void CoupledRun::save(io::CheckpointWriter& w) const {
-  w.put("run.time_s", time_);
-  w.put("run.dt_prev_s", dt_prev_);
-  w.put_int("run.steps", steps_);
-  w.put_int("run.unconverged_fluid_steps", unconverged_);
-  w.put_int("run.pressure_fallbacks", pressure_fallbacks());
-  io::save(w, "dem.", dem_->export_state());
-  io::save(w, "fluid.", fluid_->export_state());
-  io::save(w, "coupler.", coupler_->export_state());
-}
-
-void CoupledRun::load(const io::CheckpointReader& r) {
-  time_ = r.scalar("run.time_s");
-  dt_prev_ = r.scalar("run.dt_prev_s");
-  steps_ = r.integer("run.steps");
-  // absent from checkpoints written before these counters existed
-  unconverged_ = r.has("run.unconverged_fluid_steps") ? r.integer("run.unconverged_fluid_steps") : 0;
-  fallbacks_before_ = (r.has("run.pressure_fallbacks") ? r.integer("run.pressure_fallbacks") : 0) - fluid_->pressure_fallbacks();
-  particles::DemState ds;
-  io::load(r, "dem.", ds);
-  dem_->import_state(ds);
-  fluid::FluidState fs;
-  io::load(r, "fluid.", fs);
-  const auto box = fluid_->owned_box();
-  if (fs.box.lo != box.lo || fs.box.size != box.size)
-    throw CheckpointError(fmt::format("{}: the fluid grid was decomposed differently (other rank count?)", r.path().string()));
-  fluid_->import_state(fs);
-  coupler_->import_state(io::load_arrays(r, "coupler."));
-}
-
-std::optional<double> CoupledRun::resume(const std::filesystem::path& run_dir, bool quiet,
-                                         const std::function<void(const io::CheckpointReader&)>& load_scene) {
-  const auto ck = io::latest_checkpoint(run_dir);
-  if (!ck) return std::nullopt;
-  io::CheckpointReader r(*ck);
-  const std::string id = case_id(p_);
-  if (r.string("case_id") != id)
-    throw CheckpointError(fmt::format("{} belongs to case {}, not {}; it is left in place", ck->string(),
-                                      r.string("case_id"), id));
-  load(r);
-  load_scene(r);
-  truncate_csv_after(run_dir / "timeseries.csv", time_);
-  if (!quiet) std::fprintf(stderr, "resuming from %s at t = %g s\n", ck->c_str(), time_);
-  return r.scalar("run.wall_time_s");
-}
-
-void CoupledRun::checkpoint(const std::filesystem::path& run_dir, double wall_time_s,
-                            const std::function<void(io::CheckpointWriter&)>& save_scene) const {
-  io::CheckpointWriter w(io::checkpoint_path(run_dir, steps_));
-  w.put_string("case_id", case_id(p_));
-  w.put_string("case_json", to_json(p_).dump());
-  w.put_string("program_version", std::string(kVersion));
-  save(w);
-  save_scene(w);
-  w.put("run.wall_time_s", wall_time_s);
-  w.commit();
-  io::prune_checkpoints(run_dir, static_cast<int>(p_.output.keep_checkpoints));
-}
-
-io::SnapshotData CoupledRun::snapshot() const {
-  io::SnapshotData d;
-  d.time_s = time_;
-  const auto& s = dem_->particles();
-  const std::size_t n = s.n_local;
-  for (auto [dst, src] : {std::pair{&d.x, &s.x}, {&d.y, &s.y}, {&d.z, &s.z}, {&d.vx, &s.vx}, {&d.vy, &s.vy},
-                          {&d.vz, &s.vz}, {&d.radius, &s.radius}})
-    dst->assign(src->begin(), src->begin() + static_cast<std::ptrdiff_t>(n));
-  const auto& g = fluid_->settings().grid;
-  const int nx = (int)g.n[0], ny = (int)g.n[1], nz = (int)g.n[2];
-  const bool walls = !g.periodic[1];
-  d.cell_fields.emplace_back("alpha_f", fluid_->gather(5));
-  d.cell_fields.emplace_back("pressure", fluid_->gather(3));
-  const char* names[3] = {"u", "v", "w"};
-  for (int c = 0; c < 3; ++c) {
-    const auto f = fluid_->gather(c);  // lower faces
-    std::vector<double> cc(f.size());
-    for (int k = 0; k < nz; ++k)
-      for (int j = 0; j < ny; ++j)
-        for (int i = 0; i < nx; ++i) {
-          const int i1 = c == 0 ? (i + 1) % nx : i, j1 = c == 1 ? j + 1 : j, k1 = c == 2 ? (k + 1) % nz : k;
-          const double lo = f[i + nx * (j + ny * k)];
-          double hi = 0.0;
-          if (c == 1 && j1 == ny)
-            hi = walls ? 0.0 : f[i + nx * (0 + ny * k)];
-          else
-            hi = f[i1 + nx * (j1 + ny * k1)];
-          cc[i + nx * (j + ny * k)] = 0.5 * (lo + hi);
-        }
-    d.cell_fields.emplace_back(names[c], std::move(cc));
-  }
-  return d;
-}
-
-double CoupledRun::mean_particle_velocity(int c) const {
+double CoupledSystem::mean_particle_velocity(int c) const {
   const auto& s = dem_->particles();
   const auto& v = c == 0 ? s.vx : c == 1 ? s.vy : s.vz;
   double sum = 0.0;
@@ -201,19 +104,19 @@ double CoupledRun::mean_particle_velocity(int c) const {
   return s.n_local ? sum / static_cast<double>(s.n_local) : 0.0;
 }
 
-double CoupledRun::mean_fluid_velocity_z() const {
+double CoupledSystem::mean_fluid_velocity_z() const {
   const double af = 1.0 - particle_volume_m3() / p_.box_volume_m3();
   return fluid_->mean_flux_z() / af;
 }
 
-double CoupledRun::slurry_velocity_z() const {
+double CoupledSystem::slurry_velocity_z() const {
   const auto& s = dem_->particles();
   double q = 0.0;
   for (std::size_t i = 0; i < s.n_local; ++i) q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
   return fluid_->mean_flux_z() + q / p_.box_volume_m3();
 }
 
-void CoupledRun::activate_models(ModelTimers& t) const {
+void CoupledSystem::activate_models(ModelTimers& t) const {
   const auto& f = p_.forces;
   t.activate("fluid", fmt::format("set II, {}, QUICK{}", fluid_->settings().coupling_name(),
                                   p_.fluid.subgrid_model == "vreman" ? ", Vreman" : ""));
@@ -236,7 +139,19 @@ void CoupledRun::activate_models(ModelTimers& t) const {
   }
 }
 
-void CoupledRun::report_timers(ModelTimers& t) const {
+CoupledCounters CoupledSystem::counters() const {
+  return CoupledCounters{time_, dt_prev_, steps_, unconverged_, pressure_fallbacks()};
+}
+
+void CoupledSystem::restore_counters(const CoupledCounters& c) {
+  time_ = c.time_s;
+  dt_prev_ = c.dt_prev_s;
+  steps_ = c.steps;
+  unconverged_ = c.unconverged_fluid_steps;
+  fallbacks_before_ = c.pressure_fallbacks - fluid_->pressure_fallbacks();
+}
+
+void CoupledSystem::report_timers(ModelTimers& t) const {
   t.add("fluid", seconds_fluid_);
   t.add("coupling_sample", coupler_->seconds_sample);
   t.add("coupling_deposit", coupler_->seconds_deposit);
@@ -247,4 +162,4 @@ void CoupledRun::report_timers(ModelTimers& t) const {
   }
 }
 
-}  // namespace boycott::scenes
+}  // namespace boycott::coupling

@@ -1,0 +1,28 @@
+#pragma once
+// Checkpoints of a coupled run: what the next step depends on (the engines' states and the
+// run's counters, under the prefixes run., dem., fluid., coupler.) and the scene's own running
+// sums, written atomically; resuming from a run folder's newest checkpoint.
+#include <filesystem>
+#include <functional>
+#include <optional>
+
+#include "coupling/coupled_system.hpp"
+#include "io/checkpoint_file.hpp"
+
+namespace boycott::scenes {
+
+void save_coupled(io::CheckpointWriter& w, const coupling::CoupledSystem& run);
+void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run);
+
+/// Resumes from the newest checkpoint in `run_dir`, if any: refuses one of another case
+/// (CheckpointError, the file left in place), loads this run's state, lets the scene load its
+/// own running sums, and cuts the time series back to the checkpoint's time. Returns the wall
+/// time the run had already spent (s), or nothing when there is no checkpoint to resume.
+std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::filesystem::path& run_dir, bool quiet,
+                                     const std::function<void(const io::CheckpointReader&)>& load_scene);
+/// Writes a checkpoint of this run and the scene's running sums (atomically; the newest
+/// output.keep_checkpoints are kept), recording the wall time spent so far (s).
+void checkpoint_coupled(const coupling::CoupledSystem& run, const std::filesystem::path& run_dir, double wall_time_s,
+                        const std::function<void(io::CheckpointWriter&)>& save_scene);
+
+}  // namespace boycott::scenes

@@ -1,0 +1,59 @@
+#pragma once
+// What a coupled scene writes at the end of each step, written once for all of them: a row of
+// timeseries.csv every output.timeseries_every (and at the last step), snapshots at
+// output.snapshot_times, particle images at output.image_times, and a checkpoint on its clock,
+// at the end and on a stop request.
+#include <string>
+#include <vector>
+
+#include "core/case_params.hpp"
+#include "core/timers.hpp"
+#include "coupling/coupled_system.hpp"
+#include "io/snapshot.hpp"
+#include "scenes/run_common.hpp"
+#include "scenes/scene.hpp"
+
+namespace boycott::scenes {
+
+/// Particles and cell-centred fluid fields (alpha_f, p, u, v, w) of a coupled run now.
+io::SnapshotData coupled_snapshot(const coupling::CoupledSystem& run);
+
+class CoupledSceneOutput {
+ public:
+  /// After the run started or resumed. columns: the scene's time-series columns, "time_s" first;
+  /// next_out_s: when the next row is due (0 on a fresh run, the checkpoint's value on a resumed
+  /// one, whose rows up to the checkpoint are kept).
+  CoupledSceneOutput(const coupling::CoupledSystem& run, const RunContext& ctx, ModelTimers& timers,
+                     std::vector<std::string> columns, bool resumed, double next_out_s);
+
+  /// At the end of a step: row() gives the row's values when one is due; write_checkpoint()
+  /// writes a checkpoint when one is due. Returns true when the scene must leave its loop (a
+  /// stop request; the summary is then marked interrupted).
+  template <class Row, class WriteCheckpoint>
+  bool after_step(Row&& row, WriteCheckpoint&& write_checkpoint, SummaryBase& summary) {
+    const double t = run_.time_s(), end = run_.params().time.end_s;
+    if (t >= next_out_s_ - 1e-12 || t >= end - 1e-12) {
+      csv_.row(row());
+      next_out_s_ = t + out_every_s_;
+      if (ctx_.progress) ctx_.progress(t);
+    }
+    write_pictures(t);
+    return checkpoint_or_stop(ctx_.should_stop(), ctx_.quiet, checkpoints_, t, end, csv_, write_checkpoint, summary);
+  }
+  /// When the next time-series row is due (s): part of a scene's checkpoint.
+  double next_out_s() const { return next_out_s_; }
+  void flush() { csv_.flush(); }
+
+ private:
+  void write_pictures(double t);
+
+  const coupling::CoupledSystem& run_;
+  const RunContext& ctx_;
+  ModelTimers& timers_;
+  CsvWriter csv_;
+  double out_every_s_ = 0.0, next_out_s_ = 0.0;
+  CheckpointClock checkpoints_;
+  OutputTimes snapshots_, images_;
+};
+
+}  // namespace boycott::scenes
