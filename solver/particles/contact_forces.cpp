@@ -238,12 +238,8 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
         double rtx = 0.0, rty = 0.0, rtz = 0.0;
         if constexpr (Rolling::enabled) {
           // The wall is a sphere of infinite inertia at rest (a_j = 0).
-          const double on = spx[i] * nx + spy[i] * ny + spz[i] * nz;
-          const double ia = inertia[i] / ri;
-          const double qx = (spx[i] - on * nx) * inv_dt * ia - mx;
-          const double qy = (spy[i] - on * ny) * inv_dt * ia - my;
-          const double qz = (spz[i] - on * nz) * inv_dt * ia - mz;
-          cap_rolling(qx, qy, qz, rolling.mu_r * std::abs(fn), rtx, rty, rtz);
+          rolling_resistance(spx[i], spy[i], spz[i], nx, ny, nz, mx, my, mz, ri / inertia[i], 0.0, inv_dt,
+                             rolling.mu_r * std::abs(fn), rtx, rty, rtz);
         }
         tx[i] += -ri * (mx + rtx);
         ty[i] += -ri * (my + rty);
