@@ -2,6 +2,9 @@
 // `boycott study run|status`: runs the missing cases of a study as child processes
 // (`boycott case run CASE --out DIR`, optionally under mpirun), records every attempt and result
 // in the study database, and resumes, skips or retries cases from what the database says.
+// study_run sets up and reports; the parts: scheduler.hpp (queue, slots, retries, stop),
+// solver_process.hpp (locks, fork/exec, signals, reaping), recording.hpp (run folder to rows),
+// progress.hpp (live display). None of them holds SQL: they read and write through store.hpp.
 #include <string>
 #include <vector>
 

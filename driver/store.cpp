@@ -165,6 +165,12 @@ void record_result(Database& db, std::int64_t attempt, const std::string& case_i
   });
 }
 
+bool has_result(Database& db, const std::string& case_id) {
+  auto st = db.prepare("SELECT 1 FROM results WHERE case_id = ?1");
+  st.bind(1, case_id);
+  return st.step();
+}
+
 const char* to_string(CaseStatus s) {
   switch (s) {
     case CaseStatus::kPending:

@@ -22,6 +22,8 @@ void finish_attempt(Database& db, std::int64_t attempt, int exit_status, const s
 /// Closes the attempt and stores the result from the solver's summary.json, in one transaction.
 void record_result(Database& db, std::int64_t attempt, const std::string& case_id,
                    const nlohmann::json& summary);
+/// Whether the case has a result (recorded by any driver on this database).
+bool has_result(Database& db, const std::string& case_id);
 
 enum class CaseStatus { kPending, kRunning, kDone, kFailed, kInterrupted };
 const char* to_string(CaseStatus s);

@@ -1,0 +1,83 @@
+#include "driver/recording.hpp"
+
+#include <signal.h>
+
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "driver/store.hpp"
+
+namespace fs = std::filesystem;
+
+namespace boycott::driver {
+namespace {
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// The last non-empty line the solver wrote to its log since `offset_bytes`: its one-line reason.
+std::string last_line(const fs::path& log, std::uintmax_t offset_bytes) {
+  std::ifstream in(log);
+  if (!in) return "";
+  in.seekg(static_cast<std::streamoff>(offset_bytes));
+  std::string line, last;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
+  return last;
+}
+
+}  // namespace
+
+AttemptEnd record_attempt_end(Database& db, const RunningCase& run, int exit_code) {
+  const StudyCase* c = run.c;
+  if (exit_code == 0) {
+    std::string why;
+    try {
+      const auto summary = nlohmann::json::parse(read_text(run.dir / "summary.json"));
+      if (summary.value("case_id", "") != c->id)
+        why = fmt::format("summary.json is for case '{}'", summary.value("case_id", ""));
+      else
+        record_result(db, run.attempt, c->id, summary);
+    } catch (const nlohmann::json::exception&) {
+      why = "exit 0 without a readable summary.json";
+    }
+    if (why.empty()) return {AttemptEnd::Kind::kDone, 0, ""};
+    finish_attempt(db, run.attempt, 1, why);
+    return {AttemptEnd::Kind::kFailed, 1, why};
+  }
+  if (exit_code == kExitInterrupted || exit_code == 128 + SIGTERM || exit_code == 128 + SIGINT) {
+    finish_attempt(db, run.attempt, exit_code,
+                   exit_code == kExitInterrupted ? "interrupted after a checkpoint"
+                                                 : "stopped by a signal while starting");
+    return {AttemptEnd::Kind::kInterrupted, exit_code, ""};
+  }
+  std::string why = last_line(run.dir / "solver.log", run.log_offset_bytes);
+  if (why.empty()) why = exit_code > 128 ? fmt::format("killed by signal {}", exit_code - 128) : "no message";
+  finish_attempt(db, run.attempt, exit_code, why);
+  return {AttemptEnd::Kind::kFailed, exit_code, why};
+}
+
+bool record_left_summary(Database& db, std::int64_t attempt, const std::string& case_id,
+                         const fs::path& run_dir) {
+  if (!fs::exists(run_dir / "summary.json")) return false;
+  try {
+    const auto summary = nlohmann::json::parse(read_text(run_dir / "summary.json"));
+    if (summary.value("status", "") == "done" && summary.value("case_id", "") == case_id) {
+      record_result(db, attempt, case_id, summary);
+      return true;
+    }
+  } catch (const nlohmann::json::exception&) {
+    // Unreadable (cut short): the solver runs again and rewrites it.
+  }
+  return false;
+}
+
+}  // namespace boycott::driver

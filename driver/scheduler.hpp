@@ -1,0 +1,55 @@
+#pragma once
+// Scheduling of `study run`: which case runs next (the queue of the cases that the database shows
+// neither done nor failed, in study order), how many run at once (--jobs slots, each case on
+// --ranks processes), which failed cases run again (--retries, counted over all runs of the
+// study), and how a stop signal drains the running cases.
+#include <deque>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "driver/database.hpp"
+#include "driver/progress.hpp"
+#include "driver/runner.hpp"
+#include "driver/solver_process.hpp"
+#include "driver/store.hpp"
+#include "driver/study.hpp"
+
+namespace boycott::driver {
+
+class Scheduler {
+ public:
+  /// Queues the cases of `study` that `states` (case_states of db) shows neither done nor failed;
+  /// each runs as `solver` in <runs_root>/<case_id>/. study and opt must outlive the scheduler.
+  Scheduler(Database& db, const Study& study, const std::vector<CaseState>& states,
+            const StudyRunOptions& opt, std::filesystem::path runs_root, std::vector<std::string> solver);
+
+  /// Runs cases until the queue is empty, or after a stop signal until the running cases have
+  /// checkpointed and exited; true when a stop signal ended it.
+  bool run();
+
+ private:
+  /// Starts the case, or records it without running it when its result is already there; false
+  /// while another process holds its run folder.
+  bool start(const StudyCase* c);
+  /// Records how a solver ended and decides whether its case runs again.
+  void finish(const RunningCase& run, int exit_code);
+  void reap(const SolverExit& exited);
+  void stop_all();
+  ProgressCounts counts() const;
+
+  Database& db_;
+  const StudyRunOptions& opt_;
+  std::filesystem::path runs_root_;
+  std::vector<std::string> solver_;
+  std::deque<const StudyCase*> queue_;
+  std::map<std::string, int> failures_;  ///< failed attempts by case id, over all runs of the study
+  int done_ = 0;
+  int failed_ = 0;
+  std::vector<RunningCase> running_;
+  bool stopping_ = false;
+  ProgressDisplay progress_;
+};
+
+}  // namespace boycott::driver
