@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 
+#include "core/error.hpp"
 #include "core/version.hpp"
 
 namespace boycott::driver {
@@ -276,7 +277,8 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
   }
   // The setting names only what varies within the group (a group's own `set` is its name's job).
   std::vector<std::vector<SweptValue>> swept(pts.size());
-  std::map<std::string, std::map<std::string, std::set<std::string>>> values_in_group;  // group -> key -> values
+  std::map<std::string, std::map<std::string, std::set<std::string>>>
+      values_in_group;  // group -> key -> values
   for (std::size_t i = 0; i < pts.size(); ++i) {
     swept[i] = case_swept_values(db, pts[i].case_id);
     for (const auto& v : swept[i]) values_in_group[pts[i].group][v.key].insert(v.value);
@@ -311,6 +313,64 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
     p.r_acc_err = (&p == ref || p.case_id == ref->case_id) ? 0.0 : std::abs(r) * std::hypot(rel_p, rel_ref);
   }
   return pts;
+}
+
+void require_study(Database& db, const std::string& study) {
+  auto st = db.prepare("SELECT COUNT(*) FROM studies WHERE name = ?1");
+  st.bind(1, study);
+  st.step();
+  if (st.integer(0) == 0) throw InputError(fmt::format("no study '{}' in '{}'", study, db.path()));
+}
+
+std::vector<std::string> study_groups(Database& db, const std::string& study) {
+  auto st = db.prepare(
+      "SELECT group_name FROM study_cases WHERE study = ?1 GROUP BY group_name ORDER BY MIN(position)");
+  st.bind(1, study);
+  std::vector<std::string> groups;
+  while (st.step()) groups.push_back(st.text(0));
+  return groups;
+}
+
+std::vector<StoredResult> stored_results(Database& db, const std::string& study) {
+  // LEFT JOIN: without a study filter, a result whose case left every study still shows.
+  auto st = db.prepare(
+      "SELECT sc.study, sc.group_name, c.id, c.scene, r.mean_settling_velocity_m_s, r.wall_time_s, "
+      "r.validation_errors_json FROM results r JOIN cases c ON c.id = r.case_id "
+      "LEFT JOIN study_cases sc ON sc.case_id = c.id WHERE (?1 = '' OR sc.study = ?1) "
+      "ORDER BY sc.study IS NULL, sc.study, sc.position, c.id");
+  st.bind(1, study);
+  std::vector<StoredResult> out;
+  while (st.step()) {
+    StoredResult r;
+    if (!st.is_null(0)) r.study = st.text(0);
+    if (!st.is_null(1)) r.group = st.text(1);
+    r.case_id = st.text(2);
+    r.scene = st.text(3);
+    if (!st.is_null(4)) r.w_m_s = st.real(4);
+    if (!st.is_null(5)) r.wall_time_s = st.real(5);
+    if (!st.is_null(6)) r.validation_errors_json = st.text(6);
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+std::vector<SettlingResult> settling_results(Database& db, const std::string& study) {
+  auto st = db.prepare(
+      "SELECT sc.group_name, c.id, c.angle_deg, r.mean_settling_velocity_m_s, "
+      "r.settling_velocity_stderr_m_s, "
+      "r.wall_time_s, r.particle_steps FROM study_cases sc JOIN cases c ON c.id = sc.case_id "
+      "JOIN results r ON r.case_id = c.id WHERE sc.study = ?1 AND r.mean_settling_velocity_m_s IS NOT NULL "
+      "ORDER BY sc.position");
+  st.bind(1, study);
+  std::vector<SettlingResult> out;
+  while (st.step()) {
+    SettlingResult r{st.text(0),   st.text(1),  st.real(2), st.real(3), st.is_null(4) ? 0.0 : st.real(4),
+                     std::nullopt, std::nullopt};
+    if (!st.is_null(5)) r.wall_time_s = st.real(5);
+    if (!st.is_null(6)) r.particle_steps = st.integer(6);
+    out.push_back(std::move(r));
+  }
+  return out;
 }
 
 }  // namespace boycott::driver

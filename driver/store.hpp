@@ -1,6 +1,7 @@
 #pragma once
 // What the driver writes to and reads from the study database; each function that writes is
 // one transaction.
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -68,5 +69,35 @@ std::vector<SweptValue> case_swept_values(Database& db, const std::string& case_
 
 /// The correlation curve of finished cases, per group in study order, by angle.
 std::vector<CurvePoint> query_curve(Database& db, const std::string& study, const std::string& group = "");
+
+/// InputError "no study 'S' in 'FILE'" when the database has no study of that name.
+void require_study(Database& db, const std::string& study);
+
+/// The groups of a study in study order (the first position of any of their cases).
+std::vector<std::string> study_groups(Database& db, const std::string& study);
+
+/// A recorded result as `query validation` reads it; unset where the column is null.
+struct StoredResult {
+  std::optional<std::string> study, group;  ///< unset for a case that no study lists any more
+  std::string case_id, scene;
+  std::optional<double> w_m_s, wall_time_s;
+  std::optional<std::string> validation_errors_json;  ///< as stored, not parsed
+};
+
+/// Every result, once per study group its case belongs to (and once with no study for a case that
+/// none lists), of one study (or all, study empty); by study (none last), position, case id.
+std::vector<StoredResult> stored_results(Database& db, const std::string& study);
+
+/// A finished case with a <<w_p>>, as `query work-precision` reads it.
+struct SettlingResult {
+  std::string group, case_id;
+  double angle_deg = 0;
+  double w_m_s = 0, w_err_m_s = 0;  ///< <<w_p>> and its standard error (0 when not recorded)
+  std::optional<double> wall_time_s;
+  std::optional<std::int64_t> particle_steps;
+};
+
+/// The study's cases with a recorded <<w_p>>, once per group they belong to, in study order.
+std::vector<SettlingResult> settling_results(Database& db, const std::string& study);
 
 }  // namespace boycott::driver

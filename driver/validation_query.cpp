@@ -4,20 +4,11 @@
 
 #include <fmt/format.h>
 
-#include "core/error.hpp"
 #include "driver/report_util.hpp"
 
 namespace boycott::driver {
 
 namespace {
-
-void require_study(Database& db, const std::string& study) {
-  if (study.empty()) return;
-  auto st = db.prepare("SELECT COUNT(*) FROM studies WHERE name = ?1");
-  st.bind(1, study);
-  st.step();
-  if (st.integer(0) == 0) throw InputError(fmt::format("no study '{}' in '{}'", study, db.path()));
-}
 
 /// A stored error for people. The scenes' "error" keys are relative errors ("rel" in the name);
 /// anything else (a count, an absolute error with a unit) is shown as it is.
@@ -54,31 +45,24 @@ nlohmann::json opt_json(const std::optional<double>& v) {
 }  // namespace
 
 std::vector<ValidationRow> query_validation(Database& db, const std::string& study) {
-  require_study(db, study);
-  // LEFT JOIN: without a study filter, a result whose case left every study still shows.
-  auto st = db.prepare(
-      "SELECT sc.study, sc.group_name, c.id, c.scene, r.mean_settling_velocity_m_s, r.wall_time_s, "
-      "r.validation_errors_json FROM results r JOIN cases c ON c.id = r.case_id "
-      "LEFT JOIN study_cases sc ON sc.case_id = c.id WHERE (?1 = '' OR sc.study = ?1) "
-      "ORDER BY sc.study IS NULL, sc.study, sc.position, c.id");
-  st.bind(1, study);
+  if (!study.empty()) require_study(db, study);
   std::vector<ValidationRow> rows;
-  while (st.step()) {
+  for (auto& stored : stored_results(db, study)) {
     ValidationRow r;
-    r.study = st.is_null(0) ? "-" : st.text(0);
-    r.group = st.is_null(1) ? "-" : st.text(1);
-    r.case_id = st.text(2);
-    r.scene = st.text(3);
-    if (!st.is_null(4)) r.w_m_s = st.real(4);
-    if (!st.is_null(5)) r.wall_time_s = st.real(5);
+    r.study = stored.study.value_or("-");
+    r.group = stored.group.value_or("-");
+    r.case_id = std::move(stored.case_id);
+    r.scene = std::move(stored.scene);
+    r.w_m_s = stored.w_m_s;
+    r.wall_time_s = stored.wall_time_s;
     // Written by record_result as an object; anything else (hand-edited, older drivers) is shown
     // as one entry rather than refused, so one odd row does not hide the others.
-    if (!st.is_null(6)) {
-      const auto j = nlohmann::json::parse(st.text(6), nullptr, /*allow_exceptions=*/false);
+    if (const auto& text = stored.validation_errors_json) {
+      const auto j = nlohmann::json::parse(*text, nullptr, /*allow_exceptions=*/false);
       if (j.is_object())
         for (const auto& [k, v] : j.items()) r.errors.emplace_back(k, v);
       else if (!j.is_null())
-        r.errors.emplace_back("validation_errors_json", j.is_discarded() ? nlohmann::json(st.text(6)) : j);
+        r.errors.emplace_back("validation_errors_json", j.is_discarded() ? nlohmann::json(*text) : j);
     }
     rows.push_back(std::move(r));
   }

@@ -16,23 +16,15 @@ namespace {
 
 constexpr const char* kAngleKey = "gravity.angle_deg";
 
-struct FinishedRun {
-  std::string group, case_id;
-  double angle_deg = 0;
-  double w = 0, w_err = 0;
-  std::optional<double> wall_time_s;
-  std::optional<std::int64_t> particle_steps;
-};
-
 std::vector<SweptValue> setting_of(Database& db, const std::string& case_id) {
   auto v = case_swept_values(db, case_id);
   std::erase_if(v, [](const SweptValue& x) { return x.key == kAngleKey; });
   return v;
 }
 
-const FinishedRun& reference_at(const std::vector<FinishedRun>& refs, const std::string& ref_group,
-                                Database& db, const FinishedRun& run) {
-  std::vector<const FinishedRun*> found;
+const SettlingResult& reference_at(const std::vector<SettlingResult>& refs, const std::string& ref_group,
+                                   Database& db, const SettlingResult& run) {
+  std::vector<const SettlingResult*> found;
   for (const auto& r : refs)
     if (r.angle_deg == run.angle_deg) found.push_back(&r);
   if (found.empty())
@@ -51,7 +43,7 @@ const FinishedRun& reference_at(const std::vector<FinishedRun>& refs, const std:
                     "one case per angle",
                     ref_group, found.size(), kAngleKey, run.angle_deg, names));
   }
-  if (found[0]->w == 0.0)
+  if (found[0]->w_m_s == 0.0)
     throw InputError(
         fmt::format("reference case {} at {} = {:g} has <<w_p>> = 0: the relative error is undefined",
                     found[0]->case_id, kAngleKey, run.angle_deg));
@@ -75,19 +67,8 @@ nlohmann::json opt_json(const std::optional<double>& v) {
 
 WorkPrecision query_work_precision(Database& db, const std::string& study,
                                    const std::string& reference_group) {
-  {
-    auto st = db.prepare("SELECT COUNT(*) FROM studies WHERE name = ?1");
-    st.bind(1, study);
-    st.step();
-    if (st.integer(0) == 0) throw InputError(fmt::format("no study '{}' in '{}'", study, db.path()));
-  }
-  std::vector<std::string> groups;  // study order
-  {
-    auto st = db.prepare(
-        "SELECT group_name FROM study_cases WHERE study = ?1 GROUP BY group_name ORDER BY MIN(position)");
-    st.bind(1, study);
-    while (st.step()) groups.push_back(st.text(0));
-  }
+  require_study(db, study);
+  const std::vector<std::string> groups = study_groups(db, study);  // study order
   if (std::find(groups.begin(), groups.end(), reference_group) == groups.end()) {
     std::string names;
     for (const auto& g : groups) names += (names.empty() ? "" : ", ") + g;
@@ -97,23 +78,9 @@ WorkPrecision query_work_precision(Database& db, const std::string& study,
                     study, reference_group, names.empty() ? "none" : names));
   }
 
-  std::vector<FinishedRun> refs, runs;
-  {
-    auto st = db.prepare(
-        "SELECT sc.group_name, c.id, c.angle_deg, r.mean_settling_velocity_m_s, "
-        "r.settling_velocity_stderr_m_s, "
-        "r.wall_time_s, r.particle_steps FROM study_cases sc JOIN cases c ON c.id = sc.case_id "
-        "JOIN results r ON r.case_id = c.id WHERE sc.study = ?1 AND r.mean_settling_velocity_m_s IS NOT NULL "
-        "ORDER BY sc.position");
-    st.bind(1, study);
-    while (st.step()) {
-      FinishedRun r{st.text(0),   st.text(1),  st.real(2), st.real(3), st.is_null(4) ? 0.0 : st.real(4),
-                    std::nullopt, std::nullopt};
-      if (!st.is_null(5)) r.wall_time_s = st.real(5);
-      if (!st.is_null(6)) r.particle_steps = st.integer(6);
-      (r.group == reference_group ? refs : runs).push_back(std::move(r));
-    }
-  }
+  std::vector<SettlingResult> refs, runs;
+  for (auto& r : settling_results(db, study))
+    (r.group == reference_group ? refs : runs).push_back(std::move(r));
 
   WorkPrecision wp{study, reference_group, {}, {}};
   for (const auto& run : runs) {
@@ -125,18 +92,19 @@ WorkPrecision query_work_precision(Database& db, const std::string& study,
     row.angle_deg = run.angle_deg;
     row.wall_time_s = run.wall_time_s;
     row.particle_steps = run.particle_steps;
-    row.w_m_s = run.w;
-    row.w_err_m_s = run.w_err;
+    row.w_m_s = run.w_m_s;
+    row.w_err_m_s = run.w_err_m_s;
     row.ref_case_id = ref.case_id;
-    row.w_ref_m_s = ref.w;
-    row.w_ref_err_m_s = ref.w_err;
+    row.w_ref_m_s = ref.w_m_s;
+    row.w_ref_err_m_s = ref.w_err_m_s;
     // e = w/w_ref - 1; de/dw = 1/w_ref, de/dw_ref = -w/w_ref^2 (independent standard errors).
-    row.rel_error_w = run.w / ref.w - 1.0;
-    row.rel_error_w_unc = std::hypot(run.w_err / ref.w, run.w * ref.w_err / (ref.w * ref.w));
+    row.rel_error_w = run.w_m_s / ref.w_m_s - 1.0;
+    row.rel_error_w_unc =
+        std::hypot(run.w_err_m_s / ref.w_m_s, run.w_m_s * ref.w_err_m_s / (ref.w_m_s * ref.w_m_s));
     wp.rows.push_back(std::move(row));
     if (std::none_of(wp.references.begin(), wp.references.end(),
                      [&](const ReferenceRun& r) { return r.case_id == ref.case_id; }))
-      wp.references.push_back({ref.case_id, ref.angle_deg, ref.w, ref.w_err, ref.wall_time_s});
+      wp.references.push_back({ref.case_id, ref.angle_deg, ref.w_m_s, ref.w_err_m_s, ref.wall_time_s});
   }
 
   // r_acc against the reference's r_acc: the quantity the paper reports, whose error can be far
