@@ -2,11 +2,14 @@
 
 #include <chrono>
 #include <cmath>
+#include <memory>
+#include <vector>
 
 #include <fmt/format.h>
 
 #include "core/constants.hpp"
 #include "core/error.hpp"
+#include "coupling/slab_exchange.hpp"
 
 namespace boycott::coupling {
 
@@ -18,18 +21,72 @@ CoupledSystem::CoupledSystem(const CaseParams& p, const CoupledOptions& opt) : p
   // The fluid feels gravity (alpha_f rho_f g in set II) and, in z, the driving gradient G.
   fs.body_acceleration_m_s2 = p.gravity_vector();
   if (std::isfinite(opt.target_mean_flux_z_m_s)) fs.target_mean_flux_z_m_s = opt.target_mean_flux_z_m_s;
-  fluid_ = std::make_unique<fluid::FluidSolver>(fs);
-  coupler_ = std::make_unique<Coupler>(CouplingSettings::from_case(p), fs.grid);
+  const MPI_Comm comm = PETSC_COMM_WORLD;
+  MPI_Comm_size(comm, &ranks_);
+  if (ranks_ > 1) check_rank_count(fs.grid, ranks_);
+  fluid_ = std::make_unique<fluid::FluidSolver>(fs, comm);
+  std::shared_ptr<const SlabExchange> window;
+  if (ranks_ > 1) {
+    // The fluid's z-slabs, which the particles follow; the window reaches the planes a
+    // particle up to one cell outside the slab samples and deposits on, and the stencils that
+    // derive the sampled fields (fluid_fields.cpp).
+    const auto box = fluid_->owned_box();
+    const int nz = static_cast<int>(fs.grid.n[2]);
+    if (box.lo[0] != 0 || box.lo[1] != 0 || box.size[0] != fs.grid.n[0] || box.size[1] != fs.grid.n[1])
+      throw InputError(fmt::format("the fluid grid is not cut into z-slabs on {} ranks: at most {} ranks for {} "
+                                   "planes in z",
+                                   ranks_, max_ranks(nz), nz));
+    std::vector<int> begins(static_cast<std::size_t>(ranks_) + 1);
+    const int mine = static_cast<int>(box.lo[2]);
+    MPI_Allgather(&mine, 1, MPI_INT, begins.data(), 1, MPI_INT, comm);
+    begins.back() = nz;
+    window = std::make_shared<SlabExchange>(comm, begins, kWindowBelow, kWindowAbove);
+  }
+  coupler_ = std::make_unique<Coupler>(CouplingSettings::from_case(p), fs.grid, window);
+}
+
+int CoupledSystem::max_ranks(int nz) {
+  // FFTW's slabs (its default block, ceil(nz / N) planes) with at least 2 planes on every rank.
+  int best = 1;
+  for (int n = 2; n <= nz; ++n) {
+    const int b = (nz + n - 1) / n;
+    if (nz - (n - 1) * b >= 2) best = n;
+  }
+  return best;
+}
+
+void CoupledSystem::check_rank_count(const GridSpec& g, int ranks) {
+  const int nz = static_cast<int>(g.n[2]);
+  if (ranks > max_ranks(nz))
+    throw InputError(fmt::format("{} MPI ranks: a coupled case cuts its {} planes in z into slabs of at least 2 "
+                                 "planes, so at most N_max = {} ranks",
+                                 ranks, nz, max_ranks(nz)));
+}
+
+void CoupledSystem::decompose() {
+  if (decomposed_) return;
+  decomposed_ = true;
+  if (ranks_ == 1) return;
+  const auto box = fluid_->owned_box();
+  const double hz = fluid_->settings().grid.dx(2), z0 = dem_->config().box.lo[2];
+  dem_->decompose(particles::SlabDecomposition::gather(fluid_->comm(), z0 + box.lo[2] * hz,
+                                                       z0 + (box.lo[2] + box.size[2]) * hz));
+}
+
+double CoupledSystem::global_sum(double local) const {
+  // Before the particles are shared out, every rank holds all of them.
+  return dem_->decomposition().parallel() ? particles::ordered_sum(fluid_->comm(), local) : local;
 }
 
 double CoupledSystem::particle_volume_m3() const {
   const auto& s = dem_->particles();
   double v = 0.0;
   for (std::size_t i = 0; i < s.n_local; ++i) v += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i];
-  return v;
+  return global_sum(v);
 }
 
 void CoupledSystem::start() {
+  decompose();
   dem_->initialize();
   coupler_->deposit(*dem_, *fluid_, 0.0);
   if (opt_.zero_slurry_flux) {
@@ -69,7 +126,8 @@ CoupledStep CoupledSystem::step() {
     double sum = 0.0;
     for (std::size_t i = 0; i < s.n_local; ++i)
       sum += s.x[i] + s.y[i] + s.z[i] + s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i];
-    if (!std::isfinite(sum))
+    // Every rank stops together (a NaN on one rank would otherwise leave the others waiting).
+    if (!std::isfinite(global_sum(sum)))
       throw PhysicsError(fmt::format("particle state became NaN or Inf at t = {:.6g} s (CFD step {}); nothing was "
                                      "checkpointed after the last good state",
                                      time_ + dt, steps_ + 1));
@@ -81,7 +139,7 @@ CoupledStep CoupledSystem::step() {
     const auto& s = dem_->particles();
     double q = 0.0;
     for (std::size_t i = 0; i < s.n_local; ++i) q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
-    fluid_->set_target_mean_flux_z(-q / p_.box_volume_m3());
+    fluid_->set_target_mean_flux_z(-global_sum(q) / p_.box_volume_m3());
   }
   const auto t0 = std::chrono::steady_clock::now();
   st.fluid = fluid_->step(dt);
@@ -101,7 +159,9 @@ double CoupledSystem::mean_particle_velocity(int c) const {
   const auto& v = c == 0 ? s.vx : c == 1 ? s.vy : s.vz;
   double sum = 0.0;
   for (std::size_t i = 0; i < s.n_local; ++i) sum += v[i];
-  return s.n_local ? sum / static_cast<double>(s.n_local) : 0.0;
+  if (!dem_->decomposition().parallel()) return s.n_local ? sum / static_cast<double>(s.n_local) : 0.0;
+  const std::int64_t n = dem_->global_count();
+  return n ? global_sum(sum) / static_cast<double>(n) : 0.0;
 }
 
 double CoupledSystem::mean_fluid_velocity_z() const {
@@ -113,7 +173,7 @@ double CoupledSystem::slurry_velocity_z() const {
   const auto& s = dem_->particles();
   double q = 0.0;
   for (std::size_t i = 0; i < s.n_local; ++i) q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
-  return fluid_->mean_flux_z() + q / p_.box_volume_m3();
+  return fluid_->mean_flux_z() + global_sum(q) / p_.box_volume_m3();
 }
 
 void CoupledSystem::activate_models(ModelTimers& t) const {

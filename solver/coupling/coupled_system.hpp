@@ -50,9 +50,20 @@ class CoupledSystem {
   const Coupler& coupler() const { return *coupler_; }
   const CaseParams& params() const { return p_; }
 
-  /// After the particles are placed: builds DEM forces, deposits alpha_f, sets the initial G to
-  /// the weight of the suspended mixture (so the first step does not start from free fall).
+  /// After the particles are placed (every rank places all of them): keeps each rank's own,
+  /// builds DEM forces, deposits alpha_f, sets the initial G to the weight of the suspended
+  /// mixture (so the first step does not start from free fall).
   void start();
+  /// Shares the particles among the ranks (start() does it; a resumed run, before loading).
+  void decompose();
+  int ranks() const { return ranks_; }
+  /// A sum of the ranks' particle values in rank order (the value itself on one rank, or before
+  /// the particles are shared out): the same bits on every rank.
+  double global_sum(double local) const;
+  /// The most MPI ranks a coupled case of nz planes in z can use (2 planes per slab).
+  static int max_ranks(int nz);
+  /// Throws InputError naming N_max when `ranks` exceeds it.
+  static void check_rank_count(const GridSpec& g, int ranks);
   /// One CFD step of at most time.dt_cfd (CFL-limited), a whole number of DEM sub-steps.
   CoupledStep step();
   double time_s() const { return time_; }
@@ -66,7 +77,7 @@ class CoupledSystem {
   double mean_particle_velocity(int c) const;  ///< <u_p,c>, m/s
   double mean_fluid_velocity_z() const;        ///< <w_f> = mean(alpha_f w) / mean(alpha_f), m/s
   double slurry_velocity_z() const;            ///< alpha_f <w_f> + alpha_p <w_p> over the box, m/s
-  double particle_volume_m3() const;
+  double particle_volume_m3() const;  ///< all ranks
 
   CoupledCounters counters() const;
   /// Restores the counters of a checkpoint (the engines' states are imported separately).
@@ -78,8 +89,15 @@ class CoupledSystem {
   void activate_models(ModelTimers& t) const;
 
  private:
+  // The coupling's halo of planes beyond a rank's slab (slab_exchange.hpp), below and above:
+  // a particle reaches one cell past its slab face (skin/2 < one cell), its kernel one cell
+  // more and the face fields one face more, and the fields are derived with one-plane stencils.
+  static constexpr int kWindowBelow = 3, kWindowAbove = 4;
+
   CaseParams p_;
   CoupledOptions opt_;
+  int ranks_ = 1;
+  bool decomposed_ = false;
   std::unique_ptr<particles::DemSystem> dem_;
   std::unique_ptr<fluid::FluidSolver> fluid_;
   std::unique_ptr<Coupler> coupler_;

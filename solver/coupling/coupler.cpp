@@ -1,22 +1,21 @@
 #include "coupling/coupler.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 #include <fmt/format.h>
 
 #include "core/constants.hpp"
 #include "core/error.hpp"
+#include "core/timers.hpp"
 #include "coupling/drag_laws.hpp"
 #include "fluid/fluid_solver.hpp"
 #include "particles/dem_system.hpp"
 
 namespace boycott::coupling {
 
-namespace {
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-}  // namespace
 
 CouplingSettings CouplingSettings::from_case(const CaseParams& p) {
   CouplingSettings s;
@@ -32,13 +31,16 @@ CouplingSettings CouplingSettings::from_case(const CaseParams& p) {
   return s;
 }
 
-Coupler::Coupler(const CouplingSettings& s, const GridSpec& g) : s_(s), g_(g), fields_(g, s.top_slip) {
-  const bool per[3] = {g.periodic[0], g.periodic[1], g.periodic[2]};
-  const int nx = (int)g.n[0], ny = (int)g.n[1], nz = (int)g.n[2];
-  solid_.resize(nx, ny, nz, per);
+Coupler::Coupler(const CouplingSettings& s, const GridSpec& g, std::shared_ptr<const SlabExchange> window)
+    : s_(s), g_(g), window_(std::move(window)), fields_(g, s.top_slip, window_.get()) {
+  bool per[3] = {g.periodic[0], g.periodic[1], g.periodic[2]};
+  const int nx = (int)g.n[0], ny = (int)g.n[1];
+  int nz = (int)g.n[2], k0 = 0;
+  if (window_) nz = window_->window_planes(), k0 = window_->window_begin(), per[2] = false;
+  solid_.resize(nx, ny, nz, per, k0);
   for (int c = 0; c < 3; ++c) {
     const int nyc = (c == 1 && !g.periodic[1]) ? ny + 1 : ny;
-    for (GridField* f : {&K_[c], &KU_[c], &S_[c]}) f->resize(nx, nyc, nz, per);
+    for (GridField* f : {&K_[c], &KU_[c], &S_[c]}) f->resize(nx, nyc, nz, per, k0);
   }
 }
 
@@ -47,22 +49,19 @@ Coupler::Stencil Coupler::stencil(double x, double y, double z) const {
   const double pos[3] = {x, y, z};
   for (int d = 0; d < 3; ++d) {
     st.cell[d] = cell_weights(s_.kernel, pos[d], g_.dx(d), (int)g_.n[d], !g_.periodic[d]);
+    if (d == 2 && window_) {
+      // The particle's periodic image that lies in this rank's window.
+      const int nz = (int)g_.n[2], lo = solid_.k0, hi = solid_.k0 + solid_.nz;
+      Weights1D& w = st.cell[2];
+      while (w.first < lo) w.first += nz;
+      while (w.first + w.n + 1 > hi) w.first -= nz;
+      if (w.first < lo)
+        throw PhysicsError(fmt::format("a particle at z = {:.6g} m is outside the planes its rank holds ({} to {})",
+                                       z, lo, hi - 1));
+    }
     st.face[d] = face_weights(st.cell[d]);
   }
   return st;
-}
-
-std::size_t Coupler::slot(std::int64_t id) {
-  if (id < 0) throw PhysicsError(fmt::format("negative particle id {}", id));
-  const auto k = static_cast<std::size_t>(id);
-  if (k >= v0_[0].size())
-    for (int c = 0; c < 3; ++c) {
-      v0_[c].resize(k + 1, 0.0);
-      react_[c].resize(k + 1, 0.0);
-      fpv_[c].resize(k + 1, 0.0);
-      owed_[c].resize(k + 1, 0.0);
-    }
-  return k;
 }
 
 namespace {
@@ -84,8 +83,10 @@ inline Offsets3 offsets(const Weights1D& wx, const Weights1D& wy, const Weights1
   const std::size_t stride[3] = {1, static_cast<std::size_t>(f.nx), static_cast<std::size_t>(f.nx) * f.ny};
   for (int d = 0; d < 3; ++d) {
     o.n[d] = W[d]->n;
+    // A window of planes (several ranks) is indexed from its first plane.
+    const int first = W[d]->first - (d == 2 ? f.k0 : 0);
     for (int a = 0; a < W[d]->n; ++a) {
-      const int i = f.periodic[d] ? GridField::wrap(W[d]->first + a, dim[d]) : W[d]->first + a;
+      const int i = f.periodic[d] ? GridField::wrap(first + a, dim[d]) : first + a;
       o.off[d][a] = static_cast<std::size_t>(i) * stride[d];
       o.w[d][a] = W[d]->w[a];
     }
@@ -125,6 +126,7 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
   auto& p = dem.particles();
   const double rho = s_.rho_f_kg_m3, mu = s_.mu_pa_s, nu = mu / rho;
   const auto& lo = dem.config().box.lo;
+  std::vector<double> lag(3, 0.0);  // this rank's share of totals_.lag_impulse_ns
   for (std::size_t i = 0; i < p.n_local; ++i) {
     const Stencil st = stencil(p.x[i] - lo[0], p.y[i] - lo[1], p.z[i] - lo[2]);
     const double d = 2.0 * p.radius[i];
@@ -145,13 +147,12 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
     // received at level n over the last sub-cycle, both with these weights. Measured, not fed
     // back: handing it to the fluid as an explicit source undoes the implicit drag (a frozen
     // dense bed diverges) and feeds pressure jumps back in dense beds.
-    const std::size_t k = slot(p.id[i]);
     {
       const double ufo[3] = {p.ufx[i], p.ufy[i], p.ufz[i]};
+      double* fpv[3] = {&p.fpv_x[i], &p.fpv_y[i], &p.fpv_z[i]};
       for (int c = 0; c < 3; ++c) {
-        owed_[c][k] = dt_prev * (p.beta[i] * (uf[c] - ufo[c]) + (fe[c] - fpv_[c][k]));
-        totals_.lag_impulse_ns[c] += owed_[c][k];
-        fpv_[c][k] = fe[c];
+        lag[c] += dt_prev * (p.beta[i] * (uf[c] - ufo[c]) + (fe[c] - *fpv[c]));
+        *fpv[c] = fe[c];
       }
       p.drag_jx[i] = p.drag_jy[i] = p.drag_jz[i] = 0.0;
     }
@@ -189,42 +190,82 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
     }
     p.ext_x[i] = fe[0], p.ext_y[i] = fe[1], p.ext_z[i] = fe[2];
 
-    v0_[0][k] = p.vx[i], v0_[1][k] = p.vy[i], v0_[2][k] = p.vz[i];
-    for (int c = 0; c < 3; ++c) react_[c][k] = react[c];
+    p.v0x[i] = p.vx[i], p.v0y[i] = p.vy[i], p.v0z[i] = p.vz[i];
+    p.react_x[i] = react[0], p.react_y[i] = react[1], p.react_z[i] = react[2];
   }
+  if (window_) lag = particles::ordered_sum(window_->comm(), lag);
+  for (int c = 0; c < 3; ++c) totals_.lag_impulse_ns[c] = lag[c];
+}
+
+std::vector<double> Coupler::gather_whole(const GridField& f) const {
+  if (!window_) return f.a;
+  const std::size_t ps = f.plane_size();
+  const auto first = f.a.begin() + static_cast<std::ptrdiff_t>((window_->own_begin() - f.k0) * ps);
+  const std::vector<double> own(first, first + static_cast<std::ptrdiff_t>((window_->own_end() - window_->own_begin()) * ps));
+  return gather_planes(own);
+}
+
+std::vector<double> Coupler::gather_planes(const std::vector<double>& own) const {
+  // Rank order is plane order: the slabs are consecutive.
+  const MPI_Comm comm = window_->comm();
+  const int ranks = window_->ranks();
+  const int n = static_cast<int>(own.size());
+  std::vector<int> counts(ranks), displs(ranks);
+  MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
+  int total = 0;
+  for (int r = 0; r < ranks; ++r) displs[r] = total, total += counts[r];
+  std::vector<double> all(window_->rank() == 0 ? static_cast<std::size_t>(total) : 0);
+  MPI_Gatherv(own.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, comm);
+  return all;
 }
 
 std::vector<std::vector<double>> Coupler::export_state() const {
   auto st = fields_.export_state();
-  for (int c = 0; c < 3; ++c) st.push_back(fpv_[c]);
-  st.push_back(solid_.a);
+  if (window_)
+    for (int c = 0; c < 3; ++c) st[c] = gather_planes(st[c]);
+  st.push_back(gather_whole(solid_));
   return st;
 }
 
-void Coupler::import_state(const std::vector<std::vector<double>>& st) {
-  if (st.size() != 8) throw CheckpointError("coupling state: expected 8 arrays");
-  if (st[7].size() != solid_.a.size()) throw CheckpointError("coupling state: solid fraction of another grid");
-  solid_.a = st[7];
+void Coupler::import_state(const std::vector<std::vector<double>>& st, particles::DemSystem& dem) {
+  // 5 arrays: u, v, w, the previous-level flag, the solid fraction. Earlier versions kept the
+  // pressure-gradient and viscous force of the last prepare per particle id (arrays 4-6).
+  if (st.size() != 5 && st.size() != 8) throw CheckpointError("coupling state: expected 5 (or 8) arrays");
+  const auto& solid = st.back();
+  const std::size_t ps = solid_.plane_size(), nz = g_.n[2];
+  if (solid.size() != ps * nz) throw CheckpointError("coupling state: solid fraction of another grid");
+  for (int p = 0; p < solid_.nz; ++p) {
+    const std::size_t k = static_cast<std::size_t>(((solid_.k0 + p) % (int)nz + (int)nz) % (int)nz);
+    std::copy(solid.begin() + static_cast<std::ptrdiff_t>(k * ps), solid.begin() + static_cast<std::ptrdiff_t>((k + 1) * ps),
+              solid_.a.begin() + static_cast<std::ptrdiff_t>(p * ps));
+  }
   fields_.import_state({st.begin(), st.begin() + 4});
-  for (int c = 0; c < 3; ++c) {
-    fpv_[c] = st[4 + c];
-    const std::size_t n = fpv_[c].size();
-    v0_[c].resize(n, 0.0);
-    react_[c].resize(n, 0.0);
-    owed_[c].resize(n, 0.0);
+  if (st.size() == 8) {
+    auto& p = dem.particles();
+    for (std::size_t i = 0; i < p.n_local; ++i) {
+      const auto k = static_cast<std::size_t>(p.id[i]);
+      if (p.id[i] < 0 || k >= st[4].size()) throw CheckpointError(fmt::format("coupling state: no force of particle {}", p.id[i]));
+      p.fpv_x[i] = st[4][k], p.fpv_y[i] = st[5][k], p.fpv_z[i] = st[6][k];
+    }
   }
 }
 
+std::vector<double> Coupler::sum_owned(const GridField& f) const {
+  std::vector<double> owned(f.plane_size() * static_cast<std::size_t>(window_->own_end() - window_->own_begin()));
+  window_->sum_to_owned(f.a.data(), owned.data(), f.plane_size());
+  return owned;
+}
+
 void Coupler::prepare(particles::DemSystem& dem, fluid::FluidSolver& fs, double dt_prev_s) {
-  const auto t0 = Clock::now();
+  const auto t0 = std::chrono::steady_clock::now();
   fields_.update(fs, dt_prev_s, s_.viscous, s_.added_mass, s_.saffman_lift);
   totals_.lag_impulse_ns = {0.0, 0.0, 0.0};
   visit_drag_law(s_.drag, [&](const auto& law) { prepare_impl(law, dem, dt_prev_s); });
-  seconds_sample += since(t0);
+  seconds_sample += seconds_since(t0);
 }
 
 void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double dt_s) {
-  const auto t0 = Clock::now();
+  const auto t0 = std::chrono::steady_clock::now();
   auto& p = dem.particles();
   const double vcell = g_.cell_volume_m3();
   const auto& lo = dem.config().box.lo;
@@ -235,24 +276,26 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
   const auto lag = totals_.lag_impulse_ns;
   totals_ = ExchangeTotals{};
   totals_.lag_impulse_ns = lag;
+  std::vector<double> reaction(3, 0.0);
   for (std::size_t i = 0; i < p.n_local; ++i) {
     const Stencil st = stencil(p.x[i] - lo[0], p.y[i] - lo[1], p.z[i] - lo[2]);
     const double r = p.radius[i];
     const double frac = (4.0 / 3.0) * kPi * r * r * r / vcell;
     scatter(offsets(st.cell[0], st.cell[1], st.cell[2], solid_), [&](std::size_t q, double w) { solid_.a[q] += w * frac; });
     if (!forces) continue;
-    const std::size_t s = slot(p.id[i]);
     // The fluid's drag is K (u_p - u) with K u_p = beta u_f(n) - J / dt: with u at level n it
     // returns exactly the impulse J the kicks applied. The reaction to the explicit forces uses
     // the particle's actual velocity change (added mass).
     const double vs[3] = {p.vx[i], p.vy[i], p.vz[i]};
+    const double v0[3] = {p.v0x[i], p.v0y[i], p.v0z[i]};
+    const double react[3] = {p.react_x[i], p.react_y[i], p.react_z[i]};
     const double J[3] = {p.drag_jx[i], p.drag_jy[i], p.drag_jz[i]};
     const double uf[3] = {p.ufx[i], p.ufy[i], p.ufz[i]};
     double rf[3];
     for (int c = 0; c < 3; ++c) {
-      rf[c] = react_[c][s];
-      if (s_.added_mass) rf[c] += 0.5 * s_.rho_f_kg_m3 * (4.0 / 3.0) * kPi * r * r * r * (vs[c] - v0_[c][s]) / dt_s;
-      totals_.reaction_n[c] += rf[c];
+      rf[c] = react[c];
+      if (s_.added_mass) rf[c] += 0.5 * s_.rho_f_kg_m3 * (4.0 / 3.0) * kPi * r * r * r * (vs[c] - v0[c]) / dt_s;
+      reaction[c] += rf[c];
     }
     const double b = p.beta[i];
     for (int c = 0; c < 3; ++c) {
@@ -267,40 +310,59 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
       });
     }
   }
-  for (double v : solid_.a) totals_.solid_volume_m3 += v * vcell;
+  // The planes this rank owns: on one rank the whole grid as deposited; on several, every
+  // rank's deposits there added up (and copied back into the window, whose other planes then
+  // hold their owners' totals for the next prepare's alpha_f).
+  const int nx = (int)g_.n[0], ny = (int)g_.n[1];
+  const int k_lo = window_ ? window_->own_begin() : 0, k_hi = window_ ? window_->own_end() : (int)g_.n[2];
+  std::vector<double> own_solid;
+  if (window_) {
+    own_solid = sum_owned(solid_);
+    window_->fill(own_solid.data(), solid_.a.data(), solid_.plane_size());
+  }
+  const std::vector<double>& solid = window_ ? own_solid : solid_.a;
+  double volume = 0.0;
+  for (double v : solid) volume += v * vcell;
+  totals_.solid_volume_m3 = window_ ? particles::ordered_sum(window_->comm(), volume) : volume;
+  if (window_) reaction = particles::ordered_sum(window_->comm(), reaction);
+  for (int c = 0; c < 3; ++c) totals_.reaction_n[c] = reaction[c];
 
-  // Into the fluid's deposition arrays (one rank: owned = whole grid). The y-wall rows of v are
-  // not fluid unknowns: the share deposited there goes into the wall.
-  const int nx = (int)g_.n[0], ny = (int)g_.n[1], nz = (int)g_.n[2];
+  // Into the fluid's deposition arrays. The y-wall rows of v are not fluid unknowns: the share
+  // deposited there goes into the wall.
   fs.begin_deposition();
   PetscScalar*** sol = fs.solid_fraction_local();
-  for (int k = 0; k < nz; ++k)
+  for (int k = k_lo; k < k_hi; ++k)
     for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) sol[k][j][i] += solid_.a[(static_cast<std::size_t>(k) * ny + j) * nx + i];
+      for (int i = 0; i < nx; ++i) sol[k][j][i] += solid[(static_cast<std::size_t>(k - k_lo) * ny + j) * nx + i];
   if (forces) {
     for (int c = 0; c < 3; ++c) {
       PetscScalar*** Ka = fs.drag_coefficient_local(c);
       PetscScalar*** KUa = fs.drag_momentum_local(c);
       PetscScalar*** Sa = fs.source_local(c);
-      for (int k = 0; k < nz; ++k)
+      std::vector<double> own[3];
+      if (window_) own[0] = sum_owned(K_[c]), own[1] = sum_owned(KU_[c]), own[2] = sum_owned(S_[c]);
+      const double* Kc = window_ ? own[0].data() : K_[c].a.data();
+      const double* KUc = window_ ? own[1].data() : KU_[c].a.data();
+      const double* Sc = window_ ? own[2].data() : S_[c].a.data();
+      for (int k = k_lo; k < k_hi; ++k)
         for (int j = 0; j < ny; ++j)
           for (int i = 0; i < nx; ++i) {
-            const std::size_t q = (static_cast<std::size_t>(k) * K_[c].ny + j) * nx + i;  // v has ny + 1 rows
-            Ka[k][j][i] += K_[c].a[q];
-            KUa[k][j][i] += KU_[c].a[q];
-            Sa[k][j][i] += S_[c].a[q];
+            const std::size_t q = (static_cast<std::size_t>(k - k_lo) * K_[c].ny + j) * nx + i;  // v has ny + 1 rows
+            Ka[k][j][i] += Kc[q];
+            KUa[k][j][i] += KUc[q];
+            Sa[k][j][i] += Sc[q];
           }
     }
   }
   fs.end_deposition();
   double amin = 1.0, amax = 0.0;
-  for (double v : solid_.a) {
+  for (double v : solid) {
     amin = std::min(amin, 1.0 - v);
     amax = std::max(amax, 1.0 - v);
   }
-  totals_.min_alpha_f = amin;
-  totals_.max_alpha_f = amax;
-  seconds_deposit += since(t0);
+  totals_.min_alpha_f = window_ ? particles::global_min(window_->comm(), amin) : amin;
+  totals_.max_alpha_f = window_ ? particles::global_max(window_->comm(), amax) : amax;
+  seconds_deposit += seconds_since(t0);
 }
 
 }  // namespace boycott::coupling

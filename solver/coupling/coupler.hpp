@@ -20,6 +20,7 @@
 // steady state it vanishes, and over a run it sums to roughly the difference of its end values.
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,7 @@
 #include "core/grid_spec.hpp"
 #include "coupling/fluid_fields.hpp"
 #include "coupling/kernels.hpp"
+#include "coupling/slab_exchange.hpp"
 
 namespace boycott::particles {
 class DemSystem;
@@ -60,7 +62,9 @@ struct ExchangeTotals {
 
 class Coupler {
  public:
-  Coupler(const CouplingSettings& s, const GridSpec& g);
+  /// window: on several ranks, the planes this rank samples and deposits on (the fluid's
+  /// z-slabs with their halo, slab_exchange.hpp); nullptr on one rank.
+  Coupler(const CouplingSettings& s, const GridSpec& g, std::shared_ptr<const SlabExchange> window = nullptr);
 
   /// Samples the fluid's current level (dt_prev_s: the step that led to it, for Du/Dt) and sets
   /// beta, u_f, ext and madd on every local particle.
@@ -69,17 +73,21 @@ class Coupler {
   /// only, at start-up) and arms them in the fluid for its next step.
   void deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double dt_s);
 
+  /// Over all ranks.
   const ExchangeTotals& totals() const { return totals_; }
-  /// The deposited solid fraction per cell (last deposit), x fastest.
+  /// The deposited solid fraction per cell (last deposit), x fastest: this rank's window.
   const GridField& solid_fraction() const { return solid_; }
   const FluidFields& fields() const { return fields_; }
   const CouplingSettings& settings() const { return s_; }
 
   /// What the next step depends on (checkpoints): the fluid velocity read at the last prepare
-  /// (previous level for Du/Dt), the per-particle force of that prepare (lag measurement) and
-  /// the deposited solid fraction (alpha_f at the particles).
+  /// (previous level for Du/Dt) and the deposited solid fraction (alpha_f at the particles),
+  /// over the whole grid (collective: gathered to rank 0 on several ranks). The per-particle
+  /// force of that prepare (lag measurement) is on the particles.
   std::vector<std::vector<double>> export_state() const;
-  void import_state(const std::vector<std::vector<double>>& st);
+  /// Every rank passes the whole state. A state of earlier versions (8 arrays, the force per
+  /// particle id among them) puts that force on the particles of `dem`.
+  void import_state(const std::vector<std::vector<double>>& st, particles::DemSystem& dem);
 
   /// Drag coefficient of the last prepare per particle in storage order is on the particles
   /// (beta); these are the time spent, s.
@@ -92,17 +100,18 @@ class Coupler {
   Stencil stencil(double x, double y, double z) const;
   template <class Law>
   void prepare_impl(const Law& law, particles::DemSystem& dem, double dt_prev_s);
-  std::size_t slot(std::int64_t id);
+  /// The owned planes of a windowed field, summed over every rank's window (several ranks).
+  std::vector<double> sum_owned(const GridField& f) const;
+  /// A field's own planes gathered over all ranks to rank 0 (the whole grid on one rank).
+  std::vector<double> gather_whole(const GridField& f) const;
+  /// Every rank's own planes (in plane order) gathered to rank 0 (several ranks).
+  std::vector<double> gather_planes(const std::vector<double>& own) const;
 
   CouplingSettings s_;
   GridSpec g_;
+  std::shared_ptr<const SlabExchange> window_;
   FluidFields fields_;
   GridField solid_, K_[3], KU_[3], S_[3];
-  // Per particle, indexed by slot (from the global id, so the DEM's re-sorting does not matter):
-  // velocity at the start of the sub-cycle, the explicit reaction owed to the fluid.
-  std::vector<double> v0_[3], react_[3];
-  std::vector<double> fpv_[3];   ///< pressure-gradient + viscous force of the last prepare, N
-  std::vector<double> owed_[3];  ///< lag impulse per particle of the last step, N s
   ExchangeTotals totals_;
 };
 

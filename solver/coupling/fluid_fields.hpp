@@ -6,8 +6,9 @@
 // Du/Dt on c-faces and the vorticity at cell centres. Read from the fluid solver once per CFD
 // step; particles then sample them with their kernel weights (coupler.hpp).
 //
-// One MPI rank: the fields are dense copies of the whole grid with periodic wrap. (Particles are
-// not decomposed over ranks yet; coupled scenes refuse more than one rank.)
+// One MPI rank: the fields are dense copies of the whole grid with periodic wrap. Several: each
+// rank holds the planes of its window (slab_exchange.hpp), filled from the ranks that own them,
+// and derives the fields on the planes its particles can reach.
 #include <array>
 #include <vector>
 
@@ -19,17 +20,22 @@ class FluidSolver;
 
 namespace boycott::coupling {
 
-/// A dense grid array of nx x ny x nz values (x fastest) with periodic wrap where asked.
+class SlabExchange;
+
+/// A dense grid array of nx x ny x nz values (x fastest) with periodic wrap where asked. With z
+/// not periodic it is a window of planes: plane k (grid index) is stored at k - k0.
 struct GridField {
   int nx = 0, ny = 0, nz = 0;
+  int k0 = 0;
   bool periodic[3] = {true, true, true};
   std::vector<double> a;
 
-  void resize(int x, int y, int z, const bool per[3]) {
-    nx = x, ny = y, nz = z;
+  void resize(int x, int y, int z, const bool per[3], int first_plane = 0) {
+    nx = x, ny = y, nz = z, k0 = first_plane;
     for (int d = 0; d < 3; ++d) periodic[d] = per[d];
     a.assign(static_cast<std::size_t>(nx) * ny * nz, 0.0);
   }
+  std::size_t plane_size() const { return static_cast<std::size_t>(nx) * ny; }
   static int wrap(int i, int n) {
     // Stencils reach at most two cells outside: one add or subtract instead of an integer
     // division (the % made index() a third of the field update and sampling time).
@@ -42,7 +48,10 @@ struct GridField {
   std::size_t index(int i, int j, int k) const {
     if (periodic[0]) i = wrap(i, nx);
     if (periodic[1]) j = wrap(j, ny);
-    if (periodic[2]) k = wrap(k, nz);
+    if (periodic[2])
+      k = wrap(k, nz);
+    else
+      k -= k0;
     return (static_cast<std::size_t>(k) * ny + j) * nx + i;
   }
   double& at(int i, int j, int k) { return a[index(i, j, k)]; }
@@ -51,7 +60,8 @@ struct GridField {
 
 class FluidFields {
  public:
-  explicit FluidFields(const GridSpec& g, bool top_slip);
+  /// window: the planes this rank holds on several ranks (nullptr: one rank, the whole grid).
+  FluidFields(const GridSpec& g, bool top_slip, const SlabExchange* window = nullptr);
 
   /// Reads velocity, pressure and nu_t from the solver at its current level and derives the
   /// fields above. `dt_s` is the step that led to this level (for Du/Dt; 0 = first call, then
@@ -68,8 +78,9 @@ class FluidFields {
   const GridField& vorticity(int c) const { return vort_[c]; }            ///< 1/s, cell centres
 
   /// The velocity read at the last update (the next update's previous level, for Du/Dt), for
-  /// checkpoints: u, v, w arrays and whether a previous level exists.
-  std::vector<std::vector<double>> export_state() const { return {u_[0].a, u_[1].a, u_[2].a, {have_prev_ ? 1.0 : 0.0}}; }
+  /// checkpoints: u, v, w arrays of this rank's own planes and whether a previous level exists.
+  std::vector<std::vector<double>> export_state() const;
+  /// The same arrays over the whole grid (all ranks' planes, as export_state gives them on one).
   void import_state(const std::vector<std::vector<double>>& st);
 
  private:
@@ -95,6 +106,10 @@ class FluidFields {
 
   GridSpec g_;
   bool walls_, top_slip_;
+  const SlabExchange* window_ = nullptr;
+  // Planes [kb_, ke_) get the face-derived fields, [kb_, kce_) the vorticity; kofs_ is the grid
+  // plane of the padded arrays' plane 0.
+  int kb_ = 0, ke_ = 0, kce_ = 0, kofs_ = 0;
   double rho_ = 1000.0, nu_ = 1e-6;
   GridField u_[3], uprev_[3], gradp_[3], visc_[3], dudt_[3], vort_[3], p_, nut_;
   Padded upad_[3], ppad_, nupad_;  // uval, p and nu + nu_t, padded

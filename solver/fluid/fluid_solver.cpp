@@ -63,7 +63,8 @@ void FluidSolver::create_layout() {
   PetscBool user_pc = PETSC_FALSE;
   BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-pressure_pc_type", &user_pc));
   std::vector<PetscInt> z_slabs;
-  if (nranks > 1 && !user_pc) {
+  // The slabs also with a user's -pressure_pc_type: the coupling decomposes particles by them.
+  if (nranks > 1) {
     for (int c : DistributedSpectralPoisson::z_slab_counts((int)g.n[0], (int)g.n[1], (int)g.n[2], comm_))
       z_slabs.push_back(c);
     if (std::any_of(z_slabs.begin(), z_slabs.end(), [](PetscInt c) { return c < 2; })) z_slabs.clear();

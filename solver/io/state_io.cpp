@@ -24,16 +24,27 @@ void save(CheckpointWriter& w, const std::string& prefix, const particles::DemSt
   w.put(prefix + "wall_h", s.wall_h);
   w.put_int(prefix + "steps", s.steps);
   w.put(prefix + "time_s", s.time_s);
+  if (s.n_ranks > 1) {
+    w.put_int(prefix + "n_ranks", s.n_ranks);
+    w.put(prefix + "owner_rank", s.owner_rank);
+  }
 }
 
 void load(const CheckpointReader& r, const std::string& prefix, particles::DemState& s) {
-  int k = 0;
   const int n_arrays = static_cast<int>(r.scalar(prefix + "n_arrays"));
-  s.store.for_each_array([&](std::vector<double>& a) { a = r.doubles(fmt::format("{}array{:02d}", prefix, k++)); });
-  if (k != n_arrays)
-    throw CheckpointError(fmt::format("{}: {} particle arrays stored, this program has {} (other version?)",
-                                      r.path().string(), n_arrays, k));
+  if (n_arrays > particles::ParticleStore::kArrays)
+    throw CheckpointError(fmt::format("{}: {} particle arrays stored, this program knows {} (newer version?)",
+                                      r.path().string(), n_arrays, particles::ParticleStore::kArrays));
   s.store.id = r.int64s(prefix + "id");
+  // Arrays added after a checkpoint was written (the coupling's, the last ones) start at zero.
+  int k = 0;
+  s.store.for_each_array([&](std::vector<double>& a) {
+    if (k < n_arrays)
+      a = r.doubles(fmt::format("{}array{:02d}", prefix, k));
+    else
+      a.assign(s.store.id.size(), 0.0);
+    ++k;
+  });
   s.store.n_local = static_cast<std::size_t>(r.integer(prefix + "n_local"));
   s.ref_x = r.doubles(prefix + "ref_x");
   s.ref_y = r.doubles(prefix + "ref_y");
@@ -46,6 +57,8 @@ void load(const CheckpointReader& r, const std::string& prefix, particles::DemSt
   s.wall_h = r.doubles(prefix + "wall_h");
   s.steps = r.integer(prefix + "steps");
   s.time_s = r.scalar(prefix + "time_s");
+  s.n_ranks = r.has(prefix + "n_ranks") ? static_cast<int>(r.integer(prefix + "n_ranks")) : 1;
+  s.owner_rank = s.n_ranks > 1 ? r.int64s(prefix + "owner_rank") : std::vector<std::int64_t>{};
 }
 
 void save(CheckpointWriter& w, const std::string& prefix, const fluid::FluidState& s) {

@@ -55,7 +55,6 @@ constexpr FindContactsFn kFindContacts[8] = {
 
 template <class Rolling>
 void DemSystem::compute_forces_impl(const Rolling& rolling) {
-  const std::size_t n = s_.size();
   std::fill(s_.fx.begin(), s_.fx.end(), 0.0);
   std::fill(s_.fy.begin(), s_.fy.end(), 0.0);
   std::fill(s_.fz.begin(), s_.fz.end(), 0.0);
@@ -195,7 +194,9 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   // Walls: a sphere of infinite mass at rest; history per particle and wall. As for pairs: find
   // the particles that touch the wall, reset the springs of those that have left it, then a
   // vectorisable loop over the touching ones (each particle once per wall: no conflicts).
-  wall_contact_.resize(n);
+  // Local particles only: a ghost's wall contact is its own rank's.
+  const std::size_t nloc = s_.n_local;
+  wall_contact_.resize(nloc);
   prev_wall_contacts_.resize(cfg_.walls.size());
   std::uint32_t* __restrict wc = wall_contact_.data();
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
@@ -205,7 +206,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
     double* __restrict why = why_[w].data();
     double* __restrict whz = whz_[w].data();
     std::size_t nw = 0;
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < nloc; ++i) {
       const double dist = (x[i] - wpx) * nx + (y[i] - wpy) * ny + (z[i] - wpz) * nz;
       wc[nw] = static_cast<std::uint32_t>(i);
       nw += dist < rad[i];

@@ -1,19 +1,84 @@
 // Checkpoint state of the DEM engine: export and import of everything the next step depends
-// on (particles, reference positions of the neighbour list, contact histories).
+// on (particles, reference positions of the neighbour list, contact histories). On several
+// ranks the state is gathered to rank 0 in rank order, and every rank picks its part on import.
 #include <algorithm>
+#include <cstdint>
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "particles/dem_system.hpp"
 
 namespace boycott::particles {
 
+namespace {
+
+/// Gathers a per-rank vector to rank 0 in rank order (the other ranks get an empty one).
+template <class T>
+std::vector<T> gather_to_root(MPI_Comm comm, const std::vector<T>& local) {
+  int size = 1, rank = 0;
+  MPI_Comm_size(comm, &size);
+  MPI_Comm_rank(comm, &rank);
+  const int n = static_cast<int>(local.size());
+  std::vector<int> counts(size), displs(size);
+  MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
+  std::vector<T> all;
+  if (rank == 0) {
+    int total = 0;
+    for (int r = 0; r < size; ++r) displs[r] = total, total += counts[r];
+    all.resize(static_cast<std::size_t>(total));
+  }
+  const MPI_Datatype type = sizeof(T) == 8 && std::is_integral_v<T> ? MPI_INT64_T : MPI_DOUBLE;
+  MPI_Gatherv(local.data(), n, type, all.data(), counts.data(), displs.data(), type, 0, comm);
+  return all;
+}
+
+}  // namespace
+
 DemState DemSystem::export_state() const {
+  if (!dd_.parallel()) return export_local();
+  const DemState loc = export_local();
+  DemState st;
+  st.steps = steps_;
+  st.time_s = time_;
+  st.n_ranks = dd_.size;
+  const MPI_Comm comm = dd_.comm;
+  st.store.id = gather_to_root(comm, loc.store.id);
+  ParticleStore local_store = loc.store;
+  std::vector<std::vector<double>> arrays;
+  local_store.for_each_array([&](std::vector<double>& a) { arrays.push_back(gather_to_root(comm, a)); });
+  std::size_t k = 0;
+  st.store.for_each_array([&](std::vector<double>& a) { a = std::move(arrays[k++]); });
+  st.store.n_local = st.store.id.size();
+  st.ref_x = gather_to_root(comm, loc.ref_x);
+  st.ref_y = gather_to_root(comm, loc.ref_y);
+  st.ref_z = gather_to_root(comm, loc.ref_z);
+  st.pair_id_a = gather_to_root(comm, loc.pair_id_a);
+  st.pair_id_b = gather_to_root(comm, loc.pair_id_b);
+  st.pair_hx = gather_to_root(comm, loc.pair_hx);
+  st.pair_hy = gather_to_root(comm, loc.pair_hy);
+  st.pair_hz = gather_to_root(comm, loc.pair_hz);
+  const std::size_t n = s_.n_local;
+  for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
+    const std::vector<double> mine(loc.wall_h.begin() + static_cast<std::ptrdiff_t>(3 * w * n),
+                                   loc.wall_h.begin() + static_cast<std::ptrdiff_t>(3 * (w + 1) * n));
+    const auto all = gather_to_root(comm, mine);
+    st.wall_h.insert(st.wall_h.end(), all.begin(), all.end());
+  }
+  const auto owners = gather_to_root(comm, std::vector<std::int64_t>(n, dd_.rank));
+  st.owner_rank = owners;
+  return st;
+}
+
+DemState DemSystem::export_local() const {
   DemState st;
   st.store = s_;
-  st.ref_x = ref_x_;
-  st.ref_y = ref_y_;
-  st.ref_z = ref_z_;
-  for (std::size_t i = 0; i < s_.size(); ++i)
+  st.store.resize(s_.n_local);
+  st.ref_x.assign(ref_x_.begin(), ref_x_.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
+  st.ref_y.assign(ref_y_.begin(), ref_y_.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
+  st.ref_z.assign(ref_z_.begin(), ref_z_.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
+  for (std::size_t i = 0; i < s_.n_local; ++i)
     for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
       if (h_[3 * p] == 0.0 && h_[3 * p + 1] == 0.0 && h_[3 * p + 2] == 0.0) continue;
       const std::int64_t a = s_.id[i], b = s_.id[nl_.neighbors[p]];
@@ -25,7 +90,7 @@ DemState DemSystem::export_state() const {
       st.pair_hz.push_back(sg * h_[3 * p + 2]);
     }
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w)
-    for (std::size_t i = 0; i < s_.size(); ++i)
+    for (std::size_t i = 0; i < s_.n_local; ++i)
       st.wall_h.insert(st.wall_h.end(), {whx_[w][i], why_[w][i], whz_[w][i]});
   st.steps = steps_;
   st.time_s = time_;
@@ -33,6 +98,10 @@ DemState DemSystem::export_state() const {
 }
 
 void DemSystem::import_state(const DemState& st) {
+  if (dd_.parallel()) {
+    import_parallel(st);
+    return;
+  }
   s_ = st.store;
   const std::size_t n = s_.size();
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
@@ -72,5 +141,68 @@ void DemSystem::import_state(const DemState& st) {
   initialized_ = true;
 }
 
+
+void DemSystem::import_parallel(const DemState& st) {
+  const std::size_t total = st.store.id.size();
+  // Same number of ranks: each rank's own particles in their stored order (bitwise); otherwise
+  // by slab.
+  const bool same_layout = st.n_ranks == dd_.size && st.owner_rank.size() == total;
+  std::vector<std::size_t> mine;
+  for (std::size_t i = 0; i < total; ++i)
+    if (same_layout ? st.owner_rank[i] == dd_.rank : dd_.owner(st.store.z[i]) == dd_.rank) mine.push_back(i);
+  s_ = st.store;
+  s_.permute(mine);
+  s_.n_local = mine.size();
+  s_.resize(mine.size());
+  const std::size_t n = mine.size();
+  for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
+    whx_[w].resize(n);
+    why_[w].resize(n);
+    whz_[w].resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t q = 3 * (w * total + mine[k]);
+      whx_[w][k] = st.wall_h[q];
+      why_[w][k] = st.wall_h[q + 1];
+      whz_[w][k] = st.wall_h[q + 2];
+    }
+  }
+  for (auto& a : pred_) a.assign(n, 0.0);  // set by the next step's first kick
+  set_cutoff_and_mass();
+  carry_a_ = st.pair_id_a;
+  carry_b_ = st.pair_id_b;
+  carry_h_.resize(3 * st.pair_id_a.size());
+  for (std::size_t q = 0; q < st.pair_id_a.size(); ++q) {
+    carry_h_[3 * q] = st.pair_hx[q];
+    carry_h_[3 * q + 1] = st.pair_hy[q];
+    carry_h_[3 * q + 2] = st.pair_hz[q];
+  }
+  if (same_layout) {
+    // As the uninterrupted run left it: ghosts and list of its last rebuild, at the reference
+    // positions, so that the next rebuild comes at the same step. The ghosts' current positions
+    // and velocities arrive with the next step's refresh.
+    ref_x_.resize(n), ref_y_.resize(n), ref_z_.resize(n);
+    for (std::size_t k = 0; k < n; ++k)
+      ref_x_[k] = st.ref_x[mine[k]], ref_y_[k] = st.ref_y[mine[k]], ref_z_[k] = st.ref_z[mine[k]];
+    std::vector<double> now[3] = {s_.x, s_.y, s_.z};
+    s_.x = ref_x_, s_.y = ref_y_, s_.z = ref_z_;
+    exchange_ghosts();
+    nl_.build(s_, cfg_.box, cutoff_m_, s_.n_local);
+    // The histories belong to the pairs that overlap now (the current positions, the ghosts'
+    // included).
+    std::copy(now[0].begin(), now[0].end(), s_.x.begin());
+    std::copy(now[1].begin(), now[1].end(), s_.y.begin());
+    std::copy(now[2].begin(), now[2].end(), s_.z.begin());
+    forward_ghosts();
+    restore_histories(carry_a_, carry_b_, carry_h_);
+    rescan_wall_contacts();
+  } else {
+    // Another number of ranks: a fresh rebuild at the current positions (the run continues, not
+    // bit for bit).
+    rebuild_parallel(false);
+  }
+  steps_ = st.steps;
+  time_ = st.time_s;
+  initialized_ = true;
+}
 
 }  // namespace boycott::particles

@@ -33,7 +33,8 @@ DemConfig DemConfig::from_case(const CaseParams& p) {
   return c;
 }
 
-DemSystem::DemSystem(const DemConfig& cfg) : cfg_(cfg) {
+DemSystem::DemSystem(const DemConfig& cfg)
+    : cfg_(cfg), dd_(SlabDecomposition::serial(cfg.box.lo[2], cfg.box.lo[2] + cfg.box.len[2])) {
   whx_.resize(cfg_.walls.size());
   why_.resize(cfg_.walls.size());
   whz_.resize(cfg_.walls.size());
@@ -45,6 +46,16 @@ void DemSystem::initialize() {
       if (s_.ext_x[i] != 0.0 || s_.ext_y[i] != 0.0 || s_.ext_z[i] != 0.0 || s_.ufx[i] != 0.0 || s_.ufy[i] != 0.0 ||
           s_.ufz[i] != 0.0 || s_.madd[i] != 0.0)
         throw std::logic_error("DemConfig::dry is set but a particle has a fluid force, velocity or added mass");
+  if (dd_.parallel()) {
+    // The ghosts carry their owner's velocities at the force time, so those come first.
+    set_cutoff_and_mass();
+    predict_velocities();
+    rebuild_parallel(!carry_ready_);
+    carry_ready_ = false;
+    compute_forces();
+    initialized_ = true;
+    return;
+  }
   double rmax = 0.0;
   for (double r : s_.radius) rmax = std::max(rmax, r);
   cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
@@ -127,13 +138,18 @@ void DemSystem::rebuild() {
   seconds_neighbor += seconds_since(t0);
 }
 
+std::int64_t DemSystem::global_count() const {
+  return dd_.parallel() ? global_sum(dd_.comm, static_cast<std::int64_t>(s_.n_local))
+                        : static_cast<std::int64_t>(s_.n_local);
+}
+
 double DemSystem::kinetic_energy_j() const {
   double e = 0.0;
   for (std::size_t i = 0; i < s_.n_local; ++i) {
     e += 0.5 * s_.mass[i] * (s_.vx[i] * s_.vx[i] + s_.vy[i] * s_.vy[i] + s_.vz[i] * s_.vz[i]);
     e += 0.5 * s_.inertia[i] * (s_.wx[i] * s_.wx[i] + s_.wy[i] * s_.wy[i] + s_.wz[i] * s_.wz[i]);
   }
-  return e;
+  return dd_.parallel() ? ordered_sum(dd_.comm, e) : e;
 }
 
 double DemSystem::pair_overlap(std::size_t i, std::size_t j) const {
@@ -153,7 +169,7 @@ double DemSystem::spring_energy_j() const {
     }
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
     const PlaneWall& W = cfg_.walls[w];
-    for (std::size_t i = 0; i < s_.size(); ++i) {
+    for (std::size_t i = 0; i < s_.n_local; ++i) {
       const double ov = s_.radius[i] - ((s_.x[i] - W.px) * W.nx + (s_.y[i] - W.py) * W.ny + (s_.z[i] - W.pz) * W.nz);
       if (ov > 0.0)
         e += 0.5 * kn * ov * ov +

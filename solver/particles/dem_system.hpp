@@ -11,6 +11,7 @@
 #include "particles/contact_models.hpp"
 #include "particles/neighbor_list.hpp"
 #include "particles/particle_store.hpp"
+#include "particles/slab_decomposition.hpp"
 #include "particles/walls.hpp"
 
 namespace boycott::particles {
@@ -35,7 +36,8 @@ struct DemConfig {
   static DemConfig from_case(const CaseParams& p);
 };
 
-/// Everything the next step depends on, for checkpoints (issue 5).
+/// Everything the next step depends on, for checkpoints: all particles of the run, whatever
+/// the number of ranks that wrote it.
 struct DemState {
   ParticleStore store;
   std::vector<double> ref_x, ref_y, ref_z;  ///< positions at the last neighbour-list build
@@ -44,6 +46,10 @@ struct DemState {
   std::vector<double> wall_h;  ///< per wall, per particle (storage order), 3 components, m
   std::int64_t steps = 0;
   double time_s = 0.0;
+  /// Written on several ranks: each particle's rank (the particles of a rank are stored together,
+  /// in that rank's storage order), so that the same number of ranks resumes bit for bit.
+  int n_ranks = 1;
+  std::vector<std::int64_t> owner_rank;
 };
 
 class DemSystem {
@@ -62,6 +68,14 @@ class DemSystem {
   void insert_random(std::int64_t count, double radius_m, double density_kg_m3, std::array<double, 3> lo,
                      std::array<double, 3> hi, std::uint64_t seed, double gap_m = 0.0);
 
+  /// Shares the particles among the ranks of `d`: each rank keeps those whose centre lies in its
+  /// slab. Every rank must hold the same particles when it is called (after insertion; when the
+  /// system already stepped on every rank alike, initialize() again after it). From then on the particles of the other ranks within the neighbour cutoff of
+  /// this rank's slab are held as ghost copies after the local ones, and particles that leave
+  /// the slab move to their new rank at each neighbour-list rebuild, with their histories.
+  void decompose(const SlabDecomposition& d);
+  const SlabDecomposition& decomposition() const { return dd_; }
+
   /// Builds the neighbour list and the forces at t = 0. Call once after insertion.
   void initialize();
   /// One velocity-Verlet step of dt.
@@ -76,19 +90,46 @@ class DemSystem {
   std::int64_t contact_count() const { return contacts_; }
   const NeighborList& neighbor_list() const { return nl_; }
 
+  /// Of all particles on all ranks (collective), J.
   double kinetic_energy_j() const;
-  /// Elastic energy stored in the normal and tangential springs of all contacts.
+  /// Elastic energy stored in the normal and tangential springs of this rank's contacts.
   double spring_energy_j() const;
+  /// Particles on all ranks (collective).
+  std::int64_t global_count() const;
+  /// Particles that changed rank, on this rank (arrivals), since the start.
+  std::int64_t migrations() const { return migrations_; }
 
+  /// All particles (collective): on several ranks gathered to rank 0 (the other ranks get the
+  /// step and time only).
   DemState export_state() const;
+  /// Collective; every rank passes the whole state. Written on as many ranks as this run has,
+  /// each rank takes its own particles in their stored order (the run continues bit for bit);
+  /// otherwise each takes those in its slab.
   void import_state(const DemState& st);
 
-  /// Seconds spent in neighbour search, force evaluation and integration.
-  double seconds_neighbor = 0.0, seconds_force = 0.0, seconds_integrate = 0.0;
+  /// Seconds spent in neighbour search (migration and ghost set-up included), force
+  /// evaluation, integration, and the ghost updates of the steps between rebuilds.
+  double seconds_neighbor = 0.0, seconds_force = 0.0, seconds_integrate = 0.0, seconds_ghosts = 0.0;
 
  private:
   template <class Rolling>
   void compute_forces_impl(const Rolling& rolling);
+  // Several ranks (parallel_dem.cpp): the rebuild moves particles between ranks and renews the
+  // ghost copies; between rebuilds the ghosts' positions and velocities are refreshed.
+  bool needs_rebuild_parallel() const;
+  /// collect: take the contact histories from the current list (false: from carry_*, set by
+  /// the caller).
+  void rebuild_parallel(bool collect = true);
+  void import_parallel(const DemState& st);
+  DemState export_local() const;
+  void migrate();
+  void exchange_ghosts();
+  void forward_ghosts();
+  void drop_ghosts();
+  /// Keeps the particles keep[0], keep[1], ... (local ones), with their predicted velocities and
+  /// wall histories, in that order.
+  void select_particles(const std::vector<std::size_t>& keep);
+  void set_cutoff_and_mass();
   void compute_forces();
   void kick(double h, bool predict);
   void drift();
@@ -108,7 +149,13 @@ class DemSystem {
                          const std::vector<double>& h);
 
   DemConfig cfg_;
+  SlabDecomposition dd_;
   ParticleStore s_;
+  // Several ranks: for each destination rank, the local particles it holds as ghosts, in the
+  // order it stores them.
+  std::vector<std::vector<std::uint32_t>> ghost_send_;
+  std::int64_t migrations_ = 0;
+  bool carry_ready_ = false;  ///< carry_* holds the histories for the next parallel rebuild
   NeighborList nl_;
   double cutoff_m_ = 0.0;
   double uniform_mass_kg_ = 0.0;

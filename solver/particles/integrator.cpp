@@ -148,7 +148,17 @@ void DemSystem::step() {
   kick(0.5 * cfg_.dt_s, true);
   drift();
   seconds_integrate += seconds_since(t0);
-  if (needs_rebuild()) rebuild();
+  if (dd_.parallel()) {
+    if (needs_rebuild_parallel()) {
+      rebuild_parallel();
+    } else {
+      t0 = std::chrono::steady_clock::now();
+      forward_ghosts();
+      seconds_ghosts += seconds_since(t0);
+    }
+  } else if (needs_rebuild()) {
+    rebuild();
+  }
   compute_forces();
   t0 = std::chrono::steady_clock::now();
   kick(0.5 * cfg_.dt_s, false);

@@ -56,13 +56,14 @@ std::vector<std::size_t> NeighborList::bin_and_order(const ParticleStore& s, con
   return order;
 }
 
-void NeighborList::build(const ParticleStore& s, const BoxGeometry& g, double cutoff) {
+void NeighborList::build(const ParticleStore& s, const BoxGeometry& g, double cutoff, std::size_t rows) {
   bin(s, g, cutoff);
-  build_binned(s, g, cutoff);
+  build_binned(s, g, cutoff, rows);
 }
 
-void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, double cutoff) {
+void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, double cutoff, std::size_t rows) {
   const std::size_t n = s.size();
+  rows = std::min(rows, n);
   const double cut2 = cutoff * cutoff;
   // Neighbour cell offsets per direction, deduplicated where a periodic direction has < 3 cells.
   std::array<std::vector<int>, 3> offs;
@@ -78,10 +79,11 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
   // members are a contiguous, increasing index range: then the half list (j > i) needs nothing
   // from lower cells and only the tail of the own cell, which halves the distance tests. The
   // pairs kept and their order are the same as with the full scan.
-  bool by_cell = true;
+  // Ghost copies (rows < n) are stored after the local particles, not by cell.
+  bool by_cell = rows == n;
   for (std::size_t i = 0; i < n && by_cell; ++i)
     by_cell = cell_items_[i] == i && (i == 0 || cell_of_[i - 1] <= cell_of_[i]);
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < rows; ++i) {
     const int c = cell_of_[i];
     const int cx = c % nc_[0], cy = (c / nc_[0]) % nc_[1], cz = c / (nc_[0] * nc_[1]);
     for (int oz : offs[2]) {
@@ -115,6 +117,7 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
     }
     offsets[i + 1] = static_cast<std::uint32_t>(neighbors.size());
   }
+  for (std::size_t i = rows; i < n; ++i) offsets[i + 1] = offsets[i];
 }
 
 }  // namespace boycott::particles

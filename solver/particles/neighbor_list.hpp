@@ -23,13 +23,15 @@ struct BoxGeometry {
 
 class NeighborList {
  public:
-  /// Bins particles [0, n) into cells of at least `cutoff` and builds the half list.
-  void build(const ParticleStore& s, const BoxGeometry& g, double cutoff_m);
+  /// Bins particles [0, n) into cells of at least `cutoff` and builds the half list. With
+  /// rows < n, only particles [0, rows) get pairs (ghost copies after them are partners only).
+  void build(const ParticleStore& s, const BoxGeometry& g, double cutoff_m, std::size_t rows = kAllRows);
   /// Bins particles and returns the storage order that groups them cell by cell (x fastest), for
   /// cache locality. After the caller permutes the particles by it, build_binned() builds the
   /// list without binning again.
   std::vector<std::size_t> bin_and_order(const ParticleStore& s, const BoxGeometry& g, double cutoff_m);
-  void build_binned(const ParticleStore& s, const BoxGeometry& g, double cutoff_m);
+  void build_binned(const ParticleStore& s, const BoxGeometry& g, double cutoff_m, std::size_t rows = kAllRows);
+  static constexpr std::size_t kAllRows = static_cast<std::size_t>(-1);
 
   std::size_t pair_count() const { return neighbors.size(); }
 

@@ -1,5 +1,7 @@
 #include "particles/particle_store.hpp"
 
+#include <algorithm>
+
 #include "core/constants.hpp"
 
 namespace boycott::particles {
@@ -15,6 +17,12 @@ void ParticleStore::add(std::int64_t gid, double px, double py, double pz, doubl
   mass.back() = m;
   inertia.back() = 0.4 * m * r * r;
   n_local = id.size();
+}
+
+void ParticleStore::resize(std::size_t n) {
+  id.resize(n);
+  for_each_array([n](std::vector<double>& a) { a.resize(n, 0.0); });
+  n_local = std::min(n_local, n);
 }
 
 void ParticleStore::permute(const std::vector<std::size_t>& order) {

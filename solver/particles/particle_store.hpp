@@ -27,19 +27,32 @@ struct ParticleStore {
   /// Drag impulse beta (u_f - v) dt actually applied by the kicks since the coupling last reset
   /// it, N s: what the fluid must receive back so that momentum is exchanged exactly.
   std::vector<double> drag_jx, drag_jy, drag_jz;
+  // Kept for the coupling over one CFD step, here so that they move with a particle that
+  // changes rank mid-step: the velocity at the step's start (m/s), the explicit reaction owed to
+  // the fluid (N), and the pressure-gradient plus viscous force of the last sampling (N).
+  std::vector<double> v0x, v0y, v0z;
+  std::vector<double> react_x, react_y, react_z;
+  std::vector<double> fpv_x, fpv_y, fpv_z;
 
   std::size_t size() const { return id.size(); }
+  /// Arrays that for_each_array visits (a checkpoint stores them in this order; the coupling
+  /// arrays were added last, so a checkpoint of 29 arrays is an older one).
+  static constexpr int kArrays = 38;
+  /// Keeps the first n particles (drops ghost copies, for instance).
+  void resize(std::size_t n);
 
   /// Appends a local particle at rest (before any ghost is created).
   void add(std::int64_t gid, double px, double py, double pz, double r, double density_kg_m3);
 
   /// Reorders every per-particle array by `order` (new index k holds old particle order[k]).
+  /// An order of fewer particles than stored puts those first; resize() then drops the rest.
   void permute(const std::vector<std::size_t>& order);
 
   template <class F>
   void for_each_array(F&& f) {
     for (auto* a : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &mass,
-                    &inertia, &ext_x, &ext_y, &ext_z, &beta, &ufx, &ufy, &ufz, &madd, &drag_jx, &drag_jy, &drag_jz})
+                    &inertia, &ext_x, &ext_y, &ext_z, &beta, &ufx, &ufy, &ufz, &madd, &drag_jx, &drag_jy, &drag_jz,
+                    &v0x, &v0y, &v0z, &react_x, &react_y, &react_z, &fpv_x, &fpv_y, &fpv_z})
       f(*a);
   }
 };

@@ -1,7 +1,12 @@
 #include "scenes/coupled_checkpoint.hpp"
 
+#include <mpi.h>
+
+#include <array>
 #include <cstdio>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -12,16 +17,71 @@
 
 namespace boycott::scenes {
 
-void save_coupled(io::CheckpointWriter& w, const coupling::CoupledSystem& run) {
+namespace {
+
+/// The fluid's state over the whole grid on rank 0, in natural order: the ranks' z-slabs are
+/// consecutive blocks of whole planes in rank order, so their owned arrays follow each other.
+fluid::FluidState gather_fluid(const fluid::FluidSolver& f) {
+  fluid::FluidState st = f.export_state();
+  int size = 1, rank = 0;
+  MPI_Comm_size(f.comm(), &size);
+  MPI_Comm_rank(f.comm(), &rank);
+  if (size == 1) return st;
+  const auto& g = f.settings().grid;
+  for (auto& field : st.fields) {
+    const int n = static_cast<int>(field.size());
+    std::vector<int> counts(size), displs(size);
+    MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, f.comm());
+    int total = 0;
+    for (int r = 0; r < size; ++r) displs[r] = total, total += counts[r];
+    std::vector<double> all(rank == 0 ? static_cast<std::size_t>(total) : 0);
+    MPI_Gatherv(field.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, f.comm());
+    field.swap(all);
+  }
+  st.box.lo = {0, 0, 0};
+  st.box.size = {g.n[0], g.n[1], g.n[2]};
+  return st;
+}
+
+/// This rank's planes of a whole-grid fluid state.
+fluid::FluidState own_part(const fluid::FluidState& whole, const fluid::FluidSolver& f, const std::string& file) {
+  const auto box = f.owned_box();
+  const auto& g = f.settings().grid;
+  if (whole.box.lo != box.lo || whole.box.size != box.size) {
+    const bool whole_grid = whole.box.lo == std::array<std::int64_t, 3>{0, 0, 0} &&
+                            whole.box.size == std::array<std::int64_t, 3>{g.n[0], g.n[1], g.n[2]};
+    if (!whole_grid || box.lo[0] != 0 || box.lo[1] != 0 || box.size[0] != g.n[0] || box.size[1] != g.n[1])
+      throw CheckpointError(fmt::format("{}: the fluid grid was decomposed differently", file));
+  } else {
+    return whole;
+  }
+  fluid::FluidState st = whole;
+  st.box = box;
+  const std::size_t plane = static_cast<std::size_t>(g.n[0] * g.n[1]);
+  for (auto& field : st.fields) {
+    const auto first = field.begin() + static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(box.lo[2]));
+    field = std::vector<double>(first, first + static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(box.size[2])));
+  }
+  return st;
+}
+
+}  // namespace
+
+void save_coupled(io::CheckpointWriter* w, const coupling::CoupledSystem& run) {
   const auto c = run.counters();
-  w.put("run.time_s", c.time_s);
-  w.put("run.dt_prev_s", c.dt_prev_s);
-  w.put_int("run.steps", c.steps);
-  w.put_int("run.unconverged_fluid_steps", c.unconverged_fluid_steps);
-  w.put_int("run.pressure_fallbacks", c.pressure_fallbacks);
-  io::save(w, "dem.", run.dem().export_state());
-  io::save(w, "fluid.", run.fluid().export_state());
-  io::save(w, "coupler.", run.coupler().export_state());
+  // Collective: every rank contributes, rank 0 writes.
+  const auto dem = run.dem().export_state();
+  const auto fluid = gather_fluid(run.fluid());
+  const auto coupler = run.coupler().export_state();
+  if (!w) return;
+  w->put("run.time_s", c.time_s);
+  w->put("run.dt_prev_s", c.dt_prev_s);
+  w->put_int("run.steps", c.steps);
+  w->put_int("run.unconverged_fluid_steps", c.unconverged_fluid_steps);
+  w->put_int("run.pressure_fallbacks", c.pressure_fallbacks);
+  io::save(*w, "dem.", dem);
+  io::save(*w, "fluid.", fluid);
+  io::save(*w, "coupler.", coupler);
 }
 
 void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run) {
@@ -33,16 +93,14 @@ void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run) {
   c.unconverged_fluid_steps = r.has("run.unconverged_fluid_steps") ? r.integer("run.unconverged_fluid_steps") : 0;
   c.pressure_fallbacks = r.has("run.pressure_fallbacks") ? r.integer("run.pressure_fallbacks") : 0;
   run.restore_counters(c);
+  run.decompose();
   particles::DemState ds;
   io::load(r, "dem.", ds);
   run.dem().import_state(ds);
   fluid::FluidState fs;
   io::load(r, "fluid.", fs);
-  const auto box = run.fluid().owned_box();
-  if (fs.box.lo != box.lo || fs.box.size != box.size)
-    throw CheckpointError(fmt::format("{}: the fluid grid was decomposed differently (other rank count?)", r.path().string()));
-  run.fluid().import_state(fs);
-  run.coupler().import_state(io::load_arrays(r, "coupler."));
+  run.fluid().import_state(own_part(fs, run.fluid(), r.path().string()));
+  run.coupler().import_state(io::load_arrays(r, "coupler."), run.dem());
 }
 
 std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::filesystem::path& run_dir, bool quiet,
@@ -57,20 +115,25 @@ std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::fi
   load_coupled(r, run);
   load_scene(r);
   truncate_csv_after(run_dir / "timeseries.csv", run.time_s());
-  if (!quiet) std::fprintf(stderr, "resuming from %s at t = %g s\n", ck->c_str(), run.time_s());
+  if (!quiet && output_rank()) std::fprintf(stderr, "resuming from %s at t = %g s\n", ck->c_str(), run.time_s());
   return r.scalar("run.wall_time_s");
 }
 
 void checkpoint_coupled(const coupling::CoupledSystem& run, const std::filesystem::path& run_dir, double wall_time_s,
                         const std::function<void(io::CheckpointWriter&)>& save_scene) {
-  io::CheckpointWriter w(io::checkpoint_path(run_dir, run.steps()));
-  w.put_string("case_id", case_id(run.params()));
-  w.put_string("case_json", to_json(run.params()).dump());
-  w.put_string("program_version", std::string(kVersion));
-  save_coupled(w, run);
-  save_scene(w);
-  w.put("run.wall_time_s", wall_time_s);
-  w.commit();
+  // One file for all ranks, written by rank 0 from the gathered state.
+  std::optional<io::CheckpointWriter> w;
+  if (output_rank()) {
+    w.emplace(io::checkpoint_path(run_dir, run.steps()));
+    w->put_string("case_id", case_id(run.params()));
+    w->put_string("case_json", to_json(run.params()).dump());
+    w->put_string("program_version", std::string(kVersion));
+  }
+  save_coupled(w ? &*w : nullptr, run);
+  if (!w) return;
+  save_scene(*w);
+  w->put("run.wall_time_s", wall_time_s);
+  w->commit();
   io::prune_checkpoints(run_dir, static_cast<int>(run.params().output.keep_checkpoints));
 }
 

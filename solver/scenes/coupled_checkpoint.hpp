@@ -11,7 +11,10 @@
 
 namespace boycott::scenes {
 
-void save_coupled(io::CheckpointWriter& w, const coupling::CoupledSystem& run);
+/// Collective; w is rank 0's writer (nullptr on the other ranks). The state is the whole run's
+/// (all particles, the whole grid), so another number of ranks can resume it.
+void save_coupled(io::CheckpointWriter* w, const coupling::CoupledSystem& run);
+/// Collective; every rank reads the same file.
 void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run);
 
 /// Resumes from the newest checkpoint in `run_dir`, if any: refuses one of another case
@@ -21,7 +24,8 @@ void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run);
 std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::filesystem::path& run_dir, bool quiet,
                                      const std::function<void(const io::CheckpointReader&)>& load_scene);
 /// Writes a checkpoint of this run and the scene's running sums (atomically; the newest
-/// output.keep_checkpoints are kept), recording the wall time spent so far (s).
+/// output.keep_checkpoints are kept), recording the wall time spent so far (s). Collective;
+/// save_scene runs on rank 0 only, so a scene reduces its per-rank sums before.
 void checkpoint_coupled(const coupling::CoupledSystem& run, const std::filesystem::path& run_dir, double wall_time_s,
                         const std::function<void(io::CheckpointWriter&)>& save_scene);
 

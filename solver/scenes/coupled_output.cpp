@@ -1,5 +1,9 @@
 #include "scenes/coupled_output.hpp"
 
+#include <mpi.h>
+
+#include <algorithm>
+#include <cstdint>
 #include <utility>
 
 #include <fmt/format.h>
@@ -8,14 +12,55 @@
 
 namespace boycott::scenes {
 
+std::vector<std::vector<double>> gather_particles(const coupling::CoupledSystem& run,
+                                                  const std::vector<const std::vector<double>*>& arrays) {
+  const auto& s = run.dem().particles();
+  const std::size_t n = s.n_local;
+  std::vector<std::vector<double>> out;
+  if (!run.dem().decomposition().parallel()) {
+    std::vector<std::size_t> order(n);
+    for (std::size_t k = 0; k < n; ++k) order[k] = k;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return s.id[a] < s.id[b]; });
+    for (const auto* a : arrays) {
+      std::vector<double> sorted(n);
+      for (std::size_t k = 0; k < n; ++k) sorted[k] = (*a)[order[k]];
+      out.push_back(std::move(sorted));
+    }
+    return out;
+  }
+  // Gathered to rank 0, then put in id order (each rank stores its own in spatial order).
+  const MPI_Comm comm = run.fluid().comm();
+  int size = 1, rank = 0;
+  MPI_Comm_size(comm, &size);
+  MPI_Comm_rank(comm, &rank);
+  const int mine = static_cast<int>(n);
+  std::vector<int> counts(size), displs(size);
+  MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
+  int total = 0;
+  for (int r = 0; r < size; ++r) displs[r] = total, total += counts[r];
+  std::vector<std::int64_t> ids(rank == 0 ? static_cast<std::size_t>(total) : 0);
+  MPI_Gatherv(s.id.data(), mine, MPI_INT64_T, ids.data(), counts.data(), displs.data(), MPI_INT64_T, 0, comm);
+  std::vector<std::size_t> order(ids.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return ids[a] < ids[b]; });
+  for (const auto* a : arrays) {
+    std::vector<double> all(ids.size());
+    MPI_Gatherv(a->data(), mine, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, comm);
+    std::vector<double> sorted(all.size());
+    for (std::size_t k = 0; k < order.size(); ++k) sorted[k] = all[order[k]];
+    out.push_back(std::move(sorted));
+  }
+  return out;
+}
+
 io::SnapshotData coupled_snapshot(const coupling::CoupledSystem& run) {
   io::SnapshotData d;
   d.time_s = run.time_s();
   const auto& s = run.dem().particles();
-  const std::size_t n = s.n_local;
-  for (auto [dst, src] : {std::pair{&d.x, &s.x}, {&d.y, &s.y}, {&d.z, &s.z}, {&d.vx, &s.vx}, {&d.vy, &s.vy},
-                          {&d.vz, &s.vz}, {&d.radius, &s.radius}})
-    dst->assign(src->begin(), src->begin() + static_cast<std::ptrdiff_t>(n));
+  auto parts = gather_particles(run, {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.radius});
+  d.x = std::move(parts[0]), d.y = std::move(parts[1]), d.z = std::move(parts[2]);
+  d.vx = std::move(parts[3]), d.vy = std::move(parts[4]), d.vz = std::move(parts[5]);
+  d.radius = std::move(parts[6]);
   const auto& g = run.fluid().settings().grid;
   const int nx = (int)g.n[0], ny = (int)g.n[1], nz = (int)g.n[2];
   const bool walls = !g.periodic[1];
@@ -63,14 +108,17 @@ CoupledSceneOutput::CoupledSceneOutput(const coupling::CoupledSystem& run, const
 void CoupledSceneOutput::write_pictures(double t) {
   snapshots_.reached(t, [&](std::size_t index, double) {
     ModelTimers::Scope sc(timers_, "snapshots");
-    io::write_snapshot(ctx_.out_dir, static_cast<int>(index), coupled_snapshot(run_), run_.fluid().settings().grid);
+    const auto d = coupled_snapshot(run_);  // collective
+    if (output_rank()) io::write_snapshot(ctx_.out_dir, static_cast<int>(index), d, run_.fluid().settings().grid);
   });
   images_.reached(t, [&](std::size_t, double time) {
     ModelTimers::Scope sc(timers_, "images");
     const auto& p = run_.params();
     const auto& s = run_.dem().particles();
-    const io::ParticleView view{&s.x, &s.y, &s.z, &s.radius, s.n_local, p.domain.length_x_m, p.domain.width_y_m,
-                                p.domain.height_z_m};
+    const auto parts = gather_particles(run_, {&s.x, &s.y, &s.z, &s.radius});
+    if (!output_rank()) return;
+    const io::ParticleView view{&parts[0], &parts[1], &parts[2], &parts[3], parts[0].size(), p.domain.length_x_m,
+                                p.domain.width_y_m, p.domain.height_z_m};
     io::write_particle_png(ctx_.out_dir / fmt::format("particles_t{:.3f}.png", time), view);
   });
 }

@@ -15,8 +15,13 @@
 
 namespace boycott::scenes {
 
-/// Particles and cell-centred fluid fields (alpha_f, p, u, v, w) of a coupled run now.
+/// Particles (in id order) and cell-centred fluid fields (alpha_f, p, u, v, w) of a coupled run
+/// now; collective, complete on rank 0.
 io::SnapshotData coupled_snapshot(const coupling::CoupledSystem& run);
+/// The local particles' values of some arrays, gathered in id order on rank 0 (as they are on
+/// one rank); collective.
+std::vector<std::vector<double>> gather_particles(const coupling::CoupledSystem& run,
+                                                  const std::vector<const std::vector<double>*>& arrays);
 
 class CoupledSceneOutput {
  public:

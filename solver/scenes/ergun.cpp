@@ -103,7 +103,7 @@ int run_ergun(const CaseParams& p, RunContext& ctx) {
   j["points"] = points;
   j["max_rel_error_f_star"] = max_err;
   j["porosity"] = porosity;
-  j["particle_count"] = run.dem().particles().n_local;
+  j["particle_count"] = run.dem().global_count();
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   return exit_code;
 }

@@ -42,6 +42,14 @@ double isolated_terminal_speed(const CaseParams& p) {
   });
 }
 
+/// A histogram of the particles of every rank (each rank counts its own).
+Histogram over_ranks(const coupling::CoupledSystem& run, Histogram h) {
+  for (double& c : h.counts_) c = run.global_sum(c);
+  h.outside_ = run.global_sum(h.outside_);
+  h.total_ = run.global_sum(h.total_);
+  return h;
+}
+
 void write_pdf(const std::filesystem::path& path, const std::string& column, const Histogram& h) {
   std::string text = fmt::format("{},probability_density\n", column);
   const auto dens = h.density();
@@ -73,8 +81,11 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     io::load(r, "stats.wp.", wp_avg);
     io::load(r, "stats.wf.", wf_avg);
     io::load(r, "stats.slurry.", slurry_avg);
-    io::load(r, "stats.pdf_y.", pdf_y);
-    io::load(r, "stats.pdf_w.", pdf_w);
+    // The histograms are counts over all ranks: rank 0 carries them on, the others add theirs.
+    if (output_rank()) {
+      io::load(r, "stats.pdf_y.", pdf_y);
+      io::load(r, "stats.pdf_w.", pdf_w);
+    }
     slurry_max = r.scalar("stats.slurry_max");
     next_out = r.scalar("stats.next_out");
     if (r.has("stats.alpha_min_seen")) {  // absent in checkpoints of earlier builds
@@ -96,12 +107,13 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
                          resumed.has_value(), next_out);
   auto write_checkpoint = [&] {
     ModelTimers::Scope sc(timers, "checkpoints");
+    const Histogram all_y = over_ranks(run, pdf_y), all_w = over_ranks(run, pdf_w);
     checkpoint_coupled(run, ctx.out_dir, wall_before + clock.seconds(), [&](io::CheckpointWriter& w) {
       io::save(w, "stats.wp.", wp_avg);
       io::save(w, "stats.wf.", wf_avg);
       io::save(w, "stats.slurry.", slurry_avg);
-      io::save(w, "stats.pdf_y.", pdf_y);
-      io::save(w, "stats.pdf_w.", pdf_w);
+      io::save(w, "stats.pdf_y.", all_y);
+      io::save(w, "stats.pdf_w.", all_w);
       w.put("stats.slurry_max", slurry_max);
       w.put("stats.next_out", out.next_out_s());
       w.put("stats.alpha_min_seen", alpha_min_seen);
@@ -143,6 +155,8 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   }
   out.flush();
   run.report_timers(timers);
+  pdf_y = over_ranks(run, pdf_y);
+  pdf_w = over_ranks(run, pdf_w);
   if (wp_avg.count()) {
     write_pdf(ctx.out_dir / "pdf_y.csv", "y_m", pdf_y);
     write_pdf(ctx.out_dir / "pdf_wp.csv", "wp_m_s", pdf_w);
@@ -150,7 +164,8 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
 
   sb.simulated_time_s = run.time_s();
   sb.wall_time_s = wall_before + clock.seconds();
-  sb.particle_steps = static_cast<double>(s.n_local) * static_cast<double>(run.dem().steps());
+  const std::int64_t particles = run.dem().global_count();
+  sb.particle_steps = static_cast<double>(particles) * static_cast<double>(run.dem().steps());
   sb.mean_settling_velocity_m_s = wp_avg.count() ? wp_avg.mean() : kUnset;
   sb.settling_velocity_stderr_m_s = wp_avg.stderr_of_mean();
   auto j = make_summary(p, sb, timers);
@@ -158,7 +173,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   j["mean_slurry_velocity_m_s"] = slurry_avg.count() ? slurry_avg.mean() : kUnset;
   j["max_abs_slurry_velocity_m_s"] = slurry_max;
   j["isolated_terminal_velocity_m_s"] = vt;
-  j["particle_count"] = s.n_local;
+  j["particle_count"] = particles;
   j["solid_fraction"] = p.solid_fraction();
   j["cfd_steps"] = run.steps();
   j["min_fluid_fraction"] = alpha_min_seen;

@@ -12,10 +12,30 @@
 #include <fmt/format.h>
 
 #include "core/version.hpp"
+#include "scenes/scene.hpp"
 
 namespace boycott::scenes {
 
+bool RunContext::should_stop() const {
+  int local = stop_requested && stop_requested->load(std::memory_order_relaxed) ? 1 : 0;
+  int initialized = 0, size = 1;
+  MPI_Initialized(&initialized);
+  if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &size);
+  if (size == 1) return local != 0;
+  int any = 0;
+  MPI_Allreduce(&local, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  return any != 0;
+}
+
+bool output_rank() {
+  int initialized = 0, rank = 0;
+  MPI_Initialized(&initialized);
+  if (initialized) MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  return rank == 0;
+}
+
 void write_file_atomic(const std::filesystem::path& path, const std::string& text) {
+  if (!output_rank()) return;
   const auto tmp = path.string() + ".tmp";
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (fd < 0) throw std::runtime_error(fmt::format("cannot write {}", tmp));
@@ -58,6 +78,7 @@ nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const Mod
 
 CsvWriter::CsvWriter(const std::filesystem::path& path, std::vector<std::string> columns, bool append)
     : ncol_(columns.size()) {
+  if (!output_rank()) return;
   const bool exists = std::filesystem::exists(path) && std::filesystem::file_size(path) > 0;
   f_ = std::fopen(path.c_str(), append && exists ? "a" : "w");
   if (!f_) throw std::runtime_error(fmt::format("cannot write {}", path.string()));
@@ -72,13 +93,17 @@ CsvWriter::~CsvWriter() {
 }
 
 void CsvWriter::row(const std::vector<double>& values) {
+  if (!f_) return;
   for (std::size_t i = 0; i < values.size() && i < ncol_; ++i) std::fprintf(f_, i ? ",%.10g" : "%.10g", values[i]);
   std::fputc('\n', f_);
 }
 
-void CsvWriter::flush() { std::fflush(f_); }
+void CsvWriter::flush() {
+  if (f_) std::fflush(f_);
+}
 
 void truncate_csv_after(const std::filesystem::path& path, double t_max) {
+  if (!output_rank()) return;
   std::ifstream in(path);
   if (!in) return;
   std::string line, out;

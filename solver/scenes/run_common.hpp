@@ -17,8 +17,12 @@
 
 namespace boycott::scenes {
 
+/// True on the rank that writes a run's files: rank 0 under MPI (every rank runs the scene and
+/// computes the values, which are global), or the only process.
+bool output_rank();
+
 /// Writes `text` to `path` through a temporary file, fsync and rename, so a reader (or a kill)
-/// never sees half a file.
+/// never sees half a file. Only on the output rank (a no-op on the others).
 void write_file_atomic(const std::filesystem::path& path, const std::string& text);
 
 /// Common summary keys. Scene-specific keys are added to the returned object by the scene.
@@ -33,6 +37,7 @@ struct SummaryBase {
 nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const ModelTimers& timers);
 
 /// Appends rows to a CSV file with a fixed header; creates it (with the header) when absent.
+/// Only the output rank writes.
 class CsvWriter {
  public:
   CsvWriter(const std::filesystem::path& path, std::vector<std::string> columns, bool append);
@@ -48,7 +53,7 @@ class CsvWriter {
 };
 
 /// Drops the rows of a CSV file whose first column exceeds t_max (a resumed run repeats nothing
-/// and loses nothing: rows written after its checkpoint are computed again).
+/// and loses nothing: rows written after its checkpoint are computed again). Output rank only.
 void truncate_csv_after(const std::filesystem::path& path, double t_max);
 
 /// Wall clock since construction, seconds.
@@ -91,7 +96,7 @@ bool checkpoint_or_stop(bool stop_requested, bool quiet, CheckpointClock& clock,
   }
   if (!stop_requested) return false;
   summary.status = "interrupted";
-  if (!quiet) std::fprintf(stderr, "stopped at t = %g s after writing a checkpoint; run again to resume\n", t_s);
+  if (!quiet && output_rank()) std::fprintf(stderr, "stopped at t = %g s after writing a checkpoint; run again to resume\n", t_s);
   return true;
 }
 

@@ -20,7 +20,9 @@ struct RunContext {
   bool quiet = false;
   /// Progress callback (simulated time s), for the driver's display; may be empty.
   std::function<void(double)> progress;
-  bool should_stop() const { return stop_requested && stop_requested->load(std::memory_order_relaxed); }
+  /// Whether to stop at the end of this step. Collective under MPI (every rank calls it once per
+  /// step): a signal that reached one rank stops all of them at the same step.
+  bool should_stop() const;
 };
 
 /// Runs (or resumes) a case. Returns the process exit code (error.hpp); writes summary.json.

@@ -82,16 +82,26 @@ struct Profiles {
     }
     steps += 1.0;
   }
+  /// The particle sums of every rank (the fluid profile is the same on all of them).
+  Profiles over_ranks(const coupling::CoupledSystem& run) const {
+    Profiles all = *this;
+    for (auto* v : {&all.solid_volume, &all.particle_flux})
+      for (double& x : *v) x = run.global_sum(x);
+    return all;
+  }
   void save(io::CheckpointWriter& w) const {
     w.put("stats.profile.fluid_w", fluid_w);
     w.put("stats.profile.solid_volume", solid_volume);
     w.put("stats.profile.particle_flux", particle_flux);
     w.put("stats.profile.steps", steps);
   }
+  /// The particle sums go to rank 0, which carries on the all-rank totals (the others add theirs).
   void load(const io::CheckpointReader& r) {
     fluid_w = r.doubles("stats.profile.fluid_w");
-    solid_volume = r.doubles("stats.profile.solid_volume");
-    particle_flux = r.doubles("stats.profile.particle_flux");
+    if (output_rank()) {
+      solid_volume = r.doubles("stats.profile.solid_volume");
+      particle_flux = r.doubles("stats.profile.particle_flux");
+    }
     steps = r.scalar("stats.profile.steps");
   }
   void write(const std::filesystem::path& path, double h, double area) const {
@@ -171,7 +181,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   auto transport_rate = [&] {
     double q = 0.0;
     for (std::size_t i = 0; i < s.n_local; ++i) q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
-    return q / A;  // m^2/s
+    return run.global_sum(q) / A;  // m^2/s
   };
 
   CoupledSceneOutput out(run, ctx, timers,
@@ -180,6 +190,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
                          resumed.has_value(), next_out);
   auto write_checkpoint = [&] {
     ModelTimers::Scope sc(timers, "checkpoints");
+    const Profiles all_profiles = profiles.over_ranks(run);
     checkpoint_coupled(run, ctx.out_dir, wall_before + clock.seconds(), [&](io::CheckpointWriter& w) {
       for (auto [name, b] : {std::pair{"q", &q_avg}, {"g", &g_avg}, {"wf", &wf_avg}, {"vp", &vp_avg}})
         io::save(w, fmt::format("stats.{}.", name), *b);
@@ -187,7 +198,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
       w.put("stats.ke_max_seen", ke_max_seen);
       w.put("stats.next_out", out.next_out_s());
       w.put("stats.bed_pouring_time_s", settle_s);
-      profiles.save(w);
+      all_profiles.save(w);
     });
   };
   SummaryBase sb;
@@ -217,12 +228,13 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
     }
   }
   out.flush();
-  profiles.write(ctx.out_dir / "profiles.csv", h_y, A);
+  profiles.over_ranks(run).write(ctx.out_dir / "profiles.csv", h_y, A);
   run.report_timers(timers);
 
   sb.simulated_time_s = run.time_s();
   sb.wall_time_s = wall_before + clock.seconds();
-  sb.particle_steps = static_cast<double>(s.n_local) * static_cast<double>(run.dem().steps());
+  const std::int64_t particles = run.dem().global_count();
+  sb.particle_steps = static_cast<double>(particles) * static_cast<double>(run.dem().steps());
   sb.mean_settling_velocity_m_s = vp_avg.count() ? vp_avg.mean() : kUnset;
   sb.settling_velocity_stderr_m_s = vp_avg.stderr_of_mean();
   auto j = make_summary(p, sb, timers);
@@ -249,7 +261,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   // Relative distance to each curve (null where the curve gives no transport).
   j["wong_parker_rel_error"] = qwp > 0.0 ? nlohmann::json((q_star - qwp) / qwp) : nlohmann::json(nullptr);
   j["nielsen_rel_error"] = qn > 0.0 ? nlohmann::json((q_star - qn) / qn) : nlohmann::json(nullptr);
-  j["particle_count"] = s.n_local;
+  j["particle_count"] = particles;
   j["min_fluid_fraction"] = alpha_min_seen;
   j["max_kinetic_energy_j"] = ke_max_seen;
   j["cfd_steps"] = run.steps();
@@ -257,7 +269,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   j["pressure_solver_fallbacks"] = run.pressure_fallbacks();
   j["unconverged_fluid_steps"] = run.unconverged_fluid_steps();
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
-  if (!ctx.quiet)
+  if (!ctx.quiet && output_rank())
     std::printf("sediment_transport: t = %.4g s, q* = %.4g, tau* = %.4g (Wong-Parker q* %.4g, Nielsen %.4g)\n",
                 run.time_s(), q_star, tau_star, qwp, qn);
   return exit_code;

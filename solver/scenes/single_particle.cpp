@@ -51,6 +51,8 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
                  "reynolds_number"},
                 false);
   const auto& s = run.dem().particles();
+  // The particle lives on one rank: its values as every rank sees them.
+  const auto particle = [&](const std::vector<double>& a) { return run.global_sum(s.n_local ? a[0] : 0.0); };
   BatchMeans wp_avg;
   double acc0 = kUnset;
   int exit_code = kExitOk;
@@ -60,24 +62,26 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   while (run.time_s() < end - 1e-12) {
     const coupling::CoupledStep st = run.step();
     const double t = run.time_s();
-    if (run.steps() == 1) acc0 = s.vz[0] / st.dt_s;
-    if (t > p.time.average_from_s + 1e-12) wp_avg.add(s.vz[0]);
-    const double slip = std::sqrt(std::pow(s.vx[0] - s.ufx[0], 2) + std::pow(s.vy[0] - s.ufy[0], 2) +
-                                  std::pow(s.vz[0] - s.ufz[0], 2));
-    csv.row({t, s.vz[0], s.vx[0], s.vy[0], run.mean_fluid_velocity_z(), run.slurry_velocity_z(),
-             run.fluid().mean_pressure_gradient_pa_m(), slip * d / nu});
+    const double vx = particle(s.vx), vy = particle(s.vy), vz = particle(s.vz);
+    if (run.steps() == 1) acc0 = vz / st.dt_s;
+    if (t > p.time.average_from_s + 1e-12) wp_avg.add(vz);
+    const double slip =
+        std::sqrt(std::pow(vx - particle(s.ufx), 2) + std::pow(vy - particle(s.ufy), 2) + std::pow(vz - particle(s.ufz), 2));
+    csv.row({t, vz, vx, vy, run.mean_fluid_velocity_z(), run.slurry_velocity_z(), run.fluid().mean_pressure_gradient_pa_m(),
+             slip * d / nu});
     if (ctx.progress) ctx.progress(t);
     if (ctx.should_stop()) {
       sb.status = "interrupted";
       exit_code = kExitFailure;
-      std::fprintf(stderr, "interrupted at t = %g s; single_particle writes no checkpoint, a rerun starts over\n", t);
+      if (output_rank())
+        std::fprintf(stderr, "interrupted at t = %g s; single_particle writes no checkpoint, a rerun starts over\n", t);
       break;
     }
   }
   csv.flush();
   run.report_timers(timers);
 
-  const double wt = wp_avg.count() ? wp_avg.mean() : s.vz[0];
+  const double wt = wp_avg.count() ? wp_avg.mean() : particle(s.vz);
   sb.simulated_time_s = run.time_s();
   sb.wall_time_s = clock.seconds();
   sb.particle_steps = static_cast<double>(run.dem().steps());

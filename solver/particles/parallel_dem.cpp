@@ -1,0 +1,282 @@
+// The DEM on several MPI ranks (SlabDecomposition): each rank integrates the particles of its
+// z-slab and holds copies ("ghosts") of the other ranks' particles within the neighbour cutoff of
+// its slab, stored after its own. A pair across a slab face is computed on both ranks, each
+// keeping the force on its own particle; the arithmetic of a pair is exactly antisymmetric (the
+// same bits seen from either side), so both ranks carry the same shear history for it. At each
+// neighbour-list rebuild the particles that left the slab move to their new rank with
+// everything that belongs to them (coupling arrays, predicted velocities, wall and pair
+// histories, keyed by global ids); between rebuilds only the ghosts' positions and velocities
+// are refreshed. One rank never comes here.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "core/timers.hpp"
+#include "particles/dem_system.hpp"
+
+namespace boycott::particles {
+
+namespace {
+
+/// Sends buffer out[r] to rank r and returns what arrives, sources in rank order; counts[r]: the
+/// number of values that came from rank r.
+std::vector<double> exchange(MPI_Comm comm, const std::vector<std::vector<double>>& out, std::vector<int>& counts) {
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  std::vector<int> sc(size), sd(size), rd(size);
+  counts.assign(size, 0);
+  std::size_t total_out = 0;
+  for (int r = 0; r < size; ++r) {
+    sc[r] = static_cast<int>(out[r].size());
+    sd[r] = static_cast<int>(total_out);
+    total_out += out[r].size();
+  }
+  MPI_Alltoall(sc.data(), 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  std::size_t total_in = 0;
+  for (int r = 0; r < size; ++r) {
+    rd[r] = static_cast<int>(total_in);
+    total_in += static_cast<std::size_t>(counts[r]);
+  }
+  std::vector<double> send;
+  send.reserve(total_out);
+  for (const auto& b : out) send.insert(send.end(), b.begin(), b.end());
+  std::vector<double> recv(total_in);
+  MPI_Alltoallv(send.data(), sc.data(), sd.data(), MPI_DOUBLE, recv.data(), counts.data(), rd.data(), MPI_DOUBLE,
+                comm);
+  return recv;
+}
+
+/// Ghost data on creation: id, x, y, z, radius, mass, inertia, 6 predicted velocities, spin.
+constexpr int kGhostNew = 16;
+/// Ghost refresh between rebuilds: x, y, z, 6 predicted velocities, spin.
+constexpr int kGhostUpdate = 12;
+
+}  // namespace
+
+void DemSystem::decompose(const SlabDecomposition& d) {
+  if (dd_.parallel()) throw std::logic_error("DemSystem::decompose called twice");
+  dd_ = d;
+  ghost_send_.assign(static_cast<std::size_t>(dd_.size), {});
+  if (!dd_.parallel()) return;
+  // A run that stepped on its own first (a bed poured before the flow starts) keeps its contact
+  // histories; the next initialize() builds the parallel list.
+  if (initialized_) {
+    collect_histories();
+    carry_ready_ = true;
+    initialized_ = false;
+  }
+  std::vector<std::size_t> keep;
+  for (std::size_t i = 0; i < s_.size(); ++i)
+    if (dd_.owner(s_.z[i]) == dd_.rank) keep.push_back(i);
+  select_particles(keep);
+}
+
+void DemSystem::select_particles(const std::vector<std::size_t>& keep) {
+  // permute() by a subset puts those particles first, in that order; resize drops the rest.
+  s_.permute(keep);
+  s_.n_local = keep.size();
+  s_.resize(keep.size());
+  const auto pick = [&](std::vector<double>& a) {
+    if (a.empty()) return;
+    std::vector<double> kept(keep.size());
+    for (std::size_t k = 0; k < keep.size(); ++k) kept[k] = a[keep[k]];
+    a.swap(kept);
+  };
+  for (auto& a : pred_) pick(a);
+  for (auto* wh : {&whx_, &why_, &whz_})
+    for (auto& a : *wh) pick(a);
+}
+
+void DemSystem::set_cutoff_and_mass() {
+  double rmax = 0.0, mmin = std::numeric_limits<double>::infinity(), mmax = -mmin;
+  for (std::size_t i = 0; i < s_.n_local; ++i) {
+    rmax = std::max(rmax, s_.radius[i]);
+    mmin = std::min(mmin, s_.mass[i]);
+    mmax = std::max(mmax, s_.mass[i]);
+  }
+  rmax = global_max(dd_.comm, rmax);
+  mmin = global_min(dd_.comm, mmin);
+  mmax = global_max(dd_.comm, mmax);
+  cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
+  uniform_mass_kg_ = std::isfinite(mmin) && mmin == mmax ? mmin : 0.0;
+}
+
+bool DemSystem::needs_rebuild_parallel() const {
+  // Absolute displacements (the serial rule subtracts the mean drift): the slab faces do not
+  // move with the particles, so a uniformly drifting packing changes which pairs cross a face.
+  double worst = 0.0;
+  for (std::size_t i = 0; i < s_.n_local; ++i) {
+    const double dx = s_.x[i] - ref_x_[i], dy = s_.y[i] - ref_y_[i], dz = s_.z[i] - ref_z_[i];
+    worst = std::max(worst, dx * dx + dy * dy + dz * dz);
+  }
+  return global_max(dd_.comm, worst) > 0.25 * cfg_.skin_m * cfg_.skin_m;
+}
+
+void DemSystem::drop_ghosts() {
+  s_.resize(s_.n_local);
+  for (auto& a : pred_)
+    if (a.size() > s_.n_local) a.resize(s_.n_local);
+}
+
+void DemSystem::rebuild_parallel(bool collect) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (collect) collect_histories();
+  drop_ghosts();
+  for (int d = 0; d < 3; ++d) {
+    if (!cfg_.box.periodic[d]) continue;
+    auto& c = d == 0 ? s_.x : (d == 1 ? s_.y : s_.z);
+    const double lo = cfg_.box.lo[d], len = cfg_.box.len[d];
+    for (double& v : c) v -= len * std::floor((v - lo) / len);
+  }
+  migrate();
+  const auto order = nl_.bin_and_order(s_, cfg_.box, cutoff_m_);
+  s_.permute(order);
+  std::vector<double> tmp(order.size());
+  for (auto& a : pred_) {
+    for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = a[order[k]];
+    a.swap(tmp);
+  }
+  for (auto* wh : {&whx_, &why_, &whz_})
+    for (auto& a : *wh) {
+      for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = a[order[k]];
+      a.swap(tmp);
+    }
+  exchange_ghosts();
+  nl_.build(s_, cfg_.box, cutoff_m_, s_.n_local);
+  restore_histories(carry_a_, carry_b_, carry_h_);
+  rescan_wall_contacts();
+  ref_x_ = s_.x;
+  ref_y_ = s_.y;
+  ref_z_ = s_.z;
+  ++rebuilds_;
+  seconds_neighbor += seconds_since(t0);
+}
+
+void DemSystem::migrate() {
+  const std::size_t n = s_.n_local, nw = cfg_.walls.size();
+  const auto size = static_cast<std::size_t>(dd_.size);
+  std::vector<int> dest(n);
+  std::vector<std::pair<std::int64_t, int>> leaving;  // (id, destination), sorted by id below
+  for (std::size_t i = 0; i < n; ++i) {
+    dest[i] = dd_.owner(s_.z[i]);
+    if (dest[i] != dd_.rank) leaving.emplace_back(s_.id[i], dest[i]);
+  }
+  std::vector<std::vector<double>> out(size), out_pairs(size);
+  std::vector<std::size_t> keep;
+  keep.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (dest[i] == dd_.rank) {
+      keep.push_back(i);
+      continue;
+    }
+    auto& b = out[static_cast<std::size_t>(dest[i])];
+    b.push_back(static_cast<double>(s_.id[i]));
+    s_.for_each_array([&](std::vector<double>& a) { b.push_back(a[i]); });
+    for (const auto& a : pred_) b.push_back(a[i]);
+    for (std::size_t w = 0; w < nw; ++w) b.insert(b.end(), {whx_[w][i], why_[w][i], whz_[w][i]});
+  }
+  // The shear springs of the leaving particles go with them (both partners' new ranks).
+  std::sort(leaving.begin(), leaving.end());
+  auto dest_of = [&](std::int64_t id) {
+    auto it = std::lower_bound(leaving.begin(), leaving.end(), std::pair<std::int64_t, int>{id, -1});
+    return it != leaving.end() && it->first == id ? it->second : -1;
+  };
+  for (std::size_t q = 0; q < carry_a_.size(); ++q) {
+    const int da = dest_of(carry_a_[q]), db = dest_of(carry_b_[q]);
+    const auto send_to = [&](int r) {
+      out_pairs[static_cast<std::size_t>(r)].insert(out_pairs[static_cast<std::size_t>(r)].end(),
+                                                    {static_cast<double>(carry_a_[q]), static_cast<double>(carry_b_[q]),
+                                                     carry_h_[3 * q], carry_h_[3 * q + 1], carry_h_[3 * q + 2]});
+    };
+    if (da >= 0) send_to(da);
+    if (db >= 0 && db != da) send_to(db);
+  }
+  std::vector<int> counts;
+  const std::vector<double> in = exchange(dd_.comm, out, counts);
+  const std::vector<double> in_pairs = exchange(dd_.comm, out_pairs, counts);
+
+  // Keep the staying particles in their order, then append the arrivals in source-rank order.
+  select_particles(keep);
+  const std::size_t record = 1 + ParticleStore::kArrays + 6 + 3 * nw;
+  for (std::size_t at = 0; at + record <= in.size(); at += record) {
+    std::size_t k = at;
+    s_.id.push_back(static_cast<std::int64_t>(in[k++]));
+    s_.for_each_array([&](std::vector<double>& a) { a.push_back(in[k++]); });
+    for (auto& a : pred_) a.push_back(in[k++]);
+    for (std::size_t w = 0; w < nw; ++w) {
+      whx_[w].push_back(in[k++]);
+      why_[w].push_back(in[k++]);
+      whz_[w].push_back(in[k++]);
+    }
+    ++migrations_;
+  }
+  s_.n_local = s_.id.size();
+  for (std::size_t at = 0; at + 5 <= in_pairs.size(); at += 5) {
+    carry_a_.push_back(static_cast<std::int64_t>(in_pairs[at]));
+    carry_b_.push_back(static_cast<std::int64_t>(in_pairs[at + 1]));
+    carry_h_.insert(carry_h_.end(), {in_pairs[at + 2], in_pairs[at + 3], in_pairs[at + 4]});
+  }
+}
+
+void DemSystem::exchange_ghosts() {
+  const std::size_t n = s_.n_local;
+  const auto size = static_cast<std::size_t>(dd_.size);
+  ghost_send_.assign(size, {});
+  std::vector<std::vector<double>> out(size);
+  for (std::size_t r = 0; r < size; ++r) {
+    if (static_cast<int>(r) == dd_.rank) continue;
+    auto& list = ghost_send_[r];
+    auto& b = out[r];
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!(dd_.distance_to_slab(s_.z[i], static_cast<int>(r)) < cutoff_m_)) continue;
+      list.push_back(static_cast<std::uint32_t>(i));
+      b.insert(b.end(), {static_cast<double>(s_.id[i]), s_.x[i], s_.y[i], s_.z[i], s_.radius[i], s_.mass[i],
+                         s_.inertia[i], pred_[0][i], pred_[1][i], pred_[2][i], pred_[3][i], pred_[4][i], pred_[5][i],
+                         s_.wx[i], s_.wy[i], s_.wz[i]});
+    }
+  }
+  std::vector<int> counts;
+  const std::vector<double> in = exchange(dd_.comm, out, counts);
+  const std::size_t ng = in.size() / kGhostNew, total = n + ng;
+  s_.id.resize(total);
+  s_.for_each_array([&](std::vector<double>& a) { a.resize(total, 0.0); });
+  for (auto& a : pred_) a.resize(total, 0.0);
+  for (std::size_t g = 0; g < ng; ++g) {
+    const double* v = in.data() + g * kGhostNew;
+    const std::size_t i = n + g;
+    s_.id[i] = static_cast<std::int64_t>(v[0]);
+    s_.x[i] = v[1], s_.y[i] = v[2], s_.z[i] = v[3];
+    s_.radius[i] = v[4], s_.mass[i] = v[5], s_.inertia[i] = v[6];
+    for (int c = 0; c < 6; ++c) pred_[c][i] = v[7 + c];
+    s_.wx[i] = v[13], s_.wy[i] = v[14], s_.wz[i] = v[15];
+  }
+}
+
+void DemSystem::forward_ghosts() {
+  const auto size = static_cast<std::size_t>(dd_.size);
+  std::vector<std::vector<double>> out(size);
+  for (std::size_t r = 0; r < size; ++r) {
+    auto& b = out[r];
+    b.reserve(kGhostUpdate * ghost_send_[r].size());
+    for (std::uint32_t i : ghost_send_[r])
+      b.insert(b.end(), {s_.x[i], s_.y[i], s_.z[i], pred_[0][i], pred_[1][i], pred_[2][i], pred_[3][i], pred_[4][i],
+                         pred_[5][i], s_.wx[i], s_.wy[i], s_.wz[i]});
+  }
+  std::vector<int> counts;
+  const std::vector<double> in = exchange(dd_.comm, out, counts);
+  const std::size_t n = s_.n_local, ng = in.size() / kGhostUpdate;
+  if (n + ng != s_.size()) throw std::logic_error("DemSystem: ghost refresh does not match the ghosts held");
+  for (std::size_t g = 0; g < ng; ++g) {
+    const double* v = in.data() + g * kGhostUpdate;
+    const std::size_t i = n + g;
+    s_.x[i] = v[0], s_.y[i] = v[1], s_.z[i] = v[2];
+    for (int c = 0; c < 6; ++c) pred_[c][i] = v[3 + c];
+    s_.wx[i] = v[9], s_.wy[i] = v[10], s_.wz[i] = v[11];
+  }
+}
+
+}  // namespace boycott::particles
