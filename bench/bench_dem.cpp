@@ -34,10 +34,12 @@ int main(int argc, char** argv) {
   for (long n = 0; n < nrun; ++n) dem.step();
   const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double ps = static_cast<double>(s.n_local) * static_cast<double>(nrun);
-  std::printf("boycott: %zu particles, %ld steps, %.2f s (force %.2f, neighbour %.2f in %lld rebuilds, integrate %.2f), "
-              "contacts %lld, list pairs %zu, ns_per_particle_step=%.1f\n",
-              s.n_local, nrun, t, dem.seconds_force, dem.seconds_neighbor,
-              static_cast<long long>(dem.rebuilds() - rebuilds0), dem.seconds_integrate,
-              static_cast<long long>(dem.contact_count()), dem.neighbor_list().pair_count(), t / ps * 1e9);
+  std::printf(
+      "boycott: %zu particles, %ld steps, %.2f s (force %.2f, neighbour %.2f in %lld rebuilds, integrate "
+      "%.2f), "
+      "contacts %lld, list pairs %zu, ns_per_particle_step=%.1f\n",
+      s.n_local, nrun, t, dem.seconds_force, dem.seconds_neighbor,
+      static_cast<long long>(dem.rebuilds() - rebuilds0), dem.seconds_integrate,
+      static_cast<long long>(dem.contact_count()), dem.neighbor_list().pair_count(), t / ps * 1e9);
   return 0;
 }

@@ -9,10 +9,10 @@
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <random>
 #include <string>
 #include <vector>
@@ -71,7 +71,9 @@ void deposit(FluidSolver& f, const Particles& p, double mu) {
   f.end_deposition();
 }
 
-std::string fmt_piso(int n) { return "PISO, " + std::to_string(n) + " correctors"; }
+std::string fmt_piso(int n) {
+  return "PISO, " + std::to_string(n) + " correctors";
+}
 
 }  // namespace
 
@@ -109,7 +111,8 @@ int main(int argc, char** argv) {
   // the same random particles on every rank (seeded), settling through the periodic z
   Particles p;
   std::mt19937_64 rng(12345);
-  std::uniform_real_distribution<double> ux(0.0, 0.2), uy(0.5 * kDiameter, 0.006 - 0.5 * kDiameter), uz(0.0, 0.1);
+  std::uniform_real_distribution<double> ux(0.0, 0.2), uy(0.5 * kDiameter, 0.006 - 0.5 * kDiameter),
+      uz(0.0, 0.1);
   for (int n = 0; n < 120000; ++n) p.x.push_back(ux(rng)), p.y.push_back(uy(rng)), p.z.push_back(uz(rng));
   auto advance = [&](double dt) {
     for (auto& z : p.z) z = std::fmod(z + kSettling * dt + 0.1, 0.1);
@@ -143,19 +146,21 @@ int main(int argc, char** argv) {
       step_s += std::chrono::duration<double>(t2 - t1).count();
       step_times.push_back(std::chrono::duration<double>(t2 - t1).count());
       cpu_s += c2 - c1;
-      simple += rep.simple_iterations, pk += rep.pressure_krylov_iterations, mk += rep.momentum_krylov_iterations;
+      simple += rep.simple_iterations, pk += rep.pressure_krylov_iterations,
+          mk += rep.momentum_krylov_iterations;
       unconverged += !rep.converged;
     }
   }
   // collective diagnostics, on every rank (calling them on rank 0 alone hung the 2-rank bench)
   const double dt_end = f.stable_dt(), flux_end = f.mean_flux_z(), wmax_end = f.max_abs_velocity(2);
   if (rank == 0) {
-    std::printf("cfd_steps: mesh 200x6x100, %d rank(s), %d warm-up + %d timed steps, dt %.3g s, %s\n", size, warmup,
-                timed, dt_end, s.piso ? fmt_piso(s.piso_correctors).c_str() : "SIMPLE");
+    std::printf("cfd_steps: mesh 200x6x100, %d rank(s), %d warm-up + %d timed steps, dt %.3g s, %s\n", size,
+                warmup, timed, dt_end, s.piso ? fmt_piso(s.piso_correctors).c_str() : "SIMPLE");
     std::sort(step_times.begin(), step_times.end());
     std::printf("  ms per CFD step        %.2f (median %.2f; CPU ms of rank 0 %.2f)\n", 1e3 * step_s / timed,
                 1e3 * step_times[step_times.size() / 2], 1e3 * cpu_s / timed);
-    std::printf("  SIMPLE iterations/step %.2f (unconverged steps %ld)\n", double(simple) / timed, unconverged);
+    std::printf("  SIMPLE iterations/step %.2f (unconverged steps %ld)\n", double(simple) / timed,
+                unconverged);
     std::printf("  pressure Krylov/step   %.2f\n", double(pk) / timed);
     std::printf("  momentum Krylov/step   %.2f\n", double(mk) / timed);
     std::printf("  deposition ms/step     %.2f (not in the CFD figure)\n", 1e3 * dep_s / timed);

@@ -15,7 +15,9 @@ namespace boycott::driver {
 
 namespace {
 std::atomic<bool> g_stop{false};
-extern "C" void on_stop_signal(int) { g_stop.store(true); }
+extern "C" void on_stop_signal(int) {
+  g_stop.store(true);
+}
 
 void install_stop_handlers() {
   struct sigaction sa {};

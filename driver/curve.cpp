@@ -33,12 +33,9 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
   } else if (f == CurveFormat::kJson) {
     nlohmann::json j = nlohmann::json::array();
     for (const auto& p : pts) {
-      nlohmann::json e = {{"group", p.group},
-                          {"angle_deg", p.angle_deg},
-                          {"mean_settling_velocity_m_s", p.w_m_s},
-                          {"stderr_m_s", p.w_err_m_s},
-                          {"case_id", p.case_id},
-                          {"setting", p.setting}};
+      nlohmann::json e = {
+          {"group", p.group},          {"angle_deg", p.angle_deg}, {"mean_settling_velocity_m_s", p.w_m_s},
+          {"stderr_m_s", p.w_err_m_s}, {"case_id", p.case_id},     {"setting", p.setting}};
       e["r_acc"] = p.r_acc ? nlohmann::json(*p.r_acc) : nlohmann::json(nullptr);
       e["r_acc_err"] = p.r_acc_err ? nlohmann::json(*p.r_acc_err) : nlohmann::json(nullptr);
       j.push_back(e);
@@ -47,11 +44,12 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
   } else if (pts.empty()) {
     s = "(no finished cases)\n";
   } else {
-    s = fmt::format("{:<12} {:>6}  {:>24}  {:>18}  {}\n", "group", "angle", "<<w_p>> (mm/s)", "r_acc", "setting");
+    s = fmt::format("{:<12} {:>6}  {:>24}  {:>18}  {}\n", "group", "angle", "<<w_p>> (mm/s)", "r_acc",
+                    "setting");
     for (const auto& p : pts) {
       const std::string r = p.r_acc ? fmt::format("{:.3f} +- {:.3f}", *p.r_acc, *p.r_acc_err) : "-";
-      s += fmt::format("{:<12} {:>6g}  {:>11.4f} +- {:<9.4f}  {:>18}  {}\n", p.group, p.angle_deg, p.w_m_s * 1e3,
-                       p.w_err_m_s * 1e3, r, p.setting);
+      s += fmt::format("{:<12} {:>6g}  {:>11.4f} +- {:<9.4f}  {:>18}  {}\n", p.group, p.angle_deg,
+                       p.w_m_s * 1e3, p.w_err_m_s * 1e3, r, p.setting);
     }
   }
   return s;
@@ -60,7 +58,9 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
 namespace {
 
 // One line per group, or per (group, setting) when a group sweeps more than the angle.
-std::string series_of(const CurvePoint& p) { return p.setting.empty() ? p.group : p.group + " " + p.setting; }
+std::string series_of(const CurvePoint& p) {
+  return p.setting.empty() ? p.group : p.group + " " + p.setting;
+}
 
 struct Panel {
   double x0, y0, w, h;  // pixel box of the plot area

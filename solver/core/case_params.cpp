@@ -29,13 +29,21 @@ struct Rule {
   bool optional = false;  ///< may be unset (NaN)
 };
 
-Rule positive(const char* unit) { return Rule{0.0, kInf, true, false, {}, unit}; }
-Rule nonneg(const char* unit) { return Rule{0.0, kInf, false, false, {}, unit}; }
-Rule range(double a, double b, const char* unit = "") { return Rule{a, b, false, false, {}, unit}; }
+Rule positive(const char* unit) {
+  return Rule{0.0, kInf, true, false, {}, unit};
+}
+Rule nonneg(const char* unit) {
+  return Rule{0.0, kInf, false, false, {}, unit};
+}
+Rule range(double a, double b, const char* unit = "") {
+  return Rule{a, b, false, false, {}, unit};
+}
 Rule open_range(double a, double b, bool lo_open, bool hi_open, const char* unit = "") {
   return Rule{a, b, lo_open, hi_open, {}, unit};
 }
-Rule any(const char* unit = "") { return Rule{-kInf, kInf, false, false, {}, unit}; }
+Rule any(const char* unit = "") {
+  return Rule{-kInf, kInf, false, false, {}, unit};
+}
 Rule optional(Rule r) {
   r.optional = true;
   return r;
@@ -119,13 +127,16 @@ void visit_keys(P& p, V&& v) {
   v("sediment.initial_flow", p.sediment.initial_flow, choice({"turbulent", "rest"}));
 }
 
-std::string fmt_num(double v) { return fmt::format("{:g}", v); }
+std::string fmt_num(double v) {
+  return fmt::format("{:g}", v);
+}
 
 std::string describe_rule(const Rule& r) {
   if (!r.choices.empty()) return fmt::format("one of {}", fmt::join(r.choices, ", "));
   std::string s;
   if (r.min > -kInf && r.max < kInf)
-    s = fmt::format("in {}{}, {}{}", r.min_open ? "(" : "[", fmt_num(r.min), fmt_num(r.max), r.max_open ? ")" : "]");
+    s = fmt::format("in {}{}, {}{}", r.min_open ? "(" : "[", fmt_num(r.min), fmt_num(r.max),
+                    r.max_open ? ")" : "]");
   else if (r.min > -kInf)
     s = fmt::format("{} {}", r.min_open ? ">" : ">=", fmt_num(r.min));
   else if (r.max < kInf)
@@ -141,15 +152,20 @@ void check_number(const char* key, double v, const Rule& r) {
   }
   bool ok = std::isfinite(v) || (v == kInf && r.max == kInf && !r.max_open);
   ok = ok && (r.min_open ? v > r.min : v >= r.min) && (r.max_open ? v < r.max : v <= r.max);
-  if (!ok) throw InputError(fmt::format("{} = {} is out of range: must be {}", key, fmt_num(v), describe_rule(r)));
+  if (!ok)
+    throw InputError(fmt::format("{} = {} is out of range: must be {}", key, fmt_num(v), describe_rule(r)));
 }
 
 void check_value(const char* key, const std::string& v, const Rule& r) {
   if (!r.choices.empty() && std::find(r.choices.begin(), r.choices.end(), v) == r.choices.end())
     throw InputError(fmt::format("{} = \"{}\" is not known: must be {}", key, v, describe_rule(r)));
 }
-void check_value(const char* key, double v, const Rule& r) { check_number(key, v, r); }
-void check_value(const char* key, std::int64_t v, const Rule& r) { check_number(key, static_cast<double>(v), r); }
+void check_value(const char* key, double v, const Rule& r) {
+  check_number(key, v, r);
+}
+void check_value(const char* key, std::int64_t v, const Rule& r) {
+  check_number(key, static_cast<double>(v), r);
+}
 void check_value(const char*, bool, const Rule&) {}
 template <class T, std::size_t N>
 void check_value(const char* key, const std::array<T, N>& a, const Rule& r) {
@@ -167,9 +183,12 @@ void check_value(const char* key, const std::vector<double>& a, const Rule& r) {
 
 std::string toml_repr(const toml::node& n) {
   std::ostringstream os;
-  if (auto* t = n.as_table()) os << *t;
-  else if (auto* a = n.as_array()) os << *a;
-  else n.visit([&](auto&& v) { os << v; });
+  if (auto* t = n.as_table())
+    os << *t;
+  else if (auto* a = n.as_array())
+    os << *a;
+  else
+    n.visit([&](auto&& v) { os << v; });
   return os.str();
 }
 
@@ -179,7 +198,9 @@ double toml_number(const char* key, const toml::node& n) {
   type_error(key, "a number", toml_repr(n));
 }
 
-void from_toml(const char* key, const toml::node& n, double& out) { out = toml_number(key, n); }
+void from_toml(const char* key, const toml::node& n, double& out) {
+  out = toml_number(key, n);
+}
 void from_toml(const char* key, const toml::node& n, std::int64_t& out) {
   if (auto v = n.value_exact<std::int64_t>()) {
     out = *v;
@@ -219,9 +240,12 @@ void from_toml(const char* key, const toml::node& n, std::vector<double>& out) {
 }
 
 void from_json(const char* key, const nlohmann::json& j, double& out) {
-  if (j.is_null()) out = kUnset;
-  else if (j.is_number()) out = j.get<double>();
-  else type_error(key, "a number", j.dump());
+  if (j.is_null())
+    out = kUnset;
+  else if (j.is_number())
+    out = j.get<double>();
+  else
+    type_error(key, "a number", j.dump());
 }
 void from_json(const char* key, const nlohmann::json& j, std::int64_t& out) {
   if (!j.is_number_integer()) type_error(key, "an integer", j.dump());
@@ -250,7 +274,9 @@ void from_json(const char* key, const nlohmann::json& j, std::vector<double>& ou
   }
 }
 
-nlohmann::json json_value(double v) { return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v); }
+nlohmann::json json_value(double v) {
+  return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v);
+}
 template <class T>
 nlohmann::json json_value(const T& v) {
   return nlohmann::json(v);
@@ -266,8 +292,10 @@ nlohmann::json::json_pointer pointer_of(const std::string& dotted) {
 void collect_toml_keys(const toml::table& t, const std::string& prefix, std::vector<std::string>& out) {
   for (const auto& [k, node] : t) {
     std::string name = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
-    if (const auto* sub = node.as_table()) collect_toml_keys(*sub, name, out);
-    else out.push_back(name);
+    if (const auto* sub = node.as_table())
+      collect_toml_keys(*sub, name, out);
+    else
+      out.push_back(name);
   }
 }
 
@@ -289,7 +317,7 @@ CaseParams from_toml_table(const toml::table& tbl) {
 }  // namespace
 
 const std::vector<std::string>& scene_names() {
-  static const std::vector<std::string> names = {"inclined_settling", "ergun",  "sediment_transport",
+  static const std::vector<std::string> names = {"inclined_settling", "ergun",        "sediment_transport",
                                                  "single_particle",   "channel_flow", "dem_only",
                                                  "hindered_settling"};
   return names;
@@ -298,8 +326,12 @@ const std::vector<std::string>& scene_names() {
 double CaseParams::particle_volume_m3() const {
   return kPi / 6.0 * particles.diameter_m * particles.diameter_m * particles.diameter_m;
 }
-double CaseParams::particle_mass_kg() const { return particles.density_kg_m3 * particle_volume_m3(); }
-double CaseParams::box_volume_m3() const { return domain.length_x_m * domain.width_y_m * domain.height_z_m; }
+double CaseParams::particle_mass_kg() const {
+  return particles.density_kg_m3 * particle_volume_m3();
+}
+double CaseParams::box_volume_m3() const {
+  return domain.length_x_m * domain.width_y_m * domain.height_z_m;
+}
 double CaseParams::solid_fraction() const {
   return static_cast<double>(particles.count) * particle_volume_m3() / box_volume_m3();
 }
@@ -383,38 +415,46 @@ void validate(CaseParams& p) {
     p.particles.volume_fraction = kUnset;
   }
   if (is_set(p.particles.volume_fraction)) {
-    p.particles.count = std::llround(p.particles.volume_fraction * p.box_volume_m3() / p.particle_volume_m3());
+    p.particles.count =
+        std::llround(p.particles.volume_fraction * p.box_volume_m3() / p.particle_volume_m3());
     p.particles.volume_fraction = kUnset;  // resolved: equal cases hash equal whichever way given
   }
   if (!p.domain.periodic_y && d >= p.domain.width_y_m)
-    throw InputError(fmt::format("particles.diameter = {} m does not fit the channel: must be < domain.width_y = {} m",
-                                 fmt_num(d), fmt_num(p.domain.width_y_m)));
+    throw InputError(
+        fmt::format("particles.diameter = {} m does not fit the channel: must be < domain.width_y = {} m",
+                    fmt_num(d), fmt_num(p.domain.width_y_m)));
   // The minimum-image convention needs a periodic length of at least two diameters.
-  for (auto [name, len] : {std::pair{"domain.length_x", p.domain.length_x_m}, {"domain.height_z", p.domain.height_z_m}})
+  for (auto [name, len] :
+       {std::pair{"domain.length_x", p.domain.length_x_m}, {"domain.height_z", p.domain.height_z_m}})
     if (len < 2.0 * d)
-      throw InputError(fmt::format("{} = {} m is too short for particles.diameter = {} m: must be >= 2 d = {} m",
-                                   name, fmt_num(len), fmt_num(d), fmt_num(2.0 * d)));
+      throw InputError(
+          fmt::format("{} = {} m is too short for particles.diameter = {} m: must be >= 2 d = {} m", name,
+                      fmt_num(len), fmt_num(d), fmt_num(2.0 * d)));
   // Random close packing of monodisperse spheres: no more can be placed without overlap.
   constexpr double kRandomClosePacking = 0.64;
   const double ap = p.solid_fraction();
   // Soft spheres packed by growth ("packed") sit in slight overlap: the paper's own Ergun bed
   // (Table I, 19561 spheres of 1 mm in 0.02 x 0.02 x 0.04 m) is at 0.6401.
-  const double max_fraction = p.particles.insertion == "packed" ? kRandomClosePacking + 0.005 : kRandomClosePacking;
+  const double max_fraction =
+      p.particles.insertion == "packed" ? kRandomClosePacking + 0.005 : kRandomClosePacking;
   if (ap > max_fraction)
-    throw InputError(fmt::format("particles.count = {} overfills the box: solid fraction {:.4f} exceeds {} "
-                                 "(random close packing{})",
-                                 p.particles.count, ap, max_fraction,
-                                 p.particles.insertion == "packed" ? " with soft-sphere overlap" : ""));
+    throw InputError(
+        fmt::format("particles.count = {} overfills the box: solid fraction {:.4f} exceeds {} "
+                    "(random close packing{})",
+                    p.particles.count, ap, max_fraction,
+                    p.particles.insertion == "packed" ? " with soft-sphere overlap" : ""));
   if (p.particles.count > 0 && p.particles.insertion == "random" && ap > 0.45)
-    throw InputError(fmt::format(
-        "particles.count = {} (solid fraction {:.4f}) is too dense for random insertion: must be <= 0.45; use "
-        "particles.insertion = \"bed\" or \"packed\"",
-        p.particles.count, ap));
+    throw InputError(
+        fmt::format("particles.count = {} (solid fraction {:.4f}) is too dense for random insertion: must be "
+                    "<= 0.45; use "
+                    "particles.insertion = \"bed\" or \"packed\"",
+                    p.particles.count, ap));
 
   const double limit = p.dem_spring_limit_s();
   if (p.particles.count > 0 && p.time.dt_dem_s > limit)
     throw InputError(fmt::format(
-        "time.dt_dem = {:.4g} us exceeds the spring limit (pi/5) sqrt(m/k_n) = {:.4g} us for contact.stiffness = {} N/m "
+        "time.dt_dem = {:.4g} us exceeds the spring limit (pi/5) sqrt(m/k_n) = {:.4g} us for "
+        "contact.stiffness = {} N/m "
         "and particle mass {:.4g} kg",
         p.time.dt_dem_s * 1e6, limit * 1e6, fmt_num(p.contact.stiffness_n_m), p.particle_mass_kg()));
   if (p.time.dt_dem_s > p.time.dt_cfd_s * (1.0 + 1e-12))
@@ -422,10 +462,11 @@ void validate(CaseParams& p) {
                                  fmt_num(p.time.dt_cfd_s)));
   const double ratio = p.time.dt_cfd_s / p.time.dt_dem_s;
   if (std::abs(ratio - std::round(ratio)) > 1e-6 * ratio)
-    throw InputError(fmt::format("time.dt_cfd / time.dt_dem = {} must be a whole number of DEM sub-steps", ratio));
+    throw InputError(
+        fmt::format("time.dt_cfd / time.dt_dem = {} must be a whole number of DEM sub-steps", ratio));
   if (p.time.average_from_s >= p.time.end_s)
-    throw InputError(fmt::format("time.average_from = {} s must be < time.end = {} s", fmt_num(p.time.average_from_s),
-                                 fmt_num(p.time.end_s)));
+    throw InputError(fmt::format("time.average_from = {} s must be < time.end = {} s",
+                                 fmt_num(p.time.average_from_s), fmt_num(p.time.end_s)));
   if (p.numerics.neighbor_skin_m > d)
     throw InputError(fmt::format("numerics.neighbor_skin = {} m must be <= particles.diameter = {} m",
                                  fmt_num(p.numerics.neighbor_skin_m), fmt_num(d)));
@@ -442,7 +483,8 @@ namespace {
 /// their defaults, so adding a key never changes the id of an existing case: a study database
 /// written by an older binary resumes without repeating its finished cases. Append every new
 /// key here.
-constexpr const char* kKeysHashedOnlyWhenSet[] = {"numerics.pressure_velocity_coupling", "numerics.piso_correctors"};
+constexpr const char* kKeysHashedOnlyWhenSet[] = {"numerics.pressure_velocity_coupling",
+                                                  "numerics.piso_correctors"};
 // Keys added later that only one scene reads: hashed for that scene only, so that the ids of
 // every other scene's cases stay as they were. (Its own cases get new ids: their results
 // changed with the key's default.)

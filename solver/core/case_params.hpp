@@ -14,11 +14,13 @@
 namespace boycott {
 
 inline constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
-inline bool is_set(double v) { return !std::isnan(v); }
+inline bool is_set(double v) {
+  return !std::isnan(v);
+}
 
 struct FluidParams {
   double density_kg_m3 = 1000.0;
-  double viscosity_pa_s = 1.0e-3;  ///< dynamic viscosity
+  double viscosity_pa_s = 1.0e-3;        ///< dynamic viscosity
   std::string subgrid_model = "vreman";  ///< "vreman" | "none"
 };
 
@@ -34,9 +36,9 @@ struct ParticleParams {
 };
 
 struct ContactParams {
-  double stiffness_n_m = 3.5;  ///< k_n = k_t
-  double restitution = 0.1;    ///< e, sets gamma_n (design brief section 2)
-  double friction = 0.6;       ///< mu_s, Coulomb cap (Eq. 10)
+  double stiffness_n_m = 3.5;     ///< k_n = k_t
+  double restitution = 0.1;       ///< e, sets gamma_n (design brief section 2)
+  double friction = 0.6;          ///< mu_s, Coulomb cap (Eq. 10)
   double rolling_friction = 0.1;  ///< mu_r (Eq. 11)
   /// gamma_t / gamma_n (the paper leaves gamma_t open; LIGGGHTS' deck of the bench uses 1/2).
   double tangential_damping_ratio = 0.5;
@@ -47,9 +49,9 @@ struct ContactParams {
 };
 
 struct DomainParams {
-  double length_x_m = 0.2;   ///< periodic
-  double width_y_m = 0.006;  ///< walls at y = 0 and y = W unless periodic_y
-  double height_z_m = 0.1;   ///< periodic, settling direction
+  double length_x_m = 0.2;                            ///< periodic
+  double width_y_m = 0.006;                           ///< walls at y = 0 and y = W unless periodic_y
+  double height_z_m = 0.1;                            ///< periodic, settling direction
   std::array<std::int64_t, 3> cells = {200, 6, 100};  ///< x, y, z
   bool periodic_y = false;
   std::string top_wall = "no_slip";  ///< fluid condition at y = W: "no_slip" | "slip"

@@ -8,11 +8,11 @@ namespace boycott {
 
 enum ExitCode : int {
   kExitOk = 0,
-  kExitFailure = 1,      ///< unexpected internal failure
-  kExitInputError = 2,   ///< the case or study file is wrong; nothing ran
-  kExitPhysicsError = 3, ///< the run became unphysical (NaN, alpha_f outside (0,1], ...)
+  kExitFailure = 1,          ///< unexpected internal failure
+  kExitInputError = 2,       ///< the case or study file is wrong; nothing ran
+  kExitPhysicsError = 3,     ///< the run became unphysical (NaN, alpha_f outside (0,1], ...)
   kExitCheckpointError = 4,  ///< a checkpoint exists but cannot be used (corrupt, other parameters)
-  kExitInterrupted = 75, ///< stopped by SIGINT/SIGTERM after writing a checkpoint (EX_TEMPFAIL)
+  kExitInterrupted = 75,     ///< stopped by SIGINT/SIGTERM after writing a checkpoint (EX_TEMPFAIL)
 };
 
 /// Bad input: names the field, the value and the limit.

@@ -10,7 +10,7 @@
 namespace boycott {
 
 struct GridSpec {
-  std::array<std::int64_t, 3> n = {1, 1, 1};       ///< cells in x, y, z
+  std::array<std::int64_t, 3> n = {1, 1, 1};         ///< cells in x, y, z
   std::array<double, 3> length_m = {1.0, 1.0, 1.0};  ///< domain extent from the origin
   std::array<bool, 3> periodic = {true, false, true};
 
@@ -18,7 +18,9 @@ struct GridSpec {
   double cell_volume_m3() const { return dx(0) * dx(1) * dx(2); }
   std::int64_t cell_count() const { return n[0] * n[1] * n[2]; }
   /// Linear index of cell (i, j, k), x fastest.
-  std::int64_t cell_index(std::int64_t i, std::int64_t j, std::int64_t k) const { return i + n[0] * (j + n[1] * k); }
+  std::int64_t cell_index(std::int64_t i, std::int64_t j, std::int64_t k) const {
+    return i + n[0] * (j + n[1] * k);
+  }
 
   static GridSpec from_case(const CaseParams& p) {
     GridSpec g;

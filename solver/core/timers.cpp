@@ -11,7 +11,9 @@ void ModelTimers::activate(const std::string& model, const std::string& detail) 
   if (!detail.empty()) e.detail = detail;
 }
 
-void ModelTimers::add(const std::string& model, double seconds) { entries_[model].seconds += seconds; }
+void ModelTimers::add(const std::string& model, double seconds) {
+  entries_[model].seconds += seconds;
+}
 
 double ModelTimers::seconds(const std::string& model) const {
   auto it = entries_.find(model);
@@ -26,6 +28,8 @@ nlohmann::json ModelTimers::to_json() const {
   return j;
 }
 
-std::string hex64(std::uint64_t v) { return fmt::format("{:016x}", v); }
+std::string hex64(std::uint64_t v) {
+  return fmt::format("{:016x}", v);
+}
 
 }  // namespace boycott

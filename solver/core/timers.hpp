@@ -27,7 +27,8 @@ class ModelTimers {
   /// RAII scope that adds its lifetime to a model's total.
   class Scope {
    public:
-    Scope(ModelTimers& t, const char* model) : t_(t), model_(model), start_(std::chrono::steady_clock::now()) {}
+    Scope(ModelTimers& t, const char* model)
+        : t_(t), model_(model), start_(std::chrono::steady_clock::now()) {}
     ~Scope() {
       t_.add(model_, std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count());
     }

@@ -33,9 +33,10 @@ CoupledSystem::CoupledSystem(const CaseParams& p, const CoupledOptions& opt) : p
     const auto box = fluid_->owned_box();
     const int nz = static_cast<int>(fs.grid.n[2]);
     if (box.lo[0] != 0 || box.lo[1] != 0 || box.size[0] != fs.grid.n[0] || box.size[1] != fs.grid.n[1])
-      throw InputError(fmt::format("the fluid grid is not cut into z-slabs on {} ranks: at most {} ranks for {} "
-                                   "planes in z",
-                                   ranks_, max_ranks(nz), nz));
+      throw InputError(
+          fmt::format("the fluid grid is not cut into z-slabs on {} ranks: at most {} ranks for {} "
+                      "planes in z",
+                      ranks_, max_ranks(nz), nz));
     std::vector<int> begins(static_cast<std::size_t>(ranks_) + 1);
     const int mine = static_cast<int>(box.lo[2]);
     MPI_Allgather(&mine, 1, MPI_INT, begins.data(), 1, MPI_INT, comm);
@@ -58,9 +59,10 @@ int CoupledSystem::max_ranks(int nz) {
 void CoupledSystem::check_rank_count(const GridSpec& g, int ranks) {
   const int nz = static_cast<int>(g.n[2]);
   if (ranks > max_ranks(nz))
-    throw InputError(fmt::format("{} MPI ranks: a coupled case cuts its {} planes in z into slabs of at least 2 "
-                                 "planes, so at most N_max = {} ranks",
-                                 ranks, nz, max_ranks(nz)));
+    throw InputError(
+        fmt::format("{} MPI ranks: a coupled case cuts its {} planes in z into slabs of at least 2 "
+                    "planes, so at most N_max = {} ranks",
+                    ranks, nz, max_ranks(nz)));
 }
 
 void CoupledSystem::decompose() {
@@ -81,7 +83,8 @@ double CoupledSystem::global_sum(double local) const {
 double CoupledSystem::particle_volume_m3() const {
   const auto& s = dem_->particles();
   double v = 0.0;
-  for (std::size_t i = 0; i < s.n_local; ++i) v += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i];
+  for (std::size_t i = 0; i < s.n_local; ++i)
+    v += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i];
   return global_sum(v);
 }
 
@@ -128,9 +131,10 @@ CoupledStep CoupledSystem::step() {
       sum += s.x[i] + s.y[i] + s.z[i] + s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i];
     // Every rank stops together (a NaN on one rank would otherwise leave the others waiting).
     if (!std::isfinite(global_sum(sum)))
-      throw PhysicsError(fmt::format("particle state became NaN or Inf at t = {:.6g} s (CFD step {}); nothing was "
-                                     "checkpointed after the last good state",
-                                     time_ + dt, steps_ + 1));
+      throw PhysicsError(
+          fmt::format("particle state became NaN or Inf at t = {:.6g} s (CFD step {}); nothing was "
+                      "checkpointed after the last good state",
+                      time_ + dt, steps_ + 1));
   }
   coupler_->deposit(*dem_, *fluid_, dt);
   if (opt_.zero_slurry_flux) {
@@ -138,7 +142,8 @@ CoupledStep CoupledSystem::step() {
     // particles' volume flux at the new level.
     const auto& s = dem_->particles();
     double q = 0.0;
-    for (std::size_t i = 0; i < s.n_local; ++i) q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
+    for (std::size_t i = 0; i < s.n_local; ++i)
+      q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
     fluid_->set_target_mean_flux_z(-global_sum(q) / p_.box_volume_m3());
   }
   const auto t0 = std::chrono::steady_clock::now();
@@ -150,7 +155,8 @@ CoupledStep CoupledSystem::step() {
   ++steps_;
   const double ke = dem_->kinetic_energy_j();
   if (!std::isfinite(ke))
-    throw PhysicsError(fmt::format("particle velocities became NaN at t = {:.6g} s (CFD step {})", time_, steps_));
+    throw PhysicsError(
+        fmt::format("particle velocities became NaN at t = {:.6g} s (CFD step {})", time_, steps_));
   return st;
 }
 
@@ -172,7 +178,8 @@ double CoupledSystem::mean_fluid_velocity_z() const {
 double CoupledSystem::slurry_velocity_z() const {
   const auto& s = dem_->particles();
   double q = 0.0;
-  for (std::size_t i = 0; i < s.n_local; ++i) q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
+  for (std::size_t i = 0; i < s.n_local; ++i)
+    q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
   return fluid_->mean_flux_z() + global_sum(q) / p_.box_volume_m3();
 }
 
@@ -182,19 +189,24 @@ void CoupledSystem::activate_models(ModelTimers& t) const {
                                   p_.fluid.subgrid_model == "vreman" ? ", Vreman" : ""));
   t.activate("coupling_sample", fmt::format("kernel {}", p_.numerics.void_fraction_kernel));
   t.activate("coupling_deposit", fmt::format("kernel {}", p_.numerics.void_fraction_kernel));
-  if (f.drag != "none") t.activate("drag", fmt::format("{}, implicit on both sides (timed with coupling_sample)", f.drag));
-  if (f.pressure_gradient) t.activate("pressure_gradient_force", "-V_p grad P incl. G (timed with coupling_sample)");
+  if (f.drag != "none")
+    t.activate("drag", fmt::format("{}, implicit on both sides (timed with coupling_sample)", f.drag));
+  if (f.pressure_gradient)
+    t.activate("pressure_gradient_force", "-V_p grad P incl. G (timed with coupling_sample)");
   if (f.viscous) t.activate("viscous_force", "V_p div tau (timed with coupling_sample)");
   if (f.saffman_lift) t.activate("saffman_lift", "Eq. 16 (timed with coupling_sample)");
-  if (f.added_mass) t.activate("added_mass", "Eq. 17, particle side in the mass matrix (timed with coupling_sample)");
+  if (f.added_mass)
+    t.activate("added_mass", "Eq. 17, particle side in the mass matrix (timed with coupling_sample)");
   if (opt_.zero_slurry_flux) t.activate("slurry_flux_control", "Eq. 25 through the mean gradient G");
   if (opt_.move_particles) {
-    t.activate("dem_contacts", fmt::format("{}, k_n = {} N/m, e = {}, mu = {}", p_.contact.model,
-                                           p_.contact.stiffness_n_m, p_.contact.restitution, p_.contact.friction));
+    t.activate("dem_contacts",
+               fmt::format("{}, k_n = {} N/m, e = {}, mu = {}", p_.contact.model, p_.contact.stiffness_n_m,
+                           p_.contact.restitution, p_.contact.friction));
     if (p_.contact.rolling_model != "none" && p_.contact.rolling_friction > 0.0)
-      t.activate("rolling_friction", fmt::format("{}, mu_r = {} (timed with dem_contacts)", p_.contact.rolling_model,
-                                                 p_.contact.rolling_friction));
-    t.activate("neighbor_search", fmt::format("linked cells + Verlet skin {} m", p_.numerics.neighbor_skin_m));
+      t.activate("rolling_friction", fmt::format("{}, mu_r = {} (timed with dem_contacts)",
+                                                 p_.contact.rolling_model, p_.contact.rolling_friction));
+    t.activate("neighbor_search",
+               fmt::format("linked cells + Verlet skin {} m", p_.numerics.neighbor_skin_m));
     t.activate("integration", "velocity Verlet, drag and added mass implicit");
   }
 }

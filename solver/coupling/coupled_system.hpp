@@ -77,7 +77,7 @@ class CoupledSystem {
   double mean_particle_velocity(int c) const;  ///< <u_p,c>, m/s
   double mean_fluid_velocity_z() const;        ///< <w_f> = mean(alpha_f w) / mean(alpha_f), m/s
   double slurry_velocity_z() const;            ///< alpha_f <w_f> + alpha_p <w_p> over the box, m/s
-  double particle_volume_m3() const;  ///< all ranks
+  double particle_volume_m3() const;           ///< all ranks
 
   CoupledCounters counters() const;
   /// Restores the counters of a checkpoint (the engines' states are imported separately).

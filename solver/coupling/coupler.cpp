@@ -16,7 +16,6 @@
 
 namespace boycott::coupling {
 
-
 CouplingSettings CouplingSettings::from_case(const CaseParams& p) {
   CouplingSettings s;
   s.drag = p.forces.drag;
@@ -56,8 +55,8 @@ Coupler::Stencil Coupler::stencil(double x, double y, double z) const {
       while (w.first < lo) w.first += nz;
       while (w.first + w.n + 1 > hi) w.first -= nz;
       if (w.first < lo)
-        throw PhysicsError(fmt::format("a particle at z = {:.6g} m is outside the planes its rank holds ({} to {})",
-                                       z, lo, hi - 1));
+        throw PhysicsError(fmt::format(
+            "a particle at z = {:.6g} m is outside the planes its rank holds ({} to {})", z, lo, hi - 1));
     }
     st.face[d] = face_weights(st.cell[d]);
   }
@@ -116,7 +115,8 @@ template <class F>
 inline void scatter(const Offsets3& o, F&& f) {
   for (int c = 0; c < o.n[2]; ++c)
     for (int b = 0; b < o.n[1]; ++b)
-      for (int a = 0; a < o.n[0]; ++a) f(o.off[2][c] + o.off[1][b] + o.off[0][a], o.w[0][a] * o.w[1][b] * o.w[2][c]);
+      for (int a = 0; a < o.n[0]; ++a)
+        f(o.off[2][c] + o.off[1][b] + o.off[0][a], o.w[0][a] * o.w[1][b] * o.w[2][c]);
 }
 
 }  // namespace
@@ -175,7 +175,8 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
       if (wn > 0.0) {
         // Eq. 16: 1.61 rho d^2 sqrt(nu / |w|) (u_f - u_p) x w
         const double cst = 1.61 * rho * d * d * std::sqrt(nu / wn);
-        const double fl[3] = {cst * (s1 * w[2] - s2 * w[1]), cst * (s2 * w[0] - s0 * w[2]), cst * (s0 * w[1] - s1 * w[0])};
+        const double fl[3] = {cst * (s1 * w[2] - s2 * w[1]), cst * (s2 * w[0] - s0 * w[2]),
+                              cst * (s0 * w[1] - s1 * w[0])};
         for (int c = 0; c < 3; ++c) fe[c] += fl[c], react[c] -= fl[c];
       }
     }
@@ -201,7 +202,8 @@ std::vector<double> Coupler::gather_whole(const GridField& f) const {
   if (!window_) return f.a;
   const std::size_t ps = f.plane_size();
   const auto first = f.a.begin() + static_cast<std::ptrdiff_t>((window_->own_begin() - f.k0) * ps);
-  const std::vector<double> own(first, first + static_cast<std::ptrdiff_t>((window_->own_end() - window_->own_begin()) * ps));
+  const std::vector<double> own(
+      first, first + static_cast<std::ptrdiff_t>((window_->own_end() - window_->own_begin()) * ps));
   return gather_planes(own);
 }
 
@@ -236,7 +238,8 @@ void Coupler::import_state(const std::vector<std::vector<double>>& st, particles
   if (solid.size() != ps * nz) throw CheckpointError("coupling state: solid fraction of another grid");
   for (int p = 0; p < solid_.nz; ++p) {
     const std::size_t k = static_cast<std::size_t>(((solid_.k0 + p) % (int)nz + (int)nz) % (int)nz);
-    std::copy(solid.begin() + static_cast<std::ptrdiff_t>(k * ps), solid.begin() + static_cast<std::ptrdiff_t>((k + 1) * ps),
+    std::copy(solid.begin() + static_cast<std::ptrdiff_t>(k * ps),
+              solid.begin() + static_cast<std::ptrdiff_t>((k + 1) * ps),
               solid_.a.begin() + static_cast<std::ptrdiff_t>(p * ps));
   }
   fields_.import_state({st.begin(), st.begin() + 4});
@@ -244,14 +247,16 @@ void Coupler::import_state(const std::vector<std::vector<double>>& st, particles
     auto& p = dem.particles();
     for (std::size_t i = 0; i < p.n_local; ++i) {
       const auto k = static_cast<std::size_t>(p.id[i]);
-      if (p.id[i] < 0 || k >= st[4].size()) throw CheckpointError(fmt::format("coupling state: no force of particle {}", p.id[i]));
+      if (p.id[i] < 0 || k >= st[4].size())
+        throw CheckpointError(fmt::format("coupling state: no force of particle {}", p.id[i]));
       p.fpv_x[i] = st[4][k], p.fpv_y[i] = st[5][k], p.fpv_z[i] = st[6][k];
     }
   }
 }
 
 std::vector<double> Coupler::sum_owned(const GridField& f) const {
-  std::vector<double> owned(f.plane_size() * static_cast<std::size_t>(window_->own_end() - window_->own_begin()));
+  std::vector<double> owned(f.plane_size() *
+                            static_cast<std::size_t>(window_->own_end() - window_->own_begin()));
   window_->sum_to_owned(f.a.data(), owned.data(), f.plane_size());
   return owned;
 }
@@ -281,7 +286,8 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
     const Stencil st = stencil(p.x[i] - lo[0], p.y[i] - lo[1], p.z[i] - lo[2]);
     const double r = p.radius[i];
     const double frac = (4.0 / 3.0) * kPi * r * r * r / vcell;
-    scatter(offsets(st.cell[0], st.cell[1], st.cell[2], solid_), [&](std::size_t q, double w) { solid_.a[q] += w * frac; });
+    scatter(offsets(st.cell[0], st.cell[1], st.cell[2], solid_),
+            [&](std::size_t q, double w) { solid_.a[q] += w * frac; });
     if (!forces) continue;
     // The fluid's drag is K (u_p - u) with K u_p = beta u_f(n) - J / dt: with u at level n it
     // returns exactly the impulse J the kicks applied. The reaction to the explicit forces uses
@@ -294,7 +300,8 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
     double rf[3];
     for (int c = 0; c < 3; ++c) {
       rf[c] = react[c];
-      if (s_.added_mass) rf[c] += 0.5 * s_.rho_f_kg_m3 * (4.0 / 3.0) * kPi * r * r * r * (vs[c] - v0[c]) / dt_s;
+      if (s_.added_mass)
+        rf[c] += 0.5 * s_.rho_f_kg_m3 * (4.0 / 3.0) * kPi * r * r * r * (vs[c] - v0[c]) / dt_s;
       reaction[c] += rf[c];
     }
     const double b = p.beta[i];
@@ -333,7 +340,8 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
   PetscScalar*** sol = fs.solid_fraction_local();
   for (int k = k_lo; k < k_hi; ++k)
     for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) sol[k][j][i] += solid[(static_cast<std::size_t>(k - k_lo) * ny + j) * nx + i];
+      for (int i = 0; i < nx; ++i)
+        sol[k][j][i] += solid[(static_cast<std::size_t>(k - k_lo) * ny + j) * nx + i];
   if (forces) {
     for (int c = 0; c < 3; ++c) {
       PetscScalar*** Ka = fs.drag_coefficient_local(c);
@@ -347,7 +355,8 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
       for (int k = k_lo; k < k_hi; ++k)
         for (int j = 0; j < ny; ++j)
           for (int i = 0; i < nx; ++i) {
-            const std::size_t q = (static_cast<std::size_t>(k - k_lo) * K_[c].ny + j) * nx + i;  // v has ny + 1 rows
+            const std::size_t q =
+                (static_cast<std::size_t>(k - k_lo) * K_[c].ny + j) * nx + i;  // v has ny + 1 rows
             Ka[k][j][i] += Kc[q];
             KUa[k][j][i] += KUc[q];
             Sa[k][j][i] += Sc[q];

@@ -31,7 +31,8 @@ FluidFields::FluidFields(const GridSpec& g, bool top_slip, const SlabExchange* w
   }
   for (int c = 0; c < 3; ++c) {
     const int nyc = (c == 1 && walls_) ? ny + 1 : ny;
-    for (GridField* f : {&u_[c], &uprev_[c], &gradp_[c], &visc_[c], &dudt_[c]}) f->resize(nx, nyc, nz, per, k0);
+    for (GridField* f : {&u_[c], &uprev_[c], &gradp_[c], &visc_[c], &dudt_[c]})
+      f->resize(nx, nyc, nz, per, k0);
     vort_[c].resize(nx, ny, nz, per, k0);
   }
   p_.resize(nx, ny, nz, per, k0);
@@ -47,7 +48,8 @@ std::vector<std::vector<double>> FluidFields::export_state() const {
     }
     const std::size_t ps = u_[c].plane_size();
     const auto first = u_[c].a.begin() + static_cast<std::ptrdiff_t>((window_->own_begin() - u_[c].k0) * ps);
-    st.emplace_back(first, first + static_cast<std::ptrdiff_t>((window_->own_end() - window_->own_begin()) * ps));
+    st.emplace_back(first,
+                    first + static_cast<std::ptrdiff_t>((window_->own_end() - window_->own_begin()) * ps));
   }
   st.push_back({have_prev_ ? 1.0 : 0.0});
   return st;
@@ -74,22 +76,25 @@ void FluidFields::import_state(const std::vector<std::vector<double>>& st) {
   for (int c = 0; c < 3; ++c) {
     const std::size_t ps = u_[c].plane_size(), whole = ps * static_cast<std::size_t>(nz);
     if (st[c].size() != whole)
-      throw CheckpointError(fmt::format("coupling state: velocity {} has {} values, the grid {}", c, st[c].size(),
-                                        whole));
+      throw CheckpointError(
+          fmt::format("coupling state: velocity {} has {} values, the grid {}", c, st[c].size(), whole));
     if (!window_) {
       u_[c].a = st[c];
       continue;
     }
     for (int p = 0; p < u_[c].nz; ++p) {
       const int k = ((u_[c].k0 + p) % nz + nz) % nz;
-      std::copy(st[c].begin() + static_cast<std::ptrdiff_t>(k * ps), st[c].begin() + static_cast<std::ptrdiff_t>((k + 1) * ps),
+      std::copy(st[c].begin() + static_cast<std::ptrdiff_t>(k * ps),
+                st[c].begin() + static_cast<std::ptrdiff_t>((k + 1) * ps),
                 u_[c].a.begin() + static_cast<std::ptrdiff_t>(p * ps));
     }
   }
   have_prev_ = st[3][0] != 0.0;
 }
 
-double FluidFields::nu_cell(int i, int j, int k) const { return nu_ + nut_.at(i, j, k); }
+double FluidFields::nu_cell(int i, int j, int k) const {
+  return nu_ + nut_.at(i, j, k);
+}
 
 template <class Rule>
 void FluidFields::fill_padded(Padded& dst, int nx, int ny, int nz, Rule&& value) {
@@ -132,7 +137,8 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
       window_->fill(owned.data(), win.data(), plane);
       for (int p = 0; p < dst.nz; ++p)
         for (int j = 0; j < n[1]; ++j)
-          for (int i = 0; i < n[0]; ++i) dst.at(i, j, dst.k0 + p) = win[(static_cast<std::size_t>(p) * n[1] + j) * n[0] + i];
+          for (int i = 0; i < n[0]; ++i)
+            dst.at(i, j, dst.k0 + p) = win[(static_cast<std::size_t>(p) * n[1] + j) * n[0] + i];
     }
     fs.restore_read(c);
   }
@@ -170,7 +176,8 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
           const bool wall_row = walls_ && c == 1 && (j == 0 || j == n[1]);
           if (wall_row) continue;  // filled from the nearest interior row below
           const int im = i - ec[0], jm = j - ec[1], km = k - ec[2];
-          gradp_[c].at(i, j, k) = (ppad_(i, j, k - kofs_) - ppad_(im, jm, km - kofs_)) / h[c] + (c == 2 ? G : 0.0);
+          gradp_[c].at(i, j, k) =
+              (ppad_(i, j, k - kofs_) - ppad_(im, jm, km - kofs_)) / h[c] + (c == 2 ? G : 0.0);
 
           if (need_viscous) {
             // The fluid momentum equation's viscous operator (fluid_solver.cpp), per unit mass.
@@ -183,7 +190,8 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
                 if (d == c) {
                   const int Q[3] = {s > 0 ? i : im, s > 0 ? j : jm, s > 0 ? k : km};
                   nuf = nuc(Q[0], Q[1], Q[2]);
-                  tT = nuf * (uv(c, Q[0] + ec[0], Q[1] + ec[1], Q[2] + ec[2]) - uv(c, Q[0], Q[1], Q[2])) / h[c];
+                  tT = nuf * (uv(c, Q[0] + ec[0], Q[1] + ec[1], Q[2] + ec[2]) - uv(c, Q[0], Q[1], Q[2])) /
+                       h[c];
                   lap += nuf * (uv(c, N[0], N[1], N[2]) - uP) / (h[d] * h[d]);
                 } else {
                   const int E[3] = {s > 0 ? N[0] : i, s > 0 ? N[1] : j, s > 0 ? N[2] : k};
@@ -196,7 +204,8 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
                     const int O[3] = {E[0] - kE[d][0], E[1] - kE[d][1], E[2] - kE[d][2]};
                     nuf = 0.25 * (nuc(E[0], E[1], E[2]) + nuc(E[0] - ec[0], E[1] - ec[1], E[2] - ec[2]) +
                                   nuc(O[0], O[1], O[2]) + nuc(O[0] - ec[0], O[1] - ec[1], O[2] - ec[2]));
-                    tT = nuf * (uv(d, E[0], E[1], E[2]) - uv(d, E[0] - ec[0], E[1] - ec[1], E[2] - ec[2])) / h[c];
+                    tT = nuf * (uv(d, E[0], E[1], E[2]) - uv(d, E[0] - ec[0], E[1] - ec[1], E[2] - ec[2])) /
+                         h[c];
                     lap += nuf * (uv(c, N[0], N[1], N[2]) - uP) / (h[d] * h[d]);
                   }
                 }
@@ -253,7 +262,8 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
       return uc(e, i, j, k);
     };
     auto dd = [&](int e, int d, int i, int j, int k) {
-      return (ucell(e, i + kE[d][0], j + kE[d][1], k + kE[d][2]) - ucell(e, i - kE[d][0], j - kE[d][1], k - kE[d][2])) /
+      return (ucell(e, i + kE[d][0], j + kE[d][1], k + kE[d][2]) -
+              ucell(e, i - kE[d][0], j - kE[d][1], k - kE[d][2])) /
              (2.0 * h[d]);
     };
     for (int k = kb_; k < kce_; ++k)

@@ -66,14 +66,15 @@ class FluidFields {
   /// Reads velocity, pressure and nu_t from the solver at its current level and derives the
   /// fields above. `dt_s` is the step that led to this level (for Du/Dt; 0 = first call, then
   /// the time derivative is taken as zero).
-  void update(fluid::FluidSolver& fs, double dt_s, bool need_viscous, bool need_material, bool need_vorticity);
+  void update(fluid::FluidSolver& fs, double dt_s, bool need_viscous, bool need_material,
+              bool need_vorticity);
 
   const GridSpec& grid() const { return g_; }
   /// Face fields per component c (0 u on x-faces, 1 v on y-faces, 2 w on z-faces). With y walls
   /// the v field has ny + 1 rows; rows 0 and ny are the walls (v = 0).
   const GridField& velocity(int c) const { return u_[c]; }
-  const GridField& pressure_gradient(int c) const { return gradp_[c]; }  ///< Pa/m, includes G e_z
-  const GridField& viscous(int c) const { return visc_[c]; }             ///< div tau / rho, m/s^2
+  const GridField& pressure_gradient(int c) const { return gradp_[c]; }   ///< Pa/m, includes G e_z
+  const GridField& viscous(int c) const { return visc_[c]; }              ///< div tau / rho, m/s^2
   const GridField& material_derivative(int c) const { return dudt_[c]; }  ///< m/s^2
   const GridField& vorticity(int c) const { return vort_[c]; }            ///< 1/s, cell centres
 

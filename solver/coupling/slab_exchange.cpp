@@ -13,7 +13,8 @@ std::vector<double> alltoallv(MPI_Comm comm, const std::vector<std::vector<doubl
   const int size = static_cast<int>(out.size());
   std::vector<int> sc(size), sd(size), rc(size), rd(size);
   int total_out = 0;
-  for (int r = 0; r < size; ++r) sc[r] = static_cast<int>(out[r].size()), sd[r] = total_out, total_out += sc[r];
+  for (int r = 0; r < size; ++r)
+    sc[r] = static_cast<int>(out[r].size()), sd[r] = total_out, total_out += sc[r];
   MPI_Alltoall(sc.data(), 1, MPI_INT, rc.data(), 1, MPI_INT, comm);
   int total_in = 0;
   for (int r = 0; r < size; ++r) rd[r] = total_in, total_in += rc[r];
@@ -21,7 +22,8 @@ std::vector<double> alltoallv(MPI_Comm comm, const std::vector<std::vector<doubl
   send.reserve(static_cast<std::size_t>(total_out));
   for (const auto& b : out) send.insert(send.end(), b.begin(), b.end());
   std::vector<double> recv(static_cast<std::size_t>(total_in));
-  MPI_Alltoallv(send.data(), sc.data(), sd.data(), MPI_DOUBLE, recv.data(), rc.data(), rd.data(), MPI_DOUBLE, comm);
+  MPI_Alltoallv(send.data(), sc.data(), sd.data(), MPI_DOUBLE, recv.data(), rc.data(), rd.data(), MPI_DOUBLE,
+                comm);
   return recv;
 }
 
@@ -67,17 +69,19 @@ void SlabExchange::fill(const double* owned, double* window, std::size_t ps) con
   const int planes = window_planes();
   for (int p = 0; p < planes; ++p) {
     const int g = wrap(window_begin() + p);
-    if (owner(g) == rank_) std::copy(owned + (g - own_begin()) * ps, owned + (g - own_begin() + 1) * ps, window + p * ps);
+    if (owner(g) == rank_)
+      std::copy(owned + (g - own_begin()) * ps, owned + (g - own_begin() + 1) * ps, window + p * ps);
   }
   std::vector<std::vector<double>> out(fill_send_.size());
   for (std::size_t r = 0; r < out.size(); ++r)
-    for (const auto& [p, local] : fill_send_[r]) out[r].insert(out[r].end(), owned + local * ps, owned + (local + 1) * ps);
+    for (const auto& [p, local] : fill_send_[r])
+      out[r].insert(out[r].end(), owned + local * ps, owned + (local + 1) * ps);
   const auto in = alltoallv(comm_, out);
   std::size_t at = 0;
   for (const auto& list : fill_recv_)
     for (const auto& [p, local] : list) {
-      std::copy(in.begin() + static_cast<std::ptrdiff_t>(at), in.begin() + static_cast<std::ptrdiff_t>(at + ps),
-                window + p * ps);
+      std::copy(in.begin() + static_cast<std::ptrdiff_t>(at),
+                in.begin() + static_cast<std::ptrdiff_t>(at + ps), window + p * ps);
       at += ps;
     }
 }
@@ -96,7 +100,8 @@ void SlabExchange::sum_to_owned(const double* window, double* owned, std::size_t
   }
   std::vector<std::vector<double>> out(sum_send_.size());
   for (std::size_t r = 0; r < out.size(); ++r)
-    for (const auto& [p, local] : sum_send_[r]) out[r].insert(out[r].end(), window + p * ps, window + (p + 1) * ps);
+    for (const auto& [p, local] : sum_send_[r])
+      out[r].insert(out[r].end(), window + p * ps, window + (p + 1) * ps);
   const auto in = alltoallv(comm_, out);
   std::size_t at = 0;
   for (const auto& list : sum_recv_)

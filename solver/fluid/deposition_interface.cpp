@@ -28,10 +28,18 @@ void FluidSolver::begin_deposition() {
   deposition_open_ = true;
 }
 
-PetscScalar*** FluidSolver::solid_fraction_local() { return dep_arrays_[0]; }
-PetscScalar*** FluidSolver::source_local(int c) { return dep_arrays_[1 + c]; }
-PetscScalar*** FluidSolver::drag_coefficient_local(int c) { return dep_arrays_[4 + c]; }
-PetscScalar*** FluidSolver::drag_momentum_local(int c) { return dep_arrays_[7 + c]; }
+PetscScalar*** FluidSolver::solid_fraction_local() {
+  return dep_arrays_[0];
+}
+PetscScalar*** FluidSolver::source_local(int c) {
+  return dep_arrays_[1 + c];
+}
+PetscScalar*** FluidSolver::drag_coefficient_local(int c) {
+  return dep_arrays_[4 + c];
+}
+PetscScalar*** FluidSolver::drag_momentum_local(int c) {
+  return dep_arrays_[7 + c];
+}
 
 void FluidSolver::end_deposition() {
   if (!deposition_open_) throw std::logic_error("end_deposition without begin_deposition");
@@ -51,8 +59,8 @@ void FluidSolver::end_deposition() {
   BC_PETSC(VecMin(alpha_[0], nullptr, &amin));
   BC_PETSC(VecMax(alpha_[0], nullptr, &amax));
   if (!(amin > 0.0) || !(amax <= 1.0))
-    throw PhysicsError(fmt::format("fluid fraction outside (0, 1] after deposition: min {:.4g}, max {:.4g}", amin,
-                                   amax));
+    throw PhysicsError(
+        fmt::format("fluid fraction outside (0, 1] after deposition: min {:.4g}, max {:.4g}", amin, amax));
   if (!alpha_initialised_ && steps_ == 0) {
     BC_PETSC(VecCopy(alpha_[0], alpha_[1]));
     BC_PETSC(VecCopy(alpha_[0], alpha_[2]));

@@ -18,15 +18,18 @@
 
 namespace boycott::fluid {
 
-FluidSolver::FluidSolver(const FluidSettings& s, MPI_Comm comm) : s_(s), comm_(comm) { create_layout(); }
+FluidSolver::FluidSolver(const FluidSettings& s, MPI_Comm comm) : s_(s), comm_(comm) {
+  create_layout();
+}
 
 FluidSolver::~FluidSolver() {
   auto vd = [](Vec& v) {
     if (v) VecDestroy(&v);
   };
   for (int c = 0; c < 3; ++c) {
-    for (Vec* v : {&U_[c], &Un_[c], &Unm1_[c], &alpha_[c], &Ustar_prev_[c], &D_[c], &S_[c], &K_[c], &KU_[c], &inv_diag_[c], &Ul_[c],
-                   &alphal_[c], &Dl_[c], &dep_S_[c], &dep_K_[c], &dep_KU_[c], &Fl_[c]})
+    for (Vec* v :
+         {&U_[c], &Un_[c], &Unm1_[c], &alpha_[c], &Ustar_prev_[c], &D_[c], &S_[c], &K_[c], &KU_[c],
+          &inv_diag_[c], &Ul_[c], &alphal_[c], &Dl_[c], &dep_S_[c], &dep_K_[c], &dep_KU_[c], &Fl_[c]})
       vd(*v);
   }
   for (Vec* v : {&P_, &nut_, &rhs_, &sol_, &R_, &pc_, &Pl_, &nutl_, &pcl_, &dep_solid_, &nuel_}) vd(*v);
@@ -52,7 +55,8 @@ FluidSolver::~FluidSolver() {
 void FluidSolver::create_layout() {
   const auto& g = s_.grid;
   for (int d = 0; d < 3; ++d)
-    if (g.n[d] < 2) throw InputError(fmt::format("fluid grid needs at least 2 cells per direction (got {})", g.n[d]));
+    if (g.n[d] < 2)
+      throw InputError(fmt::format("fluid grid needs at least 2 cells per direction (got {})", g.n[d]));
   const DMBoundaryType by = g.periodic[1] ? DM_BOUNDARY_PERIODIC : DM_BOUNDARY_NONE;
   // With the spectral pressure preconditioner on several ranks, the grid is cut into FFTW's
   // slabs of whole z-planes: the global vectors are then stored in the transform's own order and
@@ -70,19 +74,20 @@ void FluidSolver::create_layout() {
     if (std::any_of(z_slabs.begin(), z_slabs.end(), [](PetscInt c) { return c < 2; })) z_slabs.clear();
   }
   const PetscInt pz = z_slabs.empty() ? PETSC_DECIDE : nranks, pxy = z_slabs.empty() ? PETSC_DECIDE : 1;
-  BC_PETSC(DMDACreate3d(comm_, DM_BOUNDARY_PERIODIC, by, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_BOX, (PetscInt)g.n[0],
-                        (PetscInt)g.n[1], (PetscInt)g.n[2], pxy, pxy, pz, 1, 2, nullptr, nullptr,
-                        z_slabs.empty() ? nullptr : z_slabs.data(), &da_));
+  BC_PETSC(DMDACreate3d(comm_, DM_BOUNDARY_PERIODIC, by, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_BOX,
+                        (PetscInt)g.n[0], (PetscInt)g.n[1], (PetscInt)g.n[2], pxy, pxy, pz, 1, 2, nullptr,
+                        nullptr, z_slabs.empty() ? nullptr : z_slabs.data(), &da_));
   BC_PETSC(DMSetUp(da_));
   halo_ = std::make_unique<HaloExchange>(da_);
   const PetscInt *lx, *ly, *lz;
   PetscInt mx, my, mz;
-  BC_PETSC(DMDAGetInfo(da_, nullptr, nullptr, nullptr, nullptr, &mx, &my, &mz, nullptr, nullptr, nullptr, nullptr,
-                       nullptr, nullptr));
+  BC_PETSC(DMDAGetInfo(da_, nullptr, nullptr, nullptr, nullptr, &mx, &my, &mz, nullptr, nullptr, nullptr,
+                       nullptr, nullptr, nullptr));
   BC_PETSC(DMDAGetOwnershipRanges(da_, &lx, &ly, &lz));
   // Same ownership, 7-point star of width 1: the matrices need no more than that.
-  BC_PETSC(DMDACreate3d(comm_, DM_BOUNDARY_PERIODIC, by, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR, (PetscInt)g.n[0],
-                        (PetscInt)g.n[1], (PetscInt)g.n[2], mx, my, mz, 1, 1, lx, ly, lz, &dam_));
+  BC_PETSC(DMDACreate3d(comm_, DM_BOUNDARY_PERIODIC, by, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR,
+                        (PetscInt)g.n[0], (PetscInt)g.n[1], (PetscInt)g.n[2], mx, my, mz, 1, 1, lx, ly, lz,
+                        &dam_));
   BC_PETSC(DMSetUp(dam_));
   // Both systems are applied matrix-free (stencil_operator.hpp); an AIJ copy is made only for a
   // preconditioner that needs the entries.

@@ -166,9 +166,11 @@ class FluidSolver {
   void compute_effective_viscosity();
   /// Assembles component c's momentum equations into A and rhs_; D_[c] on the first iteration of
   /// a step.
-  void assemble_momentum(int c, double dt, double c0, double c1, double c2, bool first_iteration, StencilOperator& A);
+  void assemble_momentum(int c, double dt, double c0, double c1, double c2, bool first_iteration,
+                         StencilOperator& A);
   template <int c, bool wall, bool use_quick>
-  void assemble_momentum_t(double dt, double c0, double c1, double c2, bool first_iteration, StencilOperator& A);
+  void assemble_momentum_t(double dt, double c0, double c1, double c2, bool first_iteration,
+                           StencilOperator& A);
   void step_simple(double dt, const double c[3], StepReport& rep);
   void step_piso(double dt, const double c[3], StepReport& rep);
   /// U_[cc] = A^-1 rhs_ (from U_[cc]).
@@ -190,9 +192,9 @@ class FluidSolver {
 
   FluidSettings s_;
   MPI_Comm comm_;
-  DM da_ = nullptr;    // box stencil, width 2: ghosted fields
-  DM dam_ = nullptr;   // star stencil, width 1, same ownership: matrices
-  std::unique_ptr<HaloExchange> halo_;  // ghost fills of da_'s local vectors
+  DM da_ = nullptr;                       // box stencil, width 2: ghosted fields
+  DM dam_ = nullptr;                      // star stencil, width 1, same ownership: matrices
+  std::unique_ptr<HaloExchange> halo_;    // ghost fills of da_'s local vectors
   std::unique_ptr<StencilOperator> opA_;  // momentum operator (one component at a time)
   std::unique_ptr<StencilOperator> opP_;  // pressure-correction operator
   // PISO: each component's operator and right-hand side, kept for the corrector sweeps, and the
@@ -217,9 +219,9 @@ class FluidSolver {
 
   // global vectors
   Vec U_[3]{}, Un_[3]{}, Unm1_[3]{}, P_ = nullptr, alpha_[3]{};  // alpha_[0]=n+1, [1]=n, [2]=n-1
-  Vec Ustar_prev_[3]{};  // iterate before the momentum solve (relaxation)
-  Vec D_[3]{};           // a_face / (rho a_P') per face (SIMPLE correction coefficient)
-  Vec inv_diag_[3]{};    // 1 / diagonal of each component's momentum matrix (Jacobi)
+  Vec Ustar_prev_[3]{};            // iterate before the momentum solve (relaxation)
+  Vec D_[3]{};                     // a_face / (rho a_P') per face (SIMPLE correction coefficient)
+  Vec inv_diag_[3]{};              // 1 / diagonal of each component's momentum matrix (Jacobi)
   Vec jacobi_inv_diag_ = nullptr;  // the one the momentum solve in progress uses
   Vec S_[3]{}, K_[3]{}, KU_[3]{};  // coupling fields on faces
   Vec nut_ = nullptr;

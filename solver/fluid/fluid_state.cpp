@@ -74,7 +74,9 @@ double FluidSolver::max_abs_velocity(int c) const {
   return m;
 }
 
-double FluidSolver::max_continuity_defect() const { return last_defect_; }
+double FluidSolver::max_continuity_defect() const {
+  return last_defect_;
+}
 
 std::vector<double> FluidSolver::profile_y(int c) const {
   const OwnedBox b = owned_box();
@@ -125,7 +127,8 @@ FluidState FluidSolver::export_state() const {
   st.mean_pressure_gradient_pa_m = G_;
   // nu_t too: it was computed from the previous level at the start of the last step, and the
   // coupling reads it before the next step recomputes it.
-  const Vec vs[11] = {U_[0], U_[1], U_[2], Unm1_[0], Unm1_[1], Unm1_[2], P_, alpha_[1], alpha_[2], alpha_[0], nut_};
+  const Vec vs[11] = {U_[0], U_[1],     U_[2],     Unm1_[0],  Unm1_[1], Unm1_[2],
+                      P_,    alpha_[1], alpha_[2], alpha_[0], nut_};
   for (Vec v : vs) {
     PetscInt nloc;
     VecGetLocalSize(v, &nloc);

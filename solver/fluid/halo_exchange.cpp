@@ -17,15 +17,18 @@ HaloExchange::HaloExchange(DM dm) : dm_(dm) {
   MPI_Comm_dup(dm_comm, &comm_);
   PetscInt mx, my, mz, w, xs, ys, zs, xm, ym, zm, gxs, gys, gzs, gxm, gym, gzm;
   DMBoundaryType bx, by, bz;
-  check(DMDAGetInfo(dm, nullptr, &mx, &my, &mz, nullptr, nullptr, nullptr, nullptr, &w, &bx, &by, &bz, nullptr),
-        "DMDAGetInfo");
+  check(
+      DMDAGetInfo(dm, nullptr, &mx, &my, &mz, nullptr, nullptr, nullptr, nullptr, &w, &bx, &by, &bz, nullptr),
+      "DMDAGetInfo");
   check(DMDAGetCorners(dm, &xs, &ys, &zs, &xm, &ym, &zm), "DMDAGetCorners");
   check(DMDAGetGhostCorners(dm, &gxs, &gys, &gzs, &gxm, &gym, &gzm), "DMDAGetGhostCorners");
   const bool periodic_y = by == DM_BOUNDARY_PERIODIC;
   const PetscInt wy = periodic_y ? w : 0;
-  bool ok = bx == DM_BOUNDARY_PERIODIC && bz == DM_BOUNDARY_PERIODIC && (periodic_y || by == DM_BOUNDARY_NONE);
+  bool ok =
+      bx == DM_BOUNDARY_PERIODIC && bz == DM_BOUNDARY_PERIODIC && (periodic_y || by == DM_BOUNDARY_NONE);
   ok = ok && xs == 0 && xm == mx && ys == 0 && ym == my && zm >= w && w >= 1;
-  ok = ok && gxs == -w && gxm == mx + 2 * w && gys == -wy && gym == my + 2 * wy && gzs == zs - w && gzm == zm + 2 * w;
+  ok = ok && gxs == -w && gxm == mx + 2 * w && gys == -wy && gym == my + 2 * wy && gzs == zs - w &&
+       gzm == zm + 2 * w;
   // every rank must take the same path (the fast one exchanges messages)
   int mine = ok ? 1 : 0, all = 0;
   MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, comm_);

@@ -27,8 +27,8 @@ class HaloExchange {
   DM dm_;
   MPI_Comm comm_ = MPI_COMM_NULL;  // a duplicate of the DM's: these messages meet no others
   bool fast_ = false;
-  PetscInt w_ = 0;             // stencil width: ghost planes in z, ghost cells in x
-  PetscInt wy_ = 0;            // ghost rows in y (w where y is periodic, else 0)
+  PetscInt w_ = 0;   // stencil width: ghost planes in z, ghost cells in x
+  PetscInt wy_ = 0;  // ghost rows in y (w where y is periodic, else 0)
   PetscInt nx_ = 0, ny_ = 0, zm_ = 0, gxm_ = 0, gym_ = 0;
   int below_ = -1, above_ = -1;  // ranks owning the planes below and above this slab (periodic)
 };

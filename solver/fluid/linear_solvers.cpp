@@ -25,10 +25,10 @@ void configure_pressure_amg(PC pc) {
   const char* prefix = nullptr;
   BC_PETSC(PCGetOptionsPrefix(pc, &prefix));
   const std::pair<const char*, const char*> tuned[] = {{"-pc_hypre_boomeramg_coarsen_type", "HMIS"},
-                                                        {"-pc_hypre_boomeramg_interp_type", "ext+i"},
-                                                        {"-pc_hypre_boomeramg_strong_threshold", "0.5"},
-                                                        {"-pc_hypre_boomeramg_P_max", "4"},
-                                                        {"-pc_hypre_boomeramg_agg_nl", "1"}};
+                                                       {"-pc_hypre_boomeramg_interp_type", "ext+i"},
+                                                       {"-pc_hypre_boomeramg_strong_threshold", "0.5"},
+                                                       {"-pc_hypre_boomeramg_P_max", "4"},
+                                                       {"-pc_hypre_boomeramg_agg_nl", "1"}};
   for (const auto& [name, value] : tuned) {
     const std::string full = std::string("-") + (prefix ? prefix : "") + (name + 1);
     PetscBool given = PETSC_FALSE;
@@ -124,8 +124,8 @@ KSP create_pressure_ksp(MPI_Comm comm, SpectralPcShell* spectral) {
   return ksp;
 }
 
-PressureSolveResult solve_pressure(MPI_Comm comm, KSP main, KSP* fallback, const std::function<Mat()>& aij, Vec b,
-                                   Vec x, double abs_tol) {
+PressureSolveResult solve_pressure(MPI_Comm comm, KSP main, KSP* fallback, const std::function<Mat()>& aij,
+                                   Vec b, Vec x, double abs_tol) {
   PressureSolveResult res;
   BC_PETSC(VecZeroEntries(x));
   set_abs_tol(main, abs_tol);
@@ -149,7 +149,8 @@ PressureSolveResult solve_pressure(MPI_Comm comm, KSP main, KSP* fallback, const
     BC_PETSC(KSPSolve(*fallback, b, x));
     BC_PETSC(KSPGetConvergedReason(*fallback, &reason));
     if (reason < 0)
-      throw PhysicsError(fmt::format("pressure solve diverged: reason {} (also with the fallback solver)", (int)reason));
+      throw PhysicsError(
+          fmt::format("pressure solve diverged: reason {} (also with the fallback solver)", (int)reason));
     res.used_fallback = true;
     used = *fallback;
   }

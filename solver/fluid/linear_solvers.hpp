@@ -38,7 +38,7 @@ struct PressureSolveResult {
 /// error inside the preconditioner), redoes it with *fallback, created on first use with the
 /// operator aij() (the assembled copy an AMG needs). abs_tol (1/s), unless negative, replaces
 /// the absolute tolerance of both solvers. Throws PhysicsError when the fallback fails too.
-PressureSolveResult solve_pressure(MPI_Comm comm, KSP main, KSP* fallback, const std::function<Mat()>& aij, Vec b,
-                                   Vec x, double abs_tol);
+PressureSolveResult solve_pressure(MPI_Comm comm, KSP main, KSP* fallback, const std::function<Mat()>& aij,
+                                   Vec b, Vec x, double abs_tol);
 
 }  // namespace boycott::fluid

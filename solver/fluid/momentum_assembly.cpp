@@ -31,7 +31,8 @@ void FluidSolver::compute_face_fluxes() {
     BC_PETSC(DMDAVecGetArray(da_, Fl_[d], &F[d]));
   }
   const int lo[3] = {(int)gb.lo[0], (int)gb.lo[1], (int)gb.lo[2]};
-  const int hi[3] = {(int)(gb.lo[0] + gb.size[0]), (int)(gb.lo[1] + gb.size[1]), (int)(gb.lo[2] + gb.size[2])};
+  const int hi[3] = {(int)(gb.lo[0] + gb.size[0]), (int)(gb.lo[1] + gb.size[1]),
+                     (int)(gb.lo[2] + gb.size[2])};
   for (int d = 0; d < 3; ++d)
     for (int k = lo[2]; k < hi[2]; ++k)
       for (int j = lo[1]; j < hi[1]; ++j)
@@ -61,17 +62,25 @@ void FluidSolver::assemble_momentum(int c, double dt, double c0, double c1, doub
   // on them fold away and the neighbour loops unroll (same arithmetic, same bits).
   const bool wall = !s_.grid.periodic[1];
   const auto run = [&](auto C, auto W, auto Q) {
-    assemble_momentum_t<decltype(C)::value, decltype(W)::value, decltype(Q)::value>(dt, c0, c1, c2, first_iteration, A);
+    assemble_momentum_t<decltype(C)::value, decltype(W)::value, decltype(Q)::value>(dt, c0, c1, c2,
+                                                                                    first_iteration, A);
   };
   const auto by_flags = [&](auto C) {
-    if (wall && s_.quick) run(C, std::true_type{}, std::true_type{});
-    else if (wall) run(C, std::true_type{}, std::false_type{});
-    else if (s_.quick) run(C, std::false_type{}, std::true_type{});
-    else run(C, std::false_type{}, std::false_type{});
+    if (wall && s_.quick)
+      run(C, std::true_type{}, std::true_type{});
+    else if (wall)
+      run(C, std::true_type{}, std::false_type{});
+    else if (s_.quick)
+      run(C, std::false_type{}, std::true_type{});
+    else
+      run(C, std::false_type{}, std::false_type{});
   };
-  if (c == 0) by_flags(std::integral_constant<int, 0>{});
-  else if (c == 1) by_flags(std::integral_constant<int, 1>{});
-  else by_flags(std::integral_constant<int, 2>{});
+  if (c == 0)
+    by_flags(std::integral_constant<int, 0>{});
+  else if (c == 1)
+    by_flags(std::integral_constant<int, 1>{});
+  else
+    by_flags(std::integral_constant<int, 2>{});
 }
 
 // The row loop is split by neighbour (loop fission): for one (k, j) row of cells, each of the
@@ -144,7 +153,7 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
       const std::int64_t P0 = (k - gb.lo[2]) * off[2] + (j - gb.lo[1]) * off[1] + (b.lo[0] - gb.lo[0]);
       if (c == 1 && wall && j == 0) {  // v = 0 on the wall itself: an identity row
         for (int e = 0; e < 7; ++e) std::fill(Ae[e] + o0, Ae[e] + o0 + nx, e == 0 ? 1.0 : 0.0);
-        #pragma GCC ivdep
+#pragma GCC ivdep
         for (int i = 0; i < nx; ++i) {
           idg[o0 + i] = 1.0;
           rhs[o0 + i] = 0.0;
@@ -154,10 +163,10 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
         continue;
       }
       {  // time derivative, drag, pressure gradient, body force and sources
-        const double *__restrict a0 = al[0] + P0, *__restrict an = al[1] + P0, *__restrict anm = al[2] + P0;
-        const double *__restrict pp = p + P0, *__restrict Ko = K + o0, *__restrict uno = un + o0;
-        const double *__restrict unmo = unm1 + o0, *__restrict So = S + o0, *__restrict KUo = KU + o0;
-        #pragma GCC ivdep
+        const double* __restrict a0 = al[0] + P0, * __restrict an = al[1] + P0, * __restrict anm = al[2] + P0;
+        const double* __restrict pp = p + P0, * __restrict Ko = K + o0, * __restrict uno = un + o0;
+        const double* __restrict unmo = unm1 + o0, * __restrict So = S + o0, * __restrict KUo = KU + o0;
+#pragma GCC ivdep
         for (int i = 0; i < nx; ++i) {
           const double a1 = 0.5 * (a0[i] + a0[i - oc]);
           const double a_n = 0.5 * (an[i] + an[i - oc]);
@@ -179,8 +188,8 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
           const int e = 1 + 2 * d + (s > 0);
           const int jN = j + s * kE[d][1];
           // face flux, viscosity and transpose-stress reads of this neighbour, as offsets from P
-          std::int64_t fo;                 // first flux node (the second is fo - oc or fo + oc)
-          bool nb_known_zero = false;      // neighbour is a wall value v = 0 (not an unknown)
+          std::int64_t fo;             // first flux node (the second is fo - oc or fo + oc)
+          bool nb_known_zero = false;  // neighbour is a wall value v = 0 (not an unknown)
           if (d != c) {
             const int jE = s > 0 ? jN : j;  // the d-face of cell E = P + e_d (s > 0) or P
             if (d == 1 && wall && (jE <= 0 || jE >= n1)) {
@@ -188,7 +197,7 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
               // there, so the transpose stress term vanishes
               if (!(s > 0 && top_slip)) {
                 const double* __restrict nP = nu + P0;
-                #pragma GCC ivdep
+#pragma GCC ivdep
                 for (int i = 0; i < nx; ++i) {
                   const double nuf = 0.5 * (nP[i] + nP[i - oc]);
                   aP[i] += 2.0 * a1v[i] * nuf * ih2[d];
@@ -209,10 +218,12 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
           const bool ok_up = face_ok(j - s * kE[d][1]) && face_ok(j) && okN;
           const bool ok_dn = face_ok(j + 2 * s * kE[d][1]) && face_ok(j) && okN;
           const double zP = zero_node(j) ? 0.0 : 1.0, zN = zero_node(jN) ? 0.0 : 1.0;
-          const double zUu = zero_node(j - s * kE[d][1]) ? 0.0 : 1.0, zUd = zero_node(j + 2 * s * kE[d][1]) ? 0.0 : 1.0;
+          const double zUu = zero_node(j - s * kE[d][1]) ? 0.0 : 1.0,
+                       zUd = zero_node(j + 2 * s * kE[d][1]) ? 0.0 : 1.0;
           const double qup = ok_up ? 1.0 : 0.0, qdn = ok_dn ? 1.0 : 0.0;
           const std::int64_t oN = okN && zN != 0.0 ? s * od : 0;
-          const std::int64_t oUu = ok_up && zUu != 0.0 ? -s * od : 0, oUd = ok_dn && zUd != 0.0 ? 2 * s * od : 0;
+          const std::int64_t oUu = ok_up && zUu != 0.0 ? -s * od : 0,
+                             oUd = ok_dn && zUd != 0.0 ? 2 * s * od : 0;
           double* __restrict ae = anb[e];
           const double* __restrict uP_ = uc + P0;
           const double sh = s * 0.5;
@@ -247,7 +258,7 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
             const double zlo = zero_node(s > 0 ? j : j - kE[c][1]) ? 0.0 : 1.0;
             const double zhi = zero_node(s > 0 ? j + kE[c][1] : j) ? 0.0 : 1.0;
             const std::int64_t ohi = zhi != 0.0 ? oc : 0;  // v at j = ny is outside the ghosted box
-            #pragma GCC ivdep
+#pragma GCC ivdep
             for (int i = 0; i < nx; ++i) {
               const double F = sh * (F0[i] + F0[i + oc]);
               const double nuf = nQ[i];
@@ -258,7 +269,7 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
             const double* __restrict FE = Fd[d] + P0 + fo;
             const double* __restrict nE = nu + P0 + fo;
             const double* __restrict uE = u[d] + P0 + fo;
-            #pragma GCC ivdep
+#pragma GCC ivdep
             for (int i = 0; i < nx; ++i) {
               const double F = sh * (FE[i] + FE[i - oc]);
               const double nuf = 0.25 * (nE[i] + nE[i - oc] + nE[i - od] + nE[i - oc - od]);
@@ -270,8 +281,8 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
       }
       {
         const double* __restrict uP_ = uc + P0;
-        double *__restrict rh = rhs + o0, *__restrict pv = prev + o0, *__restrict Dd = Dv + o0;
-        #pragma GCC ivdep
+        double* __restrict rh = rhs + o0, * __restrict pv = prev + o0, * __restrict Dd = Dv + o0;
+#pragma GCC ivdep
         for (int i = 0; i < nx; ++i) {
           const double b_ = bb[i] + a1v[i] * ts[i];
           const double aPr = aP[i] * inv_lam;
@@ -282,7 +293,7 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
         // SIMPLE: u' = -(a/(rho a_P)) grad p'; SIMPLEC (Van Doormaal and Raithby 1984) subtracts
         // the neighbour sum, which keeps diffusion-dominated, high-aspect cells convergent.
         if (first_iteration)
-          #pragma GCC ivdep
+#pragma GCC ivdep
           for (int i = 0; i < nx; ++i) Dd[i] = a1v[i] / (rho * (simplec ? aP[i] - snb[i] : aP[i]));
         double* __restrict id = idg + o0;
 #pragma GCC ivdep
@@ -291,8 +302,10 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
       // entries of known zeros (wall values v = 0, no-slip faces) are stored as 0
       std::copy(aP, aP + nx, Ae[0] + o0);
       for (int e = 1; e < 7; ++e)
-        if (present >> e & 1u) std::copy(anb[e], anb[e] + nx, Ae[e] + o0);
-        else std::fill(Ae[e] + o0, Ae[e] + o0 + nx, 0.0);
+        if (present >> e & 1u)
+          std::copy(anb[e], anb[e] + nx, Ae[e] + o0);
+        else
+          std::fill(Ae[e] + o0, Ae[e] + o0 + nx, 0.0);
     }
 
   for (int d = 0; d < 3; ++d) BC_PETSC(VecRestoreArrayRead(Ul_[d], &u[d]));

@@ -9,7 +9,8 @@
 namespace boycott::fluid {
 
 inline void petsc_check(PetscErrorCode ierr, const char* what) {
-  if (ierr != 0) throw std::runtime_error(fmt::format("PETSc call failed ({}): {}", static_cast<int>(ierr), what));
+  if (ierr != 0)
+    throw std::runtime_error(fmt::format("PETSc call failed ({}): {}", static_cast<int>(ierr), what));
 }
 
 }  // namespace boycott::fluid

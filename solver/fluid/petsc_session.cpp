@@ -22,6 +22,8 @@ PetscSession::~PetscSession() {
   PetscFinalize();
 }
 
-bool PetscSession::active() { return g_active; }
+bool PetscSession::active() {
+  return g_active;
+}
 
 }  // namespace boycott::fluid

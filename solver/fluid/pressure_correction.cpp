@@ -26,7 +26,7 @@ double FluidSolver::continuity_residual(double dt, double c0, double c1, double 
   const double h[3] = {g.dx(0), g.dx(1), g.dx(2)};
   const bool wall = !g.periodic[1];
   const OwnedBox b = owned_box();
-  PetscScalar** *u[3], ***al[3], ***R;
+  PetscScalar ***u[3], ***al[3], ***R;
   for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecGetArray(da_, Ul_[d], &u[d]));
   for (int l = 0; l < 3; ++l) BC_PETSC(DMDAVecGetArray(da_, alphal_[l], &al[l]));
   BC_PETSC(DMDAVecGetArray(da_, Rv, &R));
@@ -61,7 +61,7 @@ void FluidSolver::assemble_pressure() {
   const bool wall = !g.periodic[1];
   const OwnedBox b = owned_box();
   for (int d = 0; d < 3; ++d) halo_->fill(D_[d], Dl_[d]);
-  PetscScalar** *D[3], ***al;
+  PetscScalar ***D[3], ***al;
   for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecGetArray(da_, Dl_[d], &D[d]));
   BC_PETSC(DMDAVecGetArray(da_, alphal_[0], &al));
   double* Ae[7];
@@ -123,7 +123,8 @@ void FluidSolver::correct(Vec pcorr) {
       for (int i = (int)b.lo[0]; i < b.lo[0] + b.size[0]; ++i)
         for (int d = 0; d < 3; ++d) {
           if (d == 1 && wall && j == 0) continue;
-          U[d][k][j][i] -= D[d][k][j][i] * (pc[k][j][i] - pc[k - kE[d][2]][j - kE[d][1]][i - kE[d][0]]) / h[d];
+          U[d][k][j][i] -=
+              D[d][k][j][i] * (pc[k][j][i] - pc[k - kE[d][2]][j - kE[d][1]][i - kE[d][0]]) / h[d];
         }
   BC_PETSC(DMDAVecRestoreArray(da_, pcl_, &pc));
   for (int d = 0; d < 3; ++d) {
@@ -150,8 +151,8 @@ double FluidSolver::relative_continuity_residual(double dt, const double c[3], d
   const double hmin = std::min({g.dx(0), g.dx(1), g.dx(2)});
   for (int cc = 0; cc < 3; ++cc) halo_->fill(U_[cc], Ul_[cc]);
   const double rmax = continuity_residual(dt, c[0], c[1], c[2], R_);
-  const double uref = std::max({umax, std::abs(std::isfinite(s_.target_mean_flux_z_m_s) ? s_.target_mean_flux_z_m_s : 0.0),
-                                1e-30});
+  const double uref = std::max(
+      {umax, std::abs(std::isfinite(s_.target_mean_flux_z_m_s) ? s_.target_mean_flux_z_m_s : 0.0), 1e-30});
   if (!std::isfinite(rmax) || !std::isfinite(umax))
     throw PhysicsError(fmt::format("fluid velocity became NaN at t = {:.6g} s", time_));
   // The pressure correction need not reduce a residual far below what SIMPLE's test accepts

@@ -83,8 +83,8 @@ void FluidSolver::step_simple(double dt, const double c[3], StepReport& rep) {
       apply_flux_controller();
     }
     rep.continuity_residual = relative_continuity_residual(dt, c, umax);
-    const double uref = std::max({umax, std::abs(std::isfinite(s_.target_mean_flux_z_m_s) ? s_.target_mean_flux_z_m_s : 0.0),
-                                  1e-30});
+    const double uref = std::max(
+        {umax, std::abs(std::isfinite(s_.target_mean_flux_z_m_s) ? s_.target_mean_flux_z_m_s : 0.0), 1e-30});
     const double dvel = du / uref;
     if (first) assemble_pressure();
     solve_pressure_correction(rep);
@@ -211,7 +211,8 @@ void FluidSolver::solve_momentum(int cc, const StencilOperator& op, StepReport& 
   BC_PETSC(KSPSolve(ksp_m_, rhs_, sol_));
   KSPConvergedReason reason;
   BC_PETSC(KSPGetConvergedReason(ksp_m_, &reason));
-  if (reason < 0) throw PhysicsError(fmt::format("momentum solve (component {}) diverged: reason {}", cc, (int)reason));
+  if (reason < 0)
+    throw PhysicsError(fmt::format("momentum solve (component {}) diverged: reason {}", cc, (int)reason));
   PetscInt its;
   BC_PETSC(KSPGetIterationNumber(ksp_m_, &its));
   rep.momentum_krylov_iterations += (int)its;

@@ -35,9 +35,11 @@ void make_bases(int nx, int ny, int nz, bool periodic_y, std::vector<double>& qy
       }
       qy[static_cast<std::size_t>(j) * ny + m] = v;
     }
-    sy[m] = periodic_y ? 2.0 - 2.0 * std::cos(kTwoPi * ((m + 1) / 2) / ny) : 2.0 - 2.0 * std::cos(M_PI * m / ny);
+    sy[m] =
+        periodic_y ? 2.0 - 2.0 * std::cos(kTwoPi * ((m + 1) / 2) / ny) : 2.0 - 2.0 * std::cos(M_PI * m / ny);
     double nrm = 0.0;
-    for (int j = 0; j < ny; ++j) nrm += qy[static_cast<std::size_t>(j) * ny + m] * qy[static_cast<std::size_t>(j) * ny + m];
+    for (int j = 0; j < ny; ++j)
+      nrm += qy[static_cast<std::size_t>(j) * ny + m] * qy[static_cast<std::size_t>(j) * ny + m];
     if (nrm < 1e-12) {  // the sine of the Nyquist wavenumber vanishes on the grid: unused mode
       sy[m] = -1.0;
       continue;
@@ -59,9 +61,9 @@ void make_bases(int nx, int ny, int nz, bool periodic_y, std::vector<double>& qy
 /// (the constant, the null space of the pure-Neumann/periodic system) and unused modes give 0.
 /// The loops run along the rows (contiguous) and vectorise; each value is summed over j and m in
 /// index order. eig: scratch of ny * n2.
-void solve_y_rows(const std::vector<double>& qy, const std::vector<double>& sy, double* rows, std::size_t stride,
-                  int n2, double ca, const double* sa, double kb, double cy, double scale, double tiny,
-                  double* __restrict eig) {
+void solve_y_rows(const std::vector<double>& qy, const std::vector<double>& sy, double* rows,
+                  std::size_t stride, int n2, double ca, const double* sa, double kb, double cy, double scale,
+                  double tiny, double* __restrict eig) {
   const int ny = static_cast<int>(sy.size());
   for (int m = 0; m < ny; ++m) {
     double* __restrict e = eig + static_cast<std::size_t>(m) * n2;
@@ -111,8 +113,10 @@ SpectralPoissonPreconditioner::SpectralPoissonPreconditioner(int nx, int ny, int
   eig_.resize(static_cast<std::size_t>(ny) * 2 * nkx_);
   int n[2] = {nz, nx};
   // FFTW_ESTIMATE: plans in microseconds; MEASURE would time candidate plans at every start.
-  fwd_ = fftw_plan_many_dft_r2c(2, n, ny, real_, nullptr, 1, nz * nx, spec, nullptr, 1, nz * nkx_, FFTW_ESTIMATE);
-  bwd_ = fftw_plan_many_dft_c2r(2, n, ny, spec, nullptr, 1, nz * nkx_, real_, nullptr, 1, nz * nx, FFTW_ESTIMATE);
+  fwd_ = fftw_plan_many_dft_r2c(2, n, ny, real_, nullptr, 1, nz * nx, spec, nullptr, 1, nz * nkx_,
+                                FFTW_ESTIMATE);
+  bwd_ = fftw_plan_many_dft_c2r(2, n, ny, spec, nullptr, 1, nz * nkx_, real_, nullptr, 1, nz * nx,
+                                FFTW_ESTIMATE);
   if (!fwd_ || !bwd_) throw std::runtime_error("SpectralPoissonPreconditioner: FFTW plan failed");
 }
 
@@ -123,7 +127,9 @@ SpectralPoissonPreconditioner::~SpectralPoissonPreconditioner() {
   fftw_free(spec_);
 }
 
-void SpectralPoissonPreconditioner::set_coefficients(double cx, double cy, double cz) { c_ = {cx, cy, cz}; }
+void SpectralPoissonPreconditioner::set_coefficients(double cx, double cy, double cz) {
+  c_ = {cx, cy, cz};
+}
 
 void SpectralPoissonPreconditioner::apply(const double* r, double* z) {
   const std::size_t plane = static_cast<std::size_t>(nz_) * nx_;
@@ -131,7 +137,8 @@ void SpectralPoissonPreconditioner::apply(const double* r, double* z) {
   for (int k = 0; k < nz_; ++k)
     for (int j = 0; j < ny_; ++j)
       std::memcpy(real_ + j * plane + static_cast<std::size_t>(k) * nx_,
-                  r + static_cast<std::size_t>(nx_) * (j + static_cast<std::size_t>(ny_) * k), sizeof(double) * nx_);
+                  r + static_cast<std::size_t>(nx_) * (j + static_cast<std::size_t>(ny_) * k),
+                  sizeof(double) * nx_);
   fftw_execute(static_cast<fftw_plan>(fwd_));
   auto* spec = reinterpret_cast<std::complex<double>*>(spec_);
   const std::size_t cplane = static_cast<std::size_t>(nz_) * nkx_;
@@ -140,8 +147,8 @@ void SpectralPoissonPreconditioner::apply(const double* r, double* z) {
   const double tiny = 1e-12 * (c_[0] + c_[1] + c_[2]);
   auto* sp = reinterpret_cast<double*>(spec);
   for (int kz = 0; kz < nz_; ++kz) {
-    solve_y_rows(qy_, sy_, sp + 2 * static_cast<std::size_t>(kz) * nkx_, 2 * cplane, 2 * nkx_, c_[0], sx_.data(),
-                 c_[2] * sz_[kz], c_[1], scale, tiny, eig_.data());
+    solve_y_rows(qy_, sy_, sp + 2 * static_cast<std::size_t>(kz) * nkx_, 2 * cplane, 2 * nkx_, c_[0],
+                 sx_.data(), c_[2] * sz_[kz], c_[1], scale, tiny, eig_.data());
   }
   fftw_execute(static_cast<fftw_plan>(bwd_));
   for (int k = 0; k < nz_; ++k)
@@ -168,8 +175,8 @@ std::vector<int> DistributedSpectralPoisson::z_slab_counts(int nx, int ny, int n
   init_fftw_mpi();
   const ptrdiff_t nc[2] = {nz, nx / 2 + 1};
   ptrdiff_t n0, s0, n1, s1;
-  fftw_mpi_local_size_many_transposed(2, nc, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, comm, &n0, &s0, &n1,
-                                      &s1);
+  fftw_mpi_local_size_many_transposed(2, nc, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, comm, &n0,
+                                      &s0, &n1, &s1);
   int size = 1;
   MPI_Comm_size(comm, &size);
   std::vector<int> counts(static_cast<std::size_t>(size));
@@ -185,8 +192,8 @@ DistributedSpectralPoisson::DistributedSpectralPoisson(int nx, int ny, int nz, b
   make_bases(nx, ny, nz, periodic_y, qy_, sy_, sx_, sz_);
   const ptrdiff_t nc[2] = {nz, nkx_};  // complex extents for the r2c local sizes
   ptrdiff_t n0, s0, n1, s1;
-  const ptrdiff_t alloc = fftw_mpi_local_size_many_transposed(2, nc, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK,
-                                                              comm, &n0, &s0, &n1, &s1);
+  const ptrdiff_t alloc = fftw_mpi_local_size_many_transposed(
+      2, nc, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, comm, &n0, &s0, &n1, &s1);
   z0_ = static_cast<int>(s0), nz_local_ = static_cast<int>(n0);
   kx0_ = static_cast<int>(s1), nkx_local_ = static_cast<int>(n1);
   real_ = fftw_alloc_real(2 * static_cast<std::size_t>(alloc > 0 ? alloc : 1));
@@ -195,10 +202,10 @@ DistributedSpectralPoisson::DistributedSpectralPoisson(int nx, int ny, int nz, b
   eig_.resize(static_cast<std::size_t>(ny) * 2 * nz);
   rows_.resize(static_cast<std::size_t>(ny) * 2 * nz);
   const ptrdiff_t nr[2] = {nz, nx};
-  fwd_ = fftw_mpi_plan_many_dft_r2c(2, nr, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, real_, spec, comm,
-                                    FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_OUT);
-  bwd_ = fftw_mpi_plan_many_dft_c2r(2, nr, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, spec, real_, comm,
-                                    FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_IN);
+  fwd_ = fftw_mpi_plan_many_dft_r2c(2, nr, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, real_, spec,
+                                    comm, FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_OUT);
+  bwd_ = fftw_mpi_plan_many_dft_c2r(2, nr, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, spec, real_,
+                                    comm, FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_IN);
   if (!fwd_ || !bwd_) throw std::runtime_error("DistributedSpectralPoisson: FFTW MPI plan failed");
 }
 
@@ -235,8 +242,8 @@ void DistributedSpectralPoisson::apply(const double* r, double* z) {
         rows[j * n2 + 2 * kz] = block[(static_cast<std::size_t>(kz) * ny_ + j) * 2];
         rows[j * n2 + 2 * kz + 1] = block[(static_cast<std::size_t>(kz) * ny_ + j) * 2 + 1];
       }
-    solve_y_rows(qy_, sy_, rows, n2, static_cast<int>(n2), c_[2], sz_.data(), c_[0] * sx_[kx], c_[1], scale, tiny,
-                 eig_.data());
+    solve_y_rows(qy_, sy_, rows, n2, static_cast<int>(n2), c_[2], sz_.data(), c_[0] * sx_[kx], c_[1], scale,
+                 tiny, eig_.data());
     for (int kz = 0; kz < nz_; ++kz)
       for (int j = 0; j < ny_; ++j) {
         block[(static_cast<std::size_t>(kz) * ny_ + j) * 2] = rows[j * n2 + 2 * kz];

@@ -34,13 +34,13 @@ class SpectralPoissonPreconditioner {
   int nx_, ny_, nz_, nkx_;
   bool periodic_y_;
   std::array<double, 3> c_{1.0, 1.0, 1.0};
-  std::vector<double> qy_;     ///< orthonormal eigenvectors of the 1-D y operator, [j * ny + m]
-  std::vector<double> sy_;     ///< their eigenvalues for a unit coefficient
+  std::vector<double> qy_;       ///< orthonormal eigenvectors of the 1-D y operator, [j * ny + m]
+  std::vector<double> sy_;       ///< their eigenvalues for a unit coefficient
   std::vector<double> sx_, sz_;  ///< 2 - 2 cos(2 pi k / n) per x and z wavenumber
   double* real_ = nullptr;       ///< ny planes of nz x nx reals (fftw_malloc)
   void* spec_ = nullptr;         ///< ny planes of nz x (nx/2+1) complex (fftw_complex)
-  std::vector<double> eig_;  ///< one kz row of coefficients in the y eigenbasis: ny x (re, im) x nkx
-  void* fwd_ = nullptr;  ///< fftw_plan
+  std::vector<double> eig_;      ///< one kz row of coefficients in the y eigenbasis: ny x (re, im) x nkx
+  void* fwd_ = nullptr;          ///< fftw_plan
   void* bwd_ = nullptr;
 };
 
@@ -70,8 +70,8 @@ class DistributedSpectralPoisson {
   int z0_ = 0, nz_local_ = 0, kx0_ = 0, nkx_local_ = 0;
   std::array<double, 3> c_{1.0, 1.0, 1.0};
   std::vector<double> qy_, sy_, sx_, sz_;
-  double* real_ = nullptr;  ///< [z local][2 nkx][ny] (FFTW MPI layout, y innermost)
-  void* spec_ = nullptr;    ///< transposed: [kx local][nz][ny] complex
+  double* real_ = nullptr;    ///< [z local][2 nkx][ny] (FFTW MPI layout, y innermost)
+  void* spec_ = nullptr;      ///< transposed: [kx local][nz][ny] complex
   std::vector<double> eig_;   ///< one kx block in the y eigenbasis: ny x (re, im) x nz
   std::vector<double> rows_;  ///< that block moved to ny rows over kz
   void* fwd_ = nullptr;

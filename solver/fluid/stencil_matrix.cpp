@@ -21,7 +21,8 @@ void blocks(Mat M, Mat* Ad, Mat* Ao, const PetscInt** garray) {
     check(MatMPIAIJGetSeqAIJ(M, Ad, Ao, garray), "MatMPIAIJGetSeqAIJ");
   } else {
     PetscBool seq = PETSC_FALSE;
-    check(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(M), MATSEQAIJ, &seq), "PetscObjectTypeCompare");
+    check(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(M), MATSEQAIJ, &seq),
+          "PetscObjectTypeCompare");
     if (!seq) throw std::runtime_error("StencilMatrixWriter: the matrix is neither seqaij nor mpiaij");
     *Ad = M, *Ao = nullptr, *garray = nullptr;
   }
@@ -51,7 +52,8 @@ StencilMatrixWriter::StencilMatrixWriter(DM da, Mat M) {
   DMBoundaryType bx, by, bz;
   check(DMDAGetCorners(da, &xs, &ys, &zs, &xm, &ym, &zm), "DMDAGetCorners");
   check(DMDAGetGhostCorners(da, &gxs, &gys, &gzs, &gxm, &gym, &gzm), "DMDAGetGhostCorners");
-  check(DMDAGetInfo(da, nullptr, &mx, &my, &mz, nullptr, nullptr, nullptr, nullptr, nullptr, &bx, &by, &bz, nullptr),
+  check(DMDAGetInfo(da, nullptr, &mx, &my, &mz, nullptr, nullptr, nullptr, nullptr, nullptr, &bx, &by, &bz,
+                    nullptr),
         "DMDAGetInfo");
   ISLocalToGlobalMapping ltog;
   check(DMGetLocalToGlobalMapping(da, &ltog), "DMGetLocalToGlobalMapping");
@@ -59,7 +61,8 @@ StencilMatrixWriter::StencilMatrixWriter(DM da, Mat M) {
   check(ISLocalToGlobalMappingGetIndices(ltog, &l2g), "ISLocalToGlobalMappingGetIndices");
 
   const PetscInt n[3] = {mx, my, mz};
-  const bool periodic[3] = {bx == DM_BOUNDARY_PERIODIC, by == DM_BOUNDARY_PERIODIC, bz == DM_BOUNDARY_PERIODIC};
+  const bool periodic[3] = {bx == DM_BOUNDARY_PERIODIC, by == DM_BOUNDARY_PERIODIC,
+                            bz == DM_BOUNDARY_PERIODIC};
   slots_.assign(7 * static_cast<std::size_t>(xm) * ym * zm, kMissing);
   std::int64_t o = 0;
   for (PetscInt k = zs; k < zs + zm; ++k)
@@ -82,7 +85,8 @@ StencilMatrixWriter::StencilMatrixWriter(DM da, Mat M) {
             for (PetscInt p = ib[o]; p < ib[o + 1]; ++p)
               if (garray[jb[p]] == col) slot = -(p + 1);
           }
-          if (slot == kMissing) throw std::runtime_error("StencilMatrixWriter: stencil entry not in the matrix pattern");
+          if (slot == kMissing)
+            throw std::runtime_error("StencilMatrixWriter: stencil entry not in the matrix pattern");
           slots_[7 * o + e] = slot;
         }
       }

@@ -1,10 +1,11 @@
 #pragma once
 // Writes the values of a 7-point star matrix made by DMCreateMatrix on a DMDA straight into its
 // AIJ value arrays. The fluid applies its operators matrix-free (stencil_operator.hpp) and uses
-// this only for the AIJ copies that a user-chosen preconditioner or the AMG fallback needs. MatSetValuesStencil costs ~350 ns per row (stencil to local to global index
-// mapping, then a column search per entry), which made it ~70 % of the momentum assembly on the
-// 200 x 6 x 100 bench mesh; the nonzero pattern of these matrices never changes, so the position
-// of each row's seven entries is looked up once, here, and reused for every assembly.
+// this only for the AIJ copies that a user-chosen preconditioner or the AMG fallback needs.
+// MatSetValuesStencil costs ~350 ns per row (stencil to local to global index mapping, then a column search
+// per entry), which made it ~70 % of the momentum assembly on the 200 x 6 x 100 bench mesh; the nonzero
+// pattern of these matrices never changes, so the position of each row's seven entries is looked up once,
+// here, and reused for every assembly.
 //
 // Entry e of a row: 0 the diagonal, 1 + 2 d + (s > 0) the neighbour at -e_d (s < 0) or +e_d.
 // Rows are the rank's owned cells in PETSc order (x fastest over the owned box). Entries of a
@@ -41,7 +42,7 @@ class StencilMatrixWriter {
   static constexpr std::int64_t kMissing = INT64_MIN;
   std::vector<std::int64_t> slots_;  // >= 0: index into the diagonal block's values; < 0: off-diagonal block
   PetscInt nnz_diag_ = 0, nnz_offd_ = 0;  // stored values of the two blocks
-  Mat Ad_ = nullptr, Ao_ = nullptr;  // blocks of the matrix between begin and end
+  Mat Ad_ = nullptr, Ao_ = nullptr;       // blocks of the matrix between begin and end
   PetscScalar* diag_ = nullptr;
   PetscScalar* offd_ = nullptr;
 };

@@ -43,8 +43,8 @@ PetscErrorCode shell_diagonal(Mat A, Vec d) {
 template <bool lo, bool hi>
 inline void row_product(const double* const* c, const double* __restrict x, double* __restrict y, int n,
                         std::int64_t sy, std::int64_t sz) {
-  const double *__restrict c0 = c[0], *__restrict c1 = c[1], *__restrict c2 = c[2], *__restrict c3 = c[3];
-  const double *__restrict c4 = c[4], *__restrict c5 = c[5], *__restrict c6 = c[6];
+  const double* __restrict c0 = c[0], * __restrict c1 = c[1], * __restrict c2 = c[2], * __restrict c3 = c[3];
+  const double* __restrict c4 = c[4], * __restrict c5 = c[5], * __restrict c6 = c[6];
 #pragma GCC ivdep
   for (int i = 0; i < n; ++i) {
     double s = c0[i] * x[i] + c1[i] * x[i - 1] + c2[i] * x[i + 1];
@@ -61,8 +61,8 @@ StencilOperator::StencilOperator(DM dm) : dm_(dm), halo_(dm) {
   DMBoundaryType bx, by, bz;
   check(DMDAGetCorners(dm, &xs, &ys, &zs, &xm, &ym, &zm), "DMDAGetCorners");
   check(DMDAGetGhostCorners(dm, &gxs, &gys, &gzs, &gxm, &gym, &gzm), "DMDAGetGhostCorners");
-  check(DMDAGetInfo(dm, nullptr, nullptr, &my, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, &bx, &by, &bz,
-                    nullptr),
+  check(DMDAGetInfo(dm, nullptr, nullptr, &my, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, &bx, &by,
+                    &bz, nullptr),
         "DMDAGetInfo");
   // x and z are read one cell beyond the owned box on both sides, so the ghosts must be there
   if (bx != DM_BOUNDARY_PERIODIC || bz != DM_BOUNDARY_PERIODIC || xs - gxs < 1 || zs - gzs < 1)
@@ -82,7 +82,8 @@ StencilOperator::StencilOperator(DM dm) : dm_(dm), halo_(dm) {
   MPI_Comm comm;
   check(PetscObjectGetComm(reinterpret_cast<PetscObject>(dm), &comm), "PetscObjectGetComm");
   check(MatCreateShell(comm, nl, nl, N, N, const_cast<StencilOperator*>(this), &shell_), "MatCreateShell");
-  check(MatShellSetOperation(shell_, MATOP_MULT, reinterpret_cast<void (*)(void)>(shell_mult)), "MatShellSetOperation");
+  check(MatShellSetOperation(shell_, MATOP_MULT, reinterpret_cast<void (*)(void)>(shell_mult)),
+        "MatShellSetOperation");
   check(MatShellSetOperation(shell_, MATOP_GET_DIAGONAL, reinterpret_cast<void (*)(void)>(shell_diagonal)),
         "MatShellSetOperation");
 }
@@ -107,10 +108,14 @@ void StencilOperator::apply(Vec x, Vec y) const {
       for (int e = 0; e < 7; ++e) c[e] = coef_[e].data() + o;
       const double* xr = xa + (k - glo_[2]) * sz + (j - glo_[1]) * sy + (lo_[0] - glo_[0]);
       const bool lo = !(wall_y_ && j == 0), hi = !(wall_y_ && j == ny_ - 1);
-      if (lo && hi) row_product<true, true>(c, xr, ya + o, nx, sy, sz);
-      else if (lo) row_product<true, false>(c, xr, ya + o, nx, sy, sz);
-      else if (hi) row_product<false, true>(c, xr, ya + o, nx, sy, sz);
-      else row_product<false, false>(c, xr, ya + o, nx, sy, sz);
+      if (lo && hi)
+        row_product<true, true>(c, xr, ya + o, nx, sy, sz);
+      else if (lo)
+        row_product<true, false>(c, xr, ya + o, nx, sy, sz);
+      else if (hi)
+        row_product<false, true>(c, xr, ya + o, nx, sy, sz);
+      else
+        row_product<false, false>(c, xr, ya + o, nx, sy, sz);
     }
   check(VecRestoreArrayRead(xl_, &xa), "VecRestoreArrayRead");
   check(VecRestoreArray(y, &ya), "VecRestoreArray");

@@ -98,8 +98,8 @@ void FluidSolver::compute_subgrid_viscosity() {
 #pragma GCC ivdep
       for (int i = 0; i < nx; ++i) {
         const std::array<std::array<double, 3>, 3> grad = {{{G[0][0][i], G[0][1][i], G[0][2][i]},
-                                                           {G[1][0][i], G[1][1][i], G[1][2][i]},
-                                                           {G[2][0][i], G[2][1][i], G[2][2][i]}}};
+                                                            {G[1][0][i], G[1][1][i], G[1][2][i]},
+                                                            {G[2][0][i], G[2][1][i], G[2][2][i]}}};
         nto[i] = vreman_viscosity(grad, delta, cv);
       }
     }

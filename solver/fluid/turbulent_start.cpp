@@ -34,13 +34,15 @@ void start_turbulent_channel(FluidSolver& f, const TurbulentStartSettings& s) {
       for (int b = 0; b < n; ++b) {
         if (a == 0 && b == 0) continue;
         const double* ph = &phase[static_cast<std::size_t>(((c * n + a) * n + b) * 2)];
-        sum += std::sin(2.0 * kPi * (a * x / Lx + b * z / Lz) + ph[0]) * std::sin(2.0 * kPi * (a + b) * yc + ph[1]);
+        sum += std::sin(2.0 * kPi * (a * x / Lx + b * z / Lz) + ph[0]) *
+               std::sin(2.0 * kPi * (a + b) * yc + ph[1]);
       }
     return amp * sum * std::sin(0.5 * kPi * yc);
   };
   f.set_velocity(0, [&](double x, double y, double z) { return perturbation(0, x, y, z); });
   f.set_velocity(1, [&](double x, double y, double z) { return perturbation(1, x, y, z); });
-  f.set_velocity(2, [&](double x, double y, double z) { return scale * log_law(y) + perturbation(2, x, y, z); });
+  f.set_velocity(2,
+                 [&](double x, double y, double z) { return scale * log_law(y) + perturbation(2, x, y, z); });
 }
 
 }  // namespace boycott::fluid

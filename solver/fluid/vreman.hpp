@@ -16,8 +16,8 @@ inline constexpr double kVremanConstant = 0.07;
 /// B_beta vanishes whenever the gradient has rank one (any plane shear, e.g. Poiseuille flow),
 /// so the model switches itself off in laminar shear layers.
 /// `grad[i][j]` = d u_j / d x_i (1/s); `delta_m` the cell sizes (m). Returns m^2/s.
-inline double vreman_viscosity(const std::array<std::array<double, 3>, 3>& grad, const std::array<double, 3>& delta_m,
-                               double c = kVremanConstant) {
+inline double vreman_viscosity(const std::array<std::array<double, 3>, 3>& grad,
+                               const std::array<double, 3>& delta_m, double c = kVremanConstant) {
   double aa = 0.0;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) aa += grad[i][j] * grad[i][j];
@@ -28,8 +28,8 @@ inline double vreman_viscosity(const std::array<std::array<double, 3>, 3>& grad,
       for (int m = 0; m < 3; ++m) s += delta_m[m] * delta_m[m] * grad[m][i] * grad[m][j];
       b[i][j] = s;
     }
-  const double bb = b[0][0] * b[1][1] - b[0][1] * b[0][1] + b[0][0] * b[2][2] - b[0][2] * b[0][2] + b[1][1] * b[2][2] -
-                    b[1][2] * b[1][2];
+  const double bb = b[0][0] * b[1][1] - b[0][1] * b[0][1] + b[0][0] * b[2][2] - b[0][2] * b[0][2] +
+                    b[1][1] * b[2][2] - b[1][2] * b[1][2];
   // Round-off can leave B_beta slightly negative for rank-one gradients; it is >= 0 in exact
   // arithmetic (a sum of 2x2 principal minors of a Gram matrix). A select, not early returns,
   // so that the solver's loop over a row of cells vectorises (the discarded value may be NaN).

@@ -55,7 +55,8 @@ std::vector<T> read_dataset(hid_t file, const fs::path& path, const std::string&
   herr_t e = n > 0 ? H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) : 0;
   H5Sclose(space);
   H5Dclose(ds);
-  if (e < 0) throw CheckpointError(fmt::format("{}: dataset '{}' is unreadable (corrupt file?)", path.string(), name));
+  if (e < 0)
+    throw CheckpointError(fmt::format("{}: dataset '{}' is unreadable (corrupt file?)", path.string(), name));
   return v;
 }
 
@@ -93,7 +94,8 @@ void CheckpointWriter::put_3d(const std::string& name, const std::array<std::siz
   const hsize_t d[3] = {dims[0], dims[1], dims[2]};
   if (d[0] * d[1] * d[2] != v.size()) throw CheckpointError(fmt::format("dataset '{}': size mismatch", name));
   const hid_t space = H5Screate_simple(3, d, nullptr);
-  const hid_t ds = H5Dcreate2(file_, name.c_str(), H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  const hid_t ds =
+      H5Dcreate2(file_, name.c_str(), H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   if (ds < 0) {
     H5Sclose(space);
     throw CheckpointError(fmt::format("cannot create dataset '{}'", name));
@@ -137,20 +139,24 @@ void CheckpointWriter::commit() {
 CheckpointReader::CheckpointReader(fs::path path) : path_(std::move(path)) {
   file_ = H5Fopen(path_.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   if (file_ < 0)
-    throw CheckpointError(fmt::format("checkpoint {} cannot be opened as HDF5 (truncated or corrupt); it is left "
-                                      "in place: move it away to start over",
-                                      path_.string()));
+    throw CheckpointError(
+        fmt::format("checkpoint {} cannot be opened as HDF5 (truncated or corrupt); it is left "
+                    "in place: move it away to start over",
+                    path_.string()));
   if (H5Aexists(file_, kComplete) <= 0)
-    throw CheckpointError(fmt::format("checkpoint {} has no completeness marker (cut short while written); it is "
-                                      "left in place: move it away to start over",
-                                      path_.string()));
+    throw CheckpointError(
+        fmt::format("checkpoint {} has no completeness marker (cut short while written); it is "
+                    "left in place: move it away to start over",
+                    path_.string()));
 }
 
 CheckpointReader::~CheckpointReader() {
   if (file_ >= 0) H5Fclose(file_);
 }
 
-bool CheckpointReader::has(const std::string& name) const { return H5Lexists(file_, name.c_str(), H5P_DEFAULT) > 0; }
+bool CheckpointReader::has(const std::string& name) const {
+  return H5Lexists(file_, name.c_str(), H5P_DEFAULT) > 0;
+}
 std::vector<double> CheckpointReader::doubles(const std::string& name) const {
   return read_dataset<double>(file_, path_, name, H5T_NATIVE_DOUBLE);
 }

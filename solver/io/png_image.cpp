@@ -57,7 +57,8 @@ std::vector<unsigned char> encode_png(int w, int h, const std::vector<unsigned c
     z.push_back(static_cast<unsigned char>(len >> 8));
     z.push_back(static_cast<unsigned char>(~len & 0xff));
     z.push_back(static_cast<unsigned char>((~len >> 8) & 0xff));
-    z.insert(z.end(), raw.begin() + static_cast<std::ptrdiff_t>(pos), raw.begin() + static_cast<std::ptrdiff_t>(pos + len));
+    z.insert(z.end(), raw.begin() + static_cast<std::ptrdiff_t>(pos),
+             raw.begin() + static_cast<std::ptrdiff_t>(pos + len));
     pos += len;
   } while (pos < raw.size());
   std::uint32_t a = 1, b = 0;
@@ -89,7 +90,8 @@ void write_particle_png(const std::filesystem::path& path, const ParticleView& v
     if (x < 0) x += v.length_x_m;
     if (z < 0) z += v.height_z_m;
     const double f = std::clamp((*v.y)[i] / v.width_y_m, 0.0, 1.0);
-    const unsigned char col[3] = {static_cast<unsigned char>(255 * f), 40, static_cast<unsigned char>(255 * (1 - f))};
+    const unsigned char col[3] = {static_cast<unsigned char>(255 * f), 40,
+                                  static_cast<unsigned char>(255 * (1 - f))};
     const double cx = x * scale, cy = (v.height_z_m - z) * scale, rr = std::max(0.7, (*v.radius)[i] * scale);
     for (int py = static_cast<int>(cy - rr); py <= static_cast<int>(cy + rr) + 1; ++py)
       for (int px = static_cast<int>(cx - rr); px <= static_cast<int>(cx + rr) + 1; ++px) {

@@ -62,8 +62,8 @@ void load(const CheckpointReader& r, const std::string& prefix, particles::DemSt
 }
 
 void save(CheckpointWriter& w, const std::string& prefix, const fluid::FluidState& s) {
-  w.put(prefix + "box", std::vector<std::int64_t>{s.box.lo[0], s.box.lo[1], s.box.lo[2], s.box.size[0], s.box.size[1],
-                                                  s.box.size[2]});
+  w.put(prefix + "box", std::vector<std::int64_t>{s.box.lo[0], s.box.lo[1], s.box.lo[2], s.box.size[0],
+                                                  s.box.size[1], s.box.size[2]});
   w.put(prefix + "time_s", s.time_s);
   w.put(prefix + "dt_prev_s", s.dt_prev_s);
   w.put_int(prefix + "steps", s.steps);
@@ -110,7 +110,8 @@ void load(const CheckpointReader& r, const std::string& prefix, Histogram& h) {
   const auto range = r.doubles(prefix + "range");
   const auto counts = r.doubles(prefix + "counts");
   if (range.size() != 4 || range[0] != h.lo_ || range[1] != h.hi_ || counts.size() != h.counts_.size())
-    throw CheckpointError(fmt::format("{}: histogram '{}' has another range or bin count", r.path().string(), prefix));
+    throw CheckpointError(
+        fmt::format("{}: histogram '{}' has another range or bin count", r.path().string(), prefix));
   h.outside_ = range[2];
   h.total_ = range[3];
   h.counts_ = counts;

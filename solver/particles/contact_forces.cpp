@@ -19,10 +19,12 @@ namespace {
 /// vectorises (gathers) into a byte per pair; the append is a second, branch-free scalar pass.
 /// The periodic directions are template flags so that the loop body has no branch at all.
 template <bool PX, bool PY, bool PZ>
-std::size_t find_contacts(std::size_t np, const std::uint32_t* __restrict pair_i, const std::uint32_t* __restrict nb,
-                          const double* __restrict x, const double* __restrict y, const double* __restrict z,
-                          const double* __restrict rad, const std::array<double, 3>& len, std::uint8_t* __restrict flag,
-                          std::uint32_t* __restrict ci, std::uint32_t* __restrict cp) {
+std::size_t find_contacts(std::size_t np, const std::uint32_t* __restrict pair_i,
+                          const std::uint32_t* __restrict nb, const double* __restrict x,
+                          const double* __restrict y, const double* __restrict z,
+                          const double* __restrict rad, const std::array<double, 3>& len,
+                          std::uint8_t* __restrict flag, std::uint32_t* __restrict ci,
+                          std::uint32_t* __restrict cp) {
   const double Lx = len[0], Ly = len[1], Lz = len[2];
   const double iLx = 1.0 / Lx, iLy = 1.0 / Ly, iLz = 1.0 / Lz;
   for (std::size_t p = 0; p < np; ++p) {
@@ -44,8 +46,9 @@ std::size_t find_contacts(std::size_t np, const std::uint32_t* __restrict pair_i
 }
 
 using FindContactsFn = std::size_t (*)(std::size_t, const std::uint32_t*, const std::uint32_t*, const double*,
-                                       const double*, const double*, const double*, const std::array<double, 3>&,
-                                       std::uint8_t*, std::uint32_t*, std::uint32_t*);
+                                       const double*, const double*, const double*,
+                                       const std::array<double, 3>&, std::uint8_t*, std::uint32_t*,
+                                       std::uint32_t*);
 // Indexed by periodic x | y << 1 | z << 2.
 constexpr FindContactsFn kFindContacts[8] = {
     find_contacts<false, false, false>, find_contacts<true, false, false>, find_contacts<false, true, false>,
@@ -104,8 +107,8 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   std::uint32_t* __restrict cp = contact_p_.data();
   const int periodic_bits = (px ? 1 : 0) | (py ? 2 : 0) | (pz ? 4 : 0);
   pair_flag_.resize(np);
-  const std::size_t nc =
-      kFindContacts[periodic_bits](np, pair_i_.data(), nb, x, y, z, rad, cfg_.box.len, pair_flag_.data(), ci, cp);
+  const std::size_t nc = kFindContacts[periodic_bits](np, pair_i_.data(), nb, x, y, z, rad, cfg_.box.len,
+                                                      pair_flag_.data(), ci, cp);
   forget_separated_pairs(nc);
   contacts = static_cast<std::int64_t>(nc);
 
@@ -150,10 +153,11 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       const double vrz = vz[i] - vz[j] - (cx * ny - cy * nx);
       // gamma_n needs sqrt(m_eff k_n): a constant when all masses are equal (the usual case).
       double gn = gn_pair;
-      if constexpr (!decltype(uniform_masses)::value) gn = damping_factor * std::sqrt(mi * mj / (mi + mj) * kn);
+      if constexpr (!decltype(uniform_masses)::value)
+        gn = damping_factor * std::sqrt(mi * mj / (mi + mj) * kn);
       double ftx, fty, ftz;
-      const double fn = spring_dashpot(cm, dt, nx, ny, nz, rsum - r, vrx, vry, vrz, gn, hist[3 * p], hist[3 * p + 1],
-                                       hist[3 * p + 2], ftx, fty, ftz);
+      const double fn = spring_dashpot(cm, dt, nx, ny, nz, rsum - r, vrx, vry, vrz, gn, hist[3 * p],
+                                       hist[3 * p + 1], hist[3 * p + 2], ftx, fty, ftz);
       oFx[k] = fn * nx + ftx;
       oFy[k] = fn * ny + fty;
       oFz[k] = fn * nz + ftz;
@@ -161,8 +165,9 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       const double mx = ny * ftz - nz * fty, my = nz * ftx - nx * ftz, mz = nx * fty - ny * ftx;
       double rtx = 0.0, rty = 0.0, rtz = 0.0;
       if constexpr (Rolling::enabled) {
-        rolling_resistance(spx[i] - spx[j], spy[i] - spy[j], spz[i] - spz[j], nx, ny, nz, mx, my, mz, ri / inertia[i],
-                           rj / inertia[j], inv_dt, rolling.mu_r * std::abs(fn), rtx, rty, rtz);
+        rolling_resistance(spx[i] - spx[j], spy[i] - spy[j], spz[i] - spz[j], nx, ny, nz, mx, my, mz,
+                           ri / inertia[i], rj / inertia[j], inv_dt, rolling.mu_r * std::abs(fn), rtx, rty,
+                           rtz);
       }
       oTix[k] = -ri * mx - ri * rtx;
       oTiy[k] = -ri * my - ri * rty;
@@ -172,8 +177,10 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       oTjz[k] = -rj * mz + rj * rtz;
     }
   };
-  if (uniform) contact_loop(std::true_type{});
-  else contact_loop(std::false_type{});
+  if (uniform)
+    contact_loop(std::true_type{});
+  else
+    contact_loop(std::false_type{});
   // Pass 2b: add them to the particles, in contact order.
   for (std::size_t k = 0; k < nc; ++k) {
     const std::uint32_t i = ci[k], j = nb[cp[k]];
@@ -230,8 +237,8 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
         double gn = gn_wall;
         if constexpr (!decltype(uniform_masses)::value) gn = damping_factor * std::sqrt(mi * kn);
         double ftx, fty, ftz;
-        const double fn = spring_dashpot(cm, dt, nx, ny, nz, ri - dist, vrx, vry, vrz, gn, whx[i], why[i], whz[i], ftx,
-                                         fty, ftz);
+        const double fn = spring_dashpot(cm, dt, nx, ny, nz, ri - dist, vrx, vry, vrz, gn, whx[i], why[i],
+                                         whz[i], ftx, fty, ftz);
         fx[i] += fn * nx + ftx;
         fy[i] += fn * ny + fty;
         fz[i] += fn * nz + ftz;
@@ -247,16 +254,20 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
         tz[i] += -ri * (mz + rtz);
       }
     };
-    if (uniform) wall_loop(std::true_type{});
-    else wall_loop(std::false_type{});
+    if (uniform)
+      wall_loop(std::true_type{});
+    else
+      wall_loop(std::false_type{});
   }
   contacts_ = contacts;
 }
 
 void DemSystem::compute_forces() {
   auto t0 = std::chrono::steady_clock::now();
-  if (cfg_.rolling_model == "none" || cfg_.rolling_friction == 0.0) compute_forces_impl(RollingNone{});
-  else compute_forces_impl(RollingConstantDirectional{cfg_.rolling_friction});
+  if (cfg_.rolling_model == "none" || cfg_.rolling_friction == 0.0)
+    compute_forces_impl(RollingNone{});
+  else
+    compute_forces_impl(RollingConstantDirectional{cfg_.rolling_friction});
   seconds_force += seconds_since(t0);
 }
 

@@ -44,12 +44,14 @@ void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const st
   prev_contacts_.clear();
   pair_i_.resize(np);
   for (std::size_t i = 0; i < s_.size(); ++i)
-    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) pair_i_[p] = static_cast<std::uint32_t>(i);
+    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p)
+      pair_i_[p] = static_cast<std::uint32_t>(i);
   if (ida.empty()) return;
   // Sorted (key, slot) table; only pairs that overlap now can carry a history (it is reset
   // whenever a pair separates), so only those are looked up.
   std::vector<std::pair<std::uint64_t, std::uint32_t>> table(ida.size());
-  for (std::size_t q = 0; q < ida.size(); ++q) table[q] = {pair_key(ida[q], idb[q]), static_cast<std::uint32_t>(q)};
+  for (std::size_t q = 0; q < ida.size(); ++q)
+    table[q] = {pair_key(ida[q], idb[q]), static_cast<std::uint32_t>(q)};
   std::sort(table.begin(), table.end());
   for (std::size_t i = 0; i < s_.size(); ++i)
     for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {

@@ -15,9 +15,9 @@ namespace boycott::particles {
 /// spring h (m) is advanced by vt dt, turned into the current tangent plane keeping its length,
 /// and capped by Coulomb (Eq. 10). Returns the signed normal force (N) and writes the
 /// tangential force ft (N). A free function without captures keeps the loop's state in registers.
-inline double spring_dashpot(const LinearSpringDashpot& cm, double dt, double nx, double ny, double nz, double delta,
-                             double vrx, double vry, double vrz, double gn, double& hxr, double& hyr, double& hzr,
-                             double& ftx, double& fty, double& ftz) {
+inline double spring_dashpot(const LinearSpringDashpot& cm, double dt, double nx, double ny, double nz,
+                             double delta, double vrx, double vry, double vrz, double gn, double& hxr,
+                             double& hyr, double& hzr, double& ftx, double& fty, double& ftz) {
   const double kn = cm.kn_n_m, kt = cm.kt_n_m, mu = cm.friction;
   const double gt = cm.tangential_ratio * gn;
   const double vn = vrx * nx + vry * ny + vrz * nz;
@@ -73,8 +73,8 @@ inline void cap_rolling(double qx, double qy, double qz, double qmax, double& rx
 /// friction moment m, a = R / I of each sphere (1/(kg m)); a wall is a sphere of infinite
 /// inertia (a_j = 0, w_j = 0).
 inline void rolling_resistance(double orx, double ory, double orz, double nx, double ny, double nz, double mx,
-                               double my, double mz, double ai, double aj, double inv_dt, double qmax, double& rx,
-                               double& ry, double& rz) {
+                               double my, double mz, double ai, double aj, double inv_dt, double qmax,
+                               double& rx, double& ry, double& rz) {
   const double on = orx * nx + ory * ny + orz * nz;
   const double ik = 1.0 / (ai + aj);
   const double qx = ((orx - on * nx) * inv_dt + (aj - ai) * mx) * ik;

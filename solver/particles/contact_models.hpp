@@ -21,15 +21,19 @@ namespace boycott::particles {
 struct LinearSpringDashpot {
   double kn_n_m = 3.5;
   double kt_n_m = 3.5;
-  double damping_factor = 0.0;   ///< -2 ln e / sqrt(pi^2 + ln^2 e); gamma_n = factor sqrt(m_eff k_n)
-  double tangential_ratio = 0.5; ///< gamma_t / gamma_n
-  double friction = 0.6;         ///< mu_s
+  double damping_factor = 0.0;    ///< -2 ln e / sqrt(pi^2 + ln^2 e); gamma_n = factor sqrt(m_eff k_n)
+  double tangential_ratio = 0.5;  ///< gamma_t / gamma_n
+  double friction = 0.6;          ///< mu_s
   bool clip_attractive = false;
 
   LinearSpringDashpot() = default;
   LinearSpringDashpot(double kn, double e, double tang_ratio, double mu, bool clip)
-      : kn_n_m(kn), kt_n_m(kn), damping_factor(restitution_damping_factor(e)), tangential_ratio(tang_ratio),
-        friction(mu), clip_attractive(clip) {}
+      : kn_n_m(kn),
+        kt_n_m(kn),
+        damping_factor(restitution_damping_factor(e)),
+        tangential_ratio(tang_ratio),
+        friction(mu),
+        clip_attractive(clip) {}
 
   static double restitution_damping_factor(double e) {
     const double le = std::log(e);

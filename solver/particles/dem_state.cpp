@@ -141,7 +141,6 @@ void DemSystem::import_state(const DemState& st) {
   initialized_ = true;
 }
 
-
 void DemSystem::import_parallel(const DemState& st) {
   const std::size_t total = st.store.id.size();
   // Same number of ranks: each rank's own particles in their stored order (bitwise); otherwise

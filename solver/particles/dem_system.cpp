@@ -26,8 +26,9 @@ DemConfig DemConfig::from_case(const CaseParams& p) {
   c.gravity_m_s2 = p.gravity_vector();
   c.dt_s = p.time.dt_dem_s;
   c.skin_m = p.numerics.neighbor_skin_m;
-  c.contact = LinearSpringDashpot(p.contact.stiffness_n_m, p.contact.restitution, p.contact.tangential_damping_ratio,
-                                  p.contact.friction, p.contact.clip_attractive_normal);
+  c.contact =
+      LinearSpringDashpot(p.contact.stiffness_n_m, p.contact.restitution, p.contact.tangential_damping_ratio,
+                          p.contact.friction, p.contact.clip_attractive_normal);
   c.rolling_model = p.contact.rolling_model;
   c.rolling_friction = p.contact.rolling_friction;
   return c;
@@ -43,9 +44,10 @@ DemSystem::DemSystem(const DemConfig& cfg)
 void DemSystem::initialize() {
   if (cfg_.dry)
     for (std::size_t i = 0; i < s_.size(); ++i)
-      if (s_.ext_x[i] != 0.0 || s_.ext_y[i] != 0.0 || s_.ext_z[i] != 0.0 || s_.ufx[i] != 0.0 || s_.ufy[i] != 0.0 ||
-          s_.ufz[i] != 0.0 || s_.madd[i] != 0.0)
-        throw std::logic_error("DemConfig::dry is set but a particle has a fluid force, velocity or added mass");
+      if (s_.ext_x[i] != 0.0 || s_.ext_y[i] != 0.0 || s_.ext_z[i] != 0.0 || s_.ufx[i] != 0.0 ||
+          s_.ufy[i] != 0.0 || s_.ufz[i] != 0.0 || s_.madd[i] != 0.0)
+        throw std::logic_error(
+            "DemConfig::dry is set but a particle has a fluid force, velocity or added mass");
   if (dd_.parallel()) {
     // The ghosts carry their owner's velocities at the force time, so those come first.
     set_cutoff_and_mass();
@@ -165,12 +167,16 @@ double DemSystem::spring_energy_j() const {
   for (std::size_t i = 0; i < s_.size(); ++i)
     for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
       const double ov = pair_overlap(i, nl_.neighbors[p]);
-      if (ov > 0.0) e += 0.5 * kn * ov * ov + 0.5 * kt * (h_[3 * p] * h_[3 * p] + h_[3 * p + 1] * h_[3 * p + 1] + h_[3 * p + 2] * h_[3 * p + 2]);
+      if (ov > 0.0)
+        e += 0.5 * kn * ov * ov +
+             0.5 * kt *
+                 (h_[3 * p] * h_[3 * p] + h_[3 * p + 1] * h_[3 * p + 1] + h_[3 * p + 2] * h_[3 * p + 2]);
     }
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
     const PlaneWall& W = cfg_.walls[w];
     for (std::size_t i = 0; i < s_.n_local; ++i) {
-      const double ov = s_.radius[i] - ((s_.x[i] - W.px) * W.nx + (s_.y[i] - W.py) * W.ny + (s_.z[i] - W.pz) * W.nz);
+      const double ov =
+          s_.radius[i] - ((s_.x[i] - W.px) * W.nx + (s_.y[i] - W.py) * W.ny + (s_.z[i] - W.pz) * W.nz);
       if (ov > 0.0)
         e += 0.5 * kn * ov * ov +
              0.5 * kt * (whx_[w][i] * whx_[w][i] + why_[w][i] * why_[w][i] + whz_[w][i] * whz_[w][i]);

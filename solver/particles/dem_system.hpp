@@ -40,7 +40,7 @@ struct DemConfig {
 /// the number of ranks that wrote it.
 struct DemState {
   ParticleStore store;
-  std::vector<double> ref_x, ref_y, ref_z;  ///< positions at the last neighbour-list build
+  std::vector<double> ref_x, ref_y, ref_z;         ///< positions at the last neighbour-list build
   std::vector<std::int64_t> pair_id_a, pair_id_b;  ///< contact histories, id_a < id_b
   std::vector<double> pair_hx, pair_hy, pair_hz;   ///< shear displacement seen from id_a, m
   std::vector<double> wall_h;  ///< per wall, per particle (storage order), 3 components, m
@@ -70,9 +70,10 @@ class DemSystem {
 
   /// Shares the particles among the ranks of `d`: each rank keeps those whose centre lies in its
   /// slab. Every rank must hold the same particles when it is called (after insertion; when the
-  /// system already stepped on every rank alike, initialize() again after it). From then on the particles of the other ranks within the neighbour cutoff of
-  /// this rank's slab are held as ghost copies after the local ones, and particles that leave
-  /// the slab move to their new rank at each neighbour-list rebuild, with their histories.
+  /// system already stepped on every rank alike, initialize() again after it). From then on the particles of
+  /// the other ranks within the neighbour cutoff of this rank's slab are held as ghost copies after the local
+  /// ones, and particles that leave the slab move to their new rank at each neighbour-list rebuild, with
+  /// their histories.
   void decompose(const SlabDecomposition& d);
   const SlabDecomposition& decomposition() const { return dd_; }
 

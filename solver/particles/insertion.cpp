@@ -44,9 +44,10 @@ void DemSystem::insert_random(std::int64_t count, double r, double rho, std::arr
   std::int64_t placed = 0, attempts = 0;
   while (placed < count) {
     if (++attempts > max_attempts)
-      throw InputError(fmt::format("could not insert {} particles of radius {} m without overlap after {} attempts "
-                                   "({} placed): the region is too full",
-                                   count, r, max_attempts, placed));
+      throw InputError(
+          fmt::format("could not insert {} particles of radius {} m without overlap after {} attempts "
+                      "({} placed): the region is too full",
+                      count, r, max_attempts, placed));
     const double p[3] = {U[0](rng), U[1](rng), U[2](rng)};
     bool ok = true;
     for (const auto& w : cfg_.walls) {

@@ -16,12 +16,12 @@ namespace {
 /// impulse in J; Wet: read the fluid arrays (F_ext, u_f, m_add), which a dry kick leaves out.
 template <bool Predict, bool Track, bool Wet>
 void kick_loop(std::size_t n, double h, double gx, double gy, double gz, const double* __restrict m,
-                   const double* __restrict ma, const double* __restrict b, const double* __restrict fx,
-                   const double* __restrict fy, const double* __restrict fz, const double* __restrict ex,
-                   const double* __restrict ey, const double* __restrict ez, const double* __restrict ux,
-                   const double* __restrict uy, const double* __restrict uz, double* __restrict vx, double* __restrict vy,
-                   double* __restrict vz, double* __restrict Jx, double* __restrict Jy, double* __restrict Jz,
-                   double* __restrict px, double* __restrict py, double* __restrict pz) {
+               const double* __restrict ma, const double* __restrict b, const double* __restrict fx,
+               const double* __restrict fy, const double* __restrict fz, const double* __restrict ex,
+               const double* __restrict ey, const double* __restrict ez, const double* __restrict ux,
+               const double* __restrict uy, const double* __restrict uz, double* __restrict vx,
+               double* __restrict vy, double* __restrict vz, double* __restrict Jx, double* __restrict Jy,
+               double* __restrict Jz, double* __restrict px, double* __restrict py, double* __restrict pz) {
   for (std::size_t i = 0; i < n; ++i) {
     // Dry (!Wet): F_ext, u_f and m_add are zero and not read (DemConfig::dry).
     const double M = Wet ? m[i] + ma[i] : m[i], bi = b[i], inv_D = 1.0 / (M + h * bi);
@@ -62,8 +62,9 @@ void kick_loop(std::size_t n, double h, double gx, double gy, double gz, const d
 /// Spin half kick, w += h T / I, with the prediction as above.
 template <bool Predict>
 void kick_spin(std::size_t n, double h, const double* __restrict I, const double* __restrict tx,
-               const double* __restrict ty, const double* __restrict tz, double* __restrict wx, double* __restrict wy,
-               double* __restrict wz, double* __restrict px, double* __restrict py, double* __restrict pz) {
+               const double* __restrict ty, const double* __restrict tz, double* __restrict wx,
+               double* __restrict wy, double* __restrict wz, double* __restrict px, double* __restrict py,
+               double* __restrict pz) {
   for (std::size_t i = 0; i < n; ++i) {
     const double h_I = h / I[i];
     const double w0x = wx[i], w0y = wy[i], w0z = wz[i];
@@ -80,19 +81,20 @@ void kick_spin(std::size_t n, double h, const double* __restrict I, const double
 }
 
 template <bool Predict, bool Track, bool Wet>
-void kick_all(std::size_t n, double h, const std::array<double, 3>& g, ParticleStore& s, std::vector<double>* pred) {
+void kick_all(std::size_t n, double h, const std::array<double, 3>& g, ParticleStore& s,
+              std::vector<double>* pred) {
   double* p[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
   if constexpr (Predict)
     for (int c = 0; c < 6; ++c) p[c] = pred[c].data();
-  kick_loop<Predict, Track, Wet>(n, h, g[0], g[1], g[2], s.mass.data(), s.madd.data(), s.beta.data(), s.fx.data(),
-                                s.fy.data(), s.fz.data(), s.ext_x.data(), s.ext_y.data(), s.ext_z.data(), s.ufx.data(),
-                                s.ufy.data(), s.ufz.data(), s.vx.data(), s.vy.data(), s.vz.data(), s.drag_jx.data(),
-                                s.drag_jy.data(), s.drag_jz.data(), p[0], p[1], p[2]);
+  kick_loop<Predict, Track, Wet>(n, h, g[0], g[1], g[2], s.mass.data(), s.madd.data(), s.beta.data(),
+                                 s.fx.data(), s.fy.data(), s.fz.data(), s.ext_x.data(), s.ext_y.data(),
+                                 s.ext_z.data(), s.ufx.data(), s.ufy.data(), s.ufz.data(), s.vx.data(),
+                                 s.vy.data(), s.vz.data(), s.drag_jx.data(), s.drag_jy.data(),
+                                 s.drag_jz.data(), p[0], p[1], p[2]);
   kick_spin<Predict>(n, h, s.inertia.data(), s.tx.data(), s.ty.data(), s.tz.data(), s.wx.data(), s.wy.data(),
                      s.wz.data(), p[3], p[4], p[5]);
 }
 }  // namespace
-
 
 void DemSystem::kick(double h, bool predict) {
   // Half kick of velocity Verlet with the drag implicit (backward Euler over the half step):
@@ -108,12 +110,18 @@ void DemSystem::kick(double h, bool predict) {
   // Dry only without drag tracking (tracking is for the coupling, which has fluid).
   const bool wet = !cfg_.dry || track;
   auto& g = cfg_.gravity_m_s2;
-  if (predict && track) kick_all<true, true, true>(n, h, g, s_, pred_);
-  else if (track) kick_all<false, true, true>(n, h, g, s_, pred_);
-  else if (predict && wet) kick_all<true, false, true>(n, h, g, s_, pred_);
-  else if (wet) kick_all<false, false, true>(n, h, g, s_, pred_);
-  else if (predict) kick_all<true, false, false>(n, h, g, s_, pred_);
-  else kick_all<false, false, false>(n, h, g, s_, pred_);
+  if (predict && track)
+    kick_all<true, true, true>(n, h, g, s_, pred_);
+  else if (track)
+    kick_all<false, true, true>(n, h, g, s_, pred_);
+  else if (predict && wet)
+    kick_all<true, false, true>(n, h, g, s_, pred_);
+  else if (wet)
+    kick_all<false, false, true>(n, h, g, s_, pred_);
+  else if (predict)
+    kick_all<true, false, false>(n, h, g, s_, pred_);
+  else
+    kick_all<false, false, false>(n, h, g, s_, pred_);
   if (predict) {
     // Ghost copies are not integrated here: they see the velocities their owner sent.
     const std::vector<double>* cur[6] = {&s_.vx, &s_.vy, &s_.vz, &s_.wx, &s_.wy, &s_.wz};

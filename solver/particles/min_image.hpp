@@ -11,6 +11,8 @@ namespace boycott::particles {
 /// data-dependent branch, so the pair loops vectorise (round is one instruction, roundsd, on
 /// every x86-64 machine with SSE4.1, which -march=native selects), and it holds for any |d|,
 /// not only for |d| < 1.5 L.
-inline double min_image(double d, double L, double inv_L) { return d - L * std::nearbyint(d * inv_L); }
+inline double min_image(double d, double L, double inv_L) {
+  return d - L * std::nearbyint(d * inv_L);
+}
 
 }  // namespace boycott::particles

@@ -22,8 +22,9 @@ int cell_coord(double p, double lo, double len, int n, bool periodic) {
 void NeighborList::bin(const ParticleStore& s, const BoxGeometry& g, double cutoff) {
   for (int d = 0; d < 3; ++d) {
     if (g.periodic[d] && g.len[d] < 2.0 * cutoff)
-      throw std::invalid_argument(fmt::format(
-          "periodic length {} m in direction {} is below twice the neighbour cutoff {} m", g.len[d], d, cutoff));
+      throw std::invalid_argument(
+          fmt::format("periodic length {} m in direction {} is below twice the neighbour cutoff {} m",
+                      g.len[d], d, cutoff));
     nc_[d] = std::max(1, static_cast<int>(std::floor(g.len[d] / cutoff)));
   }
   const std::size_t n = s.size();
@@ -43,7 +44,8 @@ void NeighborList::bin(const ParticleStore& s, const BoxGeometry& g, double cuto
   for (std::size_t i = 0; i < n; ++i) cell_items_[fill[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
 }
 
-std::vector<std::size_t> NeighborList::bin_and_order(const ParticleStore& s, const BoxGeometry& g, double cutoff) {
+std::vector<std::size_t> NeighborList::bin_and_order(const ParticleStore& s, const BoxGeometry& g,
+                                                     double cutoff) {
   bin(s, g, cutoff);
   std::vector<std::size_t> order(cell_items_.begin(), cell_items_.end());
   // The bins as they will be once the particles are stored in this order.
@@ -61,16 +63,20 @@ void NeighborList::build(const ParticleStore& s, const BoxGeometry& g, double cu
   build_binned(s, g, cutoff, rows);
 }
 
-void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, double cutoff, std::size_t rows) {
+void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, double cutoff,
+                                std::size_t rows) {
   const std::size_t n = s.size();
   rows = std::min(rows, n);
   const double cut2 = cutoff * cutoff;
   // Neighbour cell offsets per direction, deduplicated where a periodic direction has < 3 cells.
   std::array<std::vector<int>, 3> offs;
   for (int d = 0; d < 3; ++d) {
-    if (nc_[d] == 1) offs[d] = {0};
-    else if (nc_[d] == 2) offs[d] = g.periodic[d] ? std::vector<int>{0, 1} : std::vector<int>{-1, 0, 1};
-    else offs[d] = {-1, 0, 1};
+    if (nc_[d] == 1)
+      offs[d] = {0};
+    else if (nc_[d] == 2)
+      offs[d] = g.periodic[d] ? std::vector<int>{0, 1} : std::vector<int>{-1, 0, 1};
+    else
+      offs[d] = {-1, 0, 1};
   }
   offsets.assign(n + 1, 0);
   neighbors.clear();
@@ -88,16 +94,22 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
     const int cx = c % nc_[0], cy = (c / nc_[0]) % nc_[1], cz = c / (nc_[0] * nc_[1]);
     for (int oz : offs[2]) {
       int kz = cz + oz;
-      if (g.periodic[2]) kz = (kz + nc_[2]) % nc_[2];
-      else if (kz < 0 || kz >= nc_[2]) continue;
+      if (g.periodic[2])
+        kz = (kz + nc_[2]) % nc_[2];
+      else if (kz < 0 || kz >= nc_[2])
+        continue;
       for (int oy : offs[1]) {
         int ky = cy + oy;
-        if (g.periodic[1]) ky = (ky + nc_[1]) % nc_[1];
-        else if (ky < 0 || ky >= nc_[1]) continue;
+        if (g.periodic[1])
+          ky = (ky + nc_[1]) % nc_[1];
+        else if (ky < 0 || ky >= nc_[1])
+          continue;
         for (int ox : offs[0]) {
           int kx = cx + ox;
-          if (g.periodic[0]) kx = (kx + nc_[0]) % nc_[0];
-          else if (kx < 0 || kx >= nc_[0]) continue;
+          if (g.periodic[0])
+            kx = (kx + nc_[0]) % nc_[0];
+          else if (kx < 0 || kx >= nc_[0])
+            continue;
           const int nb = kx + nc_[0] * (ky + nc_[1] * kz);
           std::uint32_t q0 = cell_start_[nb];
           if (by_cell) {

@@ -30,7 +30,8 @@ class NeighborList {
   /// cache locality. After the caller permutes the particles by it, build_binned() builds the
   /// list without binning again.
   std::vector<std::size_t> bin_and_order(const ParticleStore& s, const BoxGeometry& g, double cutoff_m);
-  void build_binned(const ParticleStore& s, const BoxGeometry& g, double cutoff_m, std::size_t rows = kAllRows);
+  void build_binned(const ParticleStore& s, const BoxGeometry& g, double cutoff_m,
+                    std::size_t rows = kAllRows);
   static constexpr std::size_t kAllRows = static_cast<std::size_t>(-1);
 
   std::size_t pair_count() const { return neighbors.size(); }

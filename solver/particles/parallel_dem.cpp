@@ -24,7 +24,8 @@ namespace {
 
 /// Sends buffer out[r] to rank r and returns what arrives, sources in rank order; counts[r]: the
 /// number of values that came from rank r.
-std::vector<double> exchange(MPI_Comm comm, const std::vector<std::vector<double>>& out, std::vector<int>& counts) {
+std::vector<double> exchange(MPI_Comm comm, const std::vector<std::vector<double>>& out,
+                             std::vector<int>& counts) {
   int size = 1;
   MPI_Comm_size(comm, &size);
   std::vector<int> sc(size), sd(size), rd(size);
@@ -45,8 +46,8 @@ std::vector<double> exchange(MPI_Comm comm, const std::vector<std::vector<double
   send.reserve(total_out);
   for (const auto& b : out) send.insert(send.end(), b.begin(), b.end());
   std::vector<double> recv(total_in);
-  MPI_Alltoallv(send.data(), sc.data(), sd.data(), MPI_DOUBLE, recv.data(), counts.data(), rd.data(), MPI_DOUBLE,
-                comm);
+  MPI_Alltoallv(send.data(), sc.data(), sd.data(), MPI_DOUBLE, recv.data(), counts.data(), rd.data(),
+                MPI_DOUBLE, comm);
   return recv;
 }
 
@@ -188,9 +189,10 @@ void DemSystem::migrate() {
   for (std::size_t q = 0; q < carry_a_.size(); ++q) {
     const int da = dest_of(carry_a_[q]), db = dest_of(carry_b_[q]);
     const auto send_to = [&](int r) {
-      out_pairs[static_cast<std::size_t>(r)].insert(out_pairs[static_cast<std::size_t>(r)].end(),
-                                                    {static_cast<double>(carry_a_[q]), static_cast<double>(carry_b_[q]),
-                                                     carry_h_[3 * q], carry_h_[3 * q + 1], carry_h_[3 * q + 2]});
+      out_pairs[static_cast<std::size_t>(r)].insert(
+          out_pairs[static_cast<std::size_t>(r)].end(),
+          {static_cast<double>(carry_a_[q]), static_cast<double>(carry_b_[q]), carry_h_[3 * q],
+           carry_h_[3 * q + 1], carry_h_[3 * q + 2]});
     };
     if (da >= 0) send_to(da);
     if (db >= 0 && db != da) send_to(db);
@@ -235,8 +237,8 @@ void DemSystem::exchange_ghosts() {
       if (!(dd_.distance_to_slab(s_.z[i], static_cast<int>(r)) < cutoff_m_)) continue;
       list.push_back(static_cast<std::uint32_t>(i));
       b.insert(b.end(), {static_cast<double>(s_.id[i]), s_.x[i], s_.y[i], s_.z[i], s_.radius[i], s_.mass[i],
-                         s_.inertia[i], pred_[0][i], pred_[1][i], pred_[2][i], pred_[3][i], pred_[4][i], pred_[5][i],
-                         s_.wx[i], s_.wy[i], s_.wz[i]});
+                         s_.inertia[i], pred_[0][i], pred_[1][i], pred_[2][i], pred_[3][i], pred_[4][i],
+                         pred_[5][i], s_.wx[i], s_.wy[i], s_.wz[i]});
     }
   }
   std::vector<int> counts;
@@ -263,8 +265,8 @@ void DemSystem::forward_ghosts() {
     auto& b = out[r];
     b.reserve(kGhostUpdate * ghost_send_[r].size());
     for (std::uint32_t i : ghost_send_[r])
-      b.insert(b.end(), {s_.x[i], s_.y[i], s_.z[i], pred_[0][i], pred_[1][i], pred_[2][i], pred_[3][i], pred_[4][i],
-                         pred_[5][i], s_.wx[i], s_.wy[i], s_.wz[i]});
+      b.insert(b.end(), {s_.x[i], s_.y[i], s_.z[i], pred_[0][i], pred_[1][i], pred_[2][i], pred_[3][i],
+                         pred_[4][i], pred_[5][i], s_.wx[i], s_.wy[i], s_.wz[i]});
   }
   std::vector<int> counts;
   const std::vector<double> in = exchange(dd_.comm, out, counts);

@@ -12,11 +12,11 @@ struct ParticleStore {
   std::size_t n_local = 0;
 
   std::vector<std::int64_t> id;
-  std::vector<double> x, y, z;     ///< position, m
-  std::vector<double> vx, vy, vz;  ///< velocity, m/s
-  std::vector<double> wx, wy, wz;  ///< angular velocity, rad/s
-  std::vector<double> fx, fy, fz;  ///< contact force, N (recomputed every step)
-  std::vector<double> tx, ty, tz;  ///< contact torque, N m
+  std::vector<double> x, y, z;                ///< position, m
+  std::vector<double> vx, vy, vz;             ///< velocity, m/s
+  std::vector<double> wx, wy, wz;             ///< angular velocity, rad/s
+  std::vector<double> fx, fy, fz;             ///< contact force, N (recomputed every step)
+  std::vector<double> tx, ty, tz;             ///< contact torque, N m
   std::vector<double> radius, mass, inertia;  ///< m, kg, kg m^2 (solid sphere: 2/5 m r^2)
 
   // Coupling hook: (m + m_add) dv/dt = F_contact + F_ext + m g + beta (u_f - v), drag implicit.
@@ -50,9 +50,11 @@ struct ParticleStore {
 
   template <class F>
   void for_each_array(F&& f) {
-    for (auto* a : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &mass,
-                    &inertia, &ext_x, &ext_y, &ext_z, &beta, &ufx, &ufy, &ufz, &madd, &drag_jx, &drag_jy, &drag_jz,
-                    &v0x, &v0y, &v0z, &react_x, &react_y, &react_z, &fpv_x, &fpv_y, &fpv_z})
+    for (auto* a :
+         {&x,     &y,    &z,       &vx,      &vy,      &vz,     &wx,      &wy,      &wz,      &fx,
+          &fy,    &fz,   &tx,      &ty,      &tz,      &radius, &mass,    &inertia, &ext_x,   &ext_y,
+          &ext_z, &beta, &ufx,     &ufy,     &ufz,     &madd,   &drag_jx, &drag_jy, &drag_jz, &v0x,
+          &v0y,   &v0z,  &react_x, &react_y, &react_z, &fpv_x,  &fpv_y,   &fpv_z})
       f(*a);
   }
 };

@@ -49,7 +49,9 @@ double SlabDecomposition::distance_to_slab(double z, int r) const {
   return best;
 }
 
-double ordered_sum(MPI_Comm comm, double local) { return ordered_sum(comm, std::vector<double>{local})[0]; }
+double ordered_sum(MPI_Comm comm, double local) {
+  return ordered_sum(comm, std::vector<double>{local})[0];
+}
 
 std::vector<double> ordered_sum(MPI_Comm comm, const std::vector<double>& local) {
   int size = 1;

@@ -60,7 +60,8 @@ int run_channel_flow(const CaseParams& p, RunContext& ctx) {
   const auto settings = fluid::FluidSettings::from_case(p);
   timers.activate("fluid", "staggered FV, QUICK, BDF2, " + settings.coupling_name());
   if (settings.vreman) timers.activate("subgrid_viscosity", "vreman");
-  if (std::isfinite(settings.target_mean_flux_z_m_s)) timers.activate("flux_controller", "mean pressure gradient z");
+  if (std::isfinite(settings.target_mean_flux_z_m_s))
+    timers.activate("flux_controller", "mean pressure gradient z");
 
   int rank = 0;
   MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
@@ -71,8 +72,9 @@ int run_channel_flow(const CaseParams& p, RunContext& ctx) {
   if (io)
     csv = std::make_unique<CsvWriter>(
         ctx.out_dir / "timeseries.csv",
-        std::vector<std::string>{"time_s", "dt_s", "mean_velocity_x_m_s", "mean_velocity_y_m_s", "mean_velocity_z_m_s",
-                                 "centerline_velocity_m_s", "mean_pressure_gradient_pa_m", "simple_iterations",
+        std::vector<std::string>{"time_s", "dt_s", "mean_velocity_x_m_s", "mean_velocity_y_m_s",
+                                 "mean_velocity_z_m_s", "centerline_velocity_m_s",
+                                 "mean_pressure_gradient_pa_m", "simple_iterations",
                                  "pressure_krylov_iterations", "continuity_residual"},
         false);
 
@@ -96,11 +98,18 @@ int run_channel_flow(const CaseParams& p, RunContext& ctx) {
     if (!rep.converged) ++unconverged;
     if (solver.time_s() >= next_row - 1e-12 || solver.time_s() >= end * (1.0 - 1e-12)) {
       const auto w = solver.profile_y(2);
-      const double wc = p.domain.periodic_y ? solver.mean_velocity(2) : centreline(w, p.domain.width_y_m, settings.top_slip);
+      const double wc = p.domain.periodic_y ? solver.mean_velocity(2)
+                                            : centreline(w, p.domain.width_y_m, settings.top_slip);
       // mean_velocity() is collective: every rank evaluates the row, rank 0 writes it.
-      const std::vector<double> row = {solver.time_s(), dt, solver.mean_velocity(0), solver.mean_velocity(1),
-                                       solver.mean_velocity(2), wc, rep.mean_pressure_gradient_pa_m,
-                                       (double)rep.simple_iterations, (double)rep.pressure_krylov_iterations,
+      const std::vector<double> row = {solver.time_s(),
+                                       dt,
+                                       solver.mean_velocity(0),
+                                       solver.mean_velocity(1),
+                                       solver.mean_velocity(2),
+                                       wc,
+                                       rep.mean_pressure_gradient_pa_m,
+                                       (double)rep.simple_iterations,
+                                       (double)rep.pressure_krylov_iterations,
                                        rep.continuity_residual};
       if (csv) csv->row(row);
       next_row = solver.time_s() + every;
@@ -118,8 +127,9 @@ int run_channel_flow(const CaseParams& p, RunContext& ctx) {
   j["mean_velocity_m_s"] = solver.mean_velocity(2);
   j["mean_velocity_vector_m_s"] = {solver.mean_velocity(0), solver.mean_velocity(1), solver.mean_velocity(2)};
   j["mean_flux_z_m_s"] = solver.mean_flux_z();
-  j["centerline_velocity_m_s"] = p.domain.periodic_y ? nlohmann::json(nullptr)
-                                                      : nlohmann::json(centreline(w, p.domain.width_y_m, settings.top_slip));
+  j["centerline_velocity_m_s"] = p.domain.periodic_y
+                                     ? nlohmann::json(nullptr)
+                                     : nlohmann::json(centreline(w, p.domain.width_y_m, settings.top_slip));
   j["mean_pressure_gradient_pa_m"] = solver.mean_pressure_gradient_pa_m();
   j["cfd_steps"] = solver.steps_done();
   j["unconverged_steps"] = unconverged;
@@ -131,16 +141,18 @@ int run_channel_flow(const CaseParams& p, RunContext& ctx) {
     ref = std::max(ref, std::abs(exact(settings.top_slip ? p.domain.width_y_m : 0.5 * p.domain.width_y_m)));
     for (int jy = 0; jy < ny; ++jy) emax = std::max(emax, std::abs(w[jy] - exact((jy + 0.5) * h)));
     j["max_rel_error_vs_analytic"] = ref > 0.0 ? nlohmann::json(emax / ref) : nlohmann::json(nullptr);
-    j["analytic_centerline_velocity_m_s"] = exact(settings.top_slip ? p.domain.width_y_m : 0.5 * p.domain.width_y_m);
+    j["analytic_centerline_velocity_m_s"] =
+        exact(settings.top_slip ? p.domain.width_y_m : 0.5 * p.domain.width_y_m);
   } else {
     j["max_rel_error_vs_analytic"] = nullptr;
   }
   if (io) write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   if (!ctx.quiet && io)
-    std::printf("channel_flow: t = %.4g s, %d steps, mean w %.6g m/s, centreline %.6g m/s, error vs analytic %s\n",
-                solver.time_s(), solver.steps_done(), j["mean_velocity_m_s"].get<double>(),
-                j["centerline_velocity_m_s"].is_null() ? 0.0 : j["centerline_velocity_m_s"].get<double>(),
-                j["max_rel_error_vs_analytic"].dump().c_str());
+    std::printf(
+        "channel_flow: t = %.4g s, %d steps, mean w %.6g m/s, centreline %.6g m/s, error vs analytic %s\n",
+        solver.time_s(), solver.steps_done(), j["mean_velocity_m_s"].get<double>(),
+        j["centerline_velocity_m_s"].is_null() ? 0.0 : j["centerline_velocity_m_s"].get<double>(),
+        j["max_rel_error_vs_analytic"].dump().c_str());
   return interrupted ? kExitInterrupted : kExitOk;
 }
 

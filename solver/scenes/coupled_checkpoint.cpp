@@ -35,7 +35,8 @@ fluid::FluidState gather_fluid(const fluid::FluidSolver& f) {
     int total = 0;
     for (int r = 0; r < size; ++r) displs[r] = total, total += counts[r];
     std::vector<double> all(rank == 0 ? static_cast<std::size_t>(total) : 0);
-    MPI_Gatherv(field.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, f.comm());
+    MPI_Gatherv(field.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0,
+                f.comm());
     field.swap(all);
   }
   st.box.lo = {0, 0, 0};
@@ -44,7 +45,8 @@ fluid::FluidState gather_fluid(const fluid::FluidSolver& f) {
 }
 
 /// This rank's planes of a whole-grid fluid state.
-fluid::FluidState own_part(const fluid::FluidState& whole, const fluid::FluidSolver& f, const std::string& file) {
+fluid::FluidState own_part(const fluid::FluidState& whole, const fluid::FluidSolver& f,
+                           const std::string& file) {
   const auto box = f.owned_box();
   const auto& g = f.settings().grid;
   if (whole.box.lo != box.lo || whole.box.size != box.size) {
@@ -59,8 +61,10 @@ fluid::FluidState own_part(const fluid::FluidState& whole, const fluid::FluidSol
   st.box = box;
   const std::size_t plane = static_cast<std::size_t>(g.n[0] * g.n[1]);
   for (auto& field : st.fields) {
-    const auto first = field.begin() + static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(box.lo[2]));
-    field = std::vector<double>(first, first + static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(box.size[2])));
+    const auto first =
+        field.begin() + static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(box.lo[2]));
+    field = std::vector<double>(
+        first, first + static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(box.size[2])));
   }
   return st;
 }
@@ -90,7 +94,8 @@ void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run) {
   c.dt_prev_s = r.scalar("run.dt_prev_s");
   c.steps = r.integer("run.steps");
   // absent from checkpoints written before these counters existed
-  c.unconverged_fluid_steps = r.has("run.unconverged_fluid_steps") ? r.integer("run.unconverged_fluid_steps") : 0;
+  c.unconverged_fluid_steps =
+      r.has("run.unconverged_fluid_steps") ? r.integer("run.unconverged_fluid_steps") : 0;
   c.pressure_fallbacks = r.has("run.pressure_fallbacks") ? r.integer("run.pressure_fallbacks") : 0;
   run.restore_counters(c);
   run.decompose();
@@ -103,7 +108,8 @@ void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run) {
   run.coupler().import_state(io::load_arrays(r, "coupler."), run.dem());
 }
 
-std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::filesystem::path& run_dir, bool quiet,
+std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::filesystem::path& run_dir,
+                                     bool quiet,
                                      const std::function<void(const io::CheckpointReader&)>& load_scene) {
   const auto ck = io::latest_checkpoint(run_dir);
   if (!ck) return std::nullopt;
@@ -115,12 +121,13 @@ std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::fi
   load_coupled(r, run);
   load_scene(r);
   truncate_csv_after(run_dir / "timeseries.csv", run.time_s());
-  if (!quiet && output_rank()) std::fprintf(stderr, "resuming from %s at t = %g s\n", ck->c_str(), run.time_s());
+  if (!quiet && output_rank())
+    std::fprintf(stderr, "resuming from %s at t = %g s\n", ck->c_str(), run.time_s());
   return r.scalar("run.wall_time_s");
 }
 
-void checkpoint_coupled(const coupling::CoupledSystem& run, const std::filesystem::path& run_dir, double wall_time_s,
-                        const std::function<void(io::CheckpointWriter&)>& save_scene) {
+void checkpoint_coupled(const coupling::CoupledSystem& run, const std::filesystem::path& run_dir,
+                        double wall_time_s, const std::function<void(io::CheckpointWriter&)>& save_scene) {
   // One file for all ranks, written by rank 0 from the gathered state.
   std::optional<io::CheckpointWriter> w;
   if (output_rank()) {

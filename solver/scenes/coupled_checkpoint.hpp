@@ -21,12 +21,13 @@ void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run);
 /// (CheckpointError, the file left in place), loads this run's state, lets the scene load its
 /// own running sums, and cuts the time series back to the checkpoint's time. Returns the wall
 /// time the run had already spent (s), or nothing when there is no checkpoint to resume.
-std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::filesystem::path& run_dir, bool quiet,
+std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::filesystem::path& run_dir,
+                                     bool quiet,
                                      const std::function<void(const io::CheckpointReader&)>& load_scene);
 /// Writes a checkpoint of this run and the scene's running sums (atomically; the newest
 /// output.keep_checkpoints are kept), recording the wall time spent so far (s). Collective;
 /// save_scene runs on rank 0 only, so a scene reduces its per-rank sums before.
-void checkpoint_coupled(const coupling::CoupledSystem& run, const std::filesystem::path& run_dir, double wall_time_s,
-                        const std::function<void(io::CheckpointWriter&)>& save_scene);
+void checkpoint_coupled(const coupling::CoupledSystem& run, const std::filesystem::path& run_dir,
+                        double wall_time_s, const std::function<void(io::CheckpointWriter&)>& save_scene);
 
 }  // namespace boycott::scenes

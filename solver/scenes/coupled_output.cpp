@@ -87,8 +87,9 @@ io::SnapshotData coupled_snapshot(const coupling::CoupledSystem& run) {
   return d;
 }
 
-CoupledSceneOutput::CoupledSceneOutput(const coupling::CoupledSystem& run, const RunContext& ctx, ModelTimers& timers,
-                                       std::vector<std::string> columns, bool resumed, double next_out_s)
+CoupledSceneOutput::CoupledSceneOutput(const coupling::CoupledSystem& run, const RunContext& ctx,
+                                       ModelTimers& timers, std::vector<std::string> columns, bool resumed,
+                                       double next_out_s)
     : run_(run),
       ctx_(ctx),
       timers_(timers),
@@ -101,15 +102,18 @@ CoupledSceneOutput::CoupledSceneOutput(const coupling::CoupledSystem& run, const
   out_every_s_ = is_set(p.output.timeseries_every_s) ? p.output.timeseries_every_s : 0.0;
   timers.activate("checkpoints", fmt::format("HDF5 every {} s, newest {} kept", p.time.checkpoint_every_s,
                                              p.output.keep_checkpoints));
-  if (snapshots_.size()) timers.activate("snapshots", fmt::format("HDF5 + XDMF at {} times", snapshots_.size()));
-  if (images_.size()) timers.activate("images", fmt::format("PNG of the x-z plane at {} times", images_.size()));
+  if (snapshots_.size())
+    timers.activate("snapshots", fmt::format("HDF5 + XDMF at {} times", snapshots_.size()));
+  if (images_.size())
+    timers.activate("images", fmt::format("PNG of the x-z plane at {} times", images_.size()));
 }
 
 void CoupledSceneOutput::write_pictures(double t) {
   snapshots_.reached(t, [&](std::size_t index, double) {
     ModelTimers::Scope sc(timers_, "snapshots");
     const auto d = coupled_snapshot(run_);  // collective
-    if (output_rank()) io::write_snapshot(ctx_.out_dir, static_cast<int>(index), d, run_.fluid().settings().grid);
+    if (output_rank())
+      io::write_snapshot(ctx_.out_dir, static_cast<int>(index), d, run_.fluid().settings().grid);
   });
   images_.reached(t, [&](std::size_t, double time) {
     ModelTimers::Scope sc(timers_, "images");
@@ -117,7 +121,8 @@ void CoupledSceneOutput::write_pictures(double t) {
     const auto& s = run_.dem().particles();
     const auto parts = gather_particles(run_, {&s.x, &s.y, &s.z, &s.radius});
     if (!output_rank()) return;
-    const io::ParticleView view{&parts[0], &parts[1], &parts[2], &parts[3], parts[0].size(), p.domain.length_x_m,
+    const io::ParticleView view{&parts[0],          &parts[1],          &parts[2],
+                                &parts[3],          parts[0].size(),    p.domain.length_x_m,
                                 p.domain.width_y_m, p.domain.height_z_m};
     io::write_particle_png(ctx_.out_dir / fmt::format("particles_t{:.3f}.png", time), view);
   });

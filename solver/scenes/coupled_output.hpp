@@ -43,7 +43,8 @@ class CoupledSceneOutput {
       if (ctx_.progress) ctx_.progress(t);
     }
     write_pictures(t);
-    return checkpoint_or_stop(ctx_.should_stop(), ctx_.quiet, checkpoints_, t, end, csv_, write_checkpoint, summary);
+    return checkpoint_or_stop(ctx_.should_stop(), ctx_.quiet, checkpoints_, t, end, csv_, write_checkpoint,
+                              summary);
   }
   /// When the next time-series row is due (s): part of a scene's checkpoint.
   double next_out_s() const { return next_out_s_; }

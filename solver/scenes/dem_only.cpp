@@ -16,13 +16,13 @@
 
 namespace boycott::scenes {
 
-
 int run_dem_only(const CaseParams& p, RunContext& ctx) {
   WallClock clock;
   if (p.forces.drag != "stokes" && p.forces.drag != "none")
-    throw InputError(fmt::format("forces.drag = \"{}\": the dem_only scene has no fluid; use \"stokes\" (drag "
-                                 "against still fluid) or \"none\"",
-                                 p.forces.drag));
+    throw InputError(
+        fmt::format("forces.drag = \"{}\": the dem_only scene has no fluid; use \"stokes\" (drag "
+                    "against still fluid) or \"none\"",
+                    p.forces.drag));
   ModelTimers timers;
   auto dc = particles::DemConfig::from_case(p);
   dc.dry = true;  // no fluid arrays in the kicks; Stokes drag is the beta toward rest
@@ -36,19 +36,22 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
   }
   dem.initialize();
 
-  timers.activate("dem_contacts", fmt::format("{}, k_n = {} N/m, e = {}, mu = {}{}", p.contact.model,
-                                              p.contact.stiffness_n_m, p.contact.restitution, p.contact.friction,
-                                              p.contact.clip_attractive_normal ? ", normal force clipped" : ""));
+  timers.activate("dem_contacts",
+                  fmt::format("{}, k_n = {} N/m, e = {}, mu = {}{}", p.contact.model, p.contact.stiffness_n_m,
+                              p.contact.restitution, p.contact.friction,
+                              p.contact.clip_attractive_normal ? ", normal force clipped" : ""));
   if (p.contact.rolling_model != "none" && p.contact.rolling_friction > 0.0)
-    timers.activate("rolling_friction", fmt::format("{}, mu_r = {} (timed with dem_contacts)", p.contact.rolling_model,
-                                                    p.contact.rolling_friction));
-  timers.activate("neighbor_search", fmt::format("linked cells + Verlet skin {} m", p.numerics.neighbor_skin_m));
+    timers.activate("rolling_friction", fmt::format("{}, mu_r = {} (timed with dem_contacts)",
+                                                    p.contact.rolling_model, p.contact.rolling_friction));
+  timers.activate("neighbor_search",
+                  fmt::format("linked cells + Verlet skin {} m", p.numerics.neighbor_skin_m));
   timers.activate("integration", "velocity Verlet");
   if (stokes) timers.activate("stokes_drag", "implicit in the velocity update (timed with integration)");
 
   const double dt = p.time.dt_dem_s;
   const auto nsteps = static_cast<std::int64_t>(std::llround(p.time.end_s / dt));
-  const double out_every = is_set(p.output.timeseries_every_s) ? p.output.timeseries_every_s : p.time.dt_cfd_s;
+  const double out_every =
+      is_set(p.output.timeseries_every_s) ? p.output.timeseries_every_s : p.time.dt_cfd_s;
   const auto out_stride = std::max<std::int64_t>(1, std::llround(out_every / dt));
   const auto avg_from_step = static_cast<std::int64_t>(std::llround(p.time.average_from_s / dt));
   CsvWriter csv(ctx.out_dir / "timeseries.csv",
@@ -70,16 +73,18 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
     if (n % out_stride == 0 || n == nsteps) {
       const double ke = dem.kinetic_energy_j();
       if (!std::isfinite(ke))
-        throw PhysicsError(fmt::format("non-finite particle kinetic energy at t = {} s (step {})", dem.time_s(), n));
-      csv.row({dem.time_s(), mean_of(s.vx), mean_of(s.vy), mean_of(s.vz), ke, static_cast<double>(dem.contact_count()),
-               static_cast<double>(dem.rebuilds())});
+        throw PhysicsError(
+            fmt::format("non-finite particle kinetic energy at t = {} s (step {})", dem.time_s(), n));
+      csv.row({dem.time_s(), mean_of(s.vx), mean_of(s.vy), mean_of(s.vz), ke,
+               static_cast<double>(dem.contact_count()), static_cast<double>(dem.rebuilds())});
       if (ctx.progress) ctx.progress(dem.time_s());
     }
     if (ctx.should_stop()) {
       // No checkpoint is written by this scene yet: say so instead of claiming a resumable stop.
       sb.status = "interrupted";
       exit_code = kExitFailure;
-      std::fprintf(stderr, "interrupted at t = %g s; dem_only writes no checkpoint yet, a rerun starts over\n",
+      std::fprintf(stderr,
+                   "interrupted at t = %g s; dem_only writes no checkpoint yet, a rerun starts over\n",
                    dem.time_s());
       break;
     }
@@ -106,7 +111,8 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
   if (stokes) {
     // Terminal velocity of a lone particle under this drag (no buoyancy: still fluid only drags).
     const double g_along_z = p.gravity_vector()[2];
-    j["stokes_terminal_velocity_z_m_s"] = p.particle_mass_kg() * g_along_z / (3.0 * kPi * p.fluid.viscosity_pa_s * p.particles.diameter_m);
+    j["stokes_terminal_velocity_z_m_s"] =
+        p.particle_mass_kg() * g_along_z / (3.0 * kPi * p.fluid.viscosity_pa_s * p.particles.diameter_m);
   }
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   return exit_code;

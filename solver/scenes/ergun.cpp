@@ -24,12 +24,14 @@ namespace {
 
 /// Steps the frozen-bed flow until U changes by less than `tol` relative per step (at least
 /// `min_steps`, at most `max_steps`). Returns the number of steps.
-int run_to_steady(coupling::CoupledSystem& run, double tol, int min_steps, int max_steps, const RunContext& ctx) {
+int run_to_steady(coupling::CoupledSystem& run, double tol, int min_steps, int max_steps,
+                  const RunContext& ctx) {
   double u_old = run.fluid().mean_flux_z();
   for (int k = 1; k <= max_steps; ++k) {
     run.step();
     const double u = run.fluid().mean_flux_z();
-    if (!std::isfinite(u)) throw PhysicsError(fmt::format("ergun: superficial velocity became NaN at step {}", k));
+    if (!std::isfinite(u))
+      throw PhysicsError(fmt::format("ergun: superficial velocity became NaN at step {}", k));
     if (k >= min_steps && std::abs(u - u_old) <= tol * std::abs(u)) return k;
     u_old = u;
     if (ctx.should_stop()) return -k;

@@ -13,9 +13,9 @@
 #include "core/error.hpp"
 #include "core/statistics.hpp"
 #include "core/version.hpp"
+#include "coupling/drag_laws.hpp"
 #include "io/checkpoint_file.hpp"
 #include "io/state_io.hpp"
-#include "coupling/drag_laws.hpp"
 #include "scenes/coupled_checkpoint.hpp"
 #include "scenes/coupled_output.hpp"
 #include "scenes/particle_setup.hpp"
@@ -38,7 +38,8 @@ double richardson_zaki_speed(double wt, double re_t, double alpha_p) {
 double isolated_terminal_speed(const CaseParams& p) {
   return coupling::visit_drag_law(p.forces.drag, [&](const auto& law) {
     return coupling::terminal_slip_speed(law, 1.0, p.particles.diameter_m, p.particles.density_kg_m3,
-                                         p.fluid.density_kg_m3, p.fluid.viscosity_pa_s, p.gravity.magnitude_m_s2);
+                                         p.fluid.density_kg_m3, p.fluid.viscosity_pa_s,
+                                         p.gravity.magnitude_m_s2);
   });
 }
 
@@ -101,10 +102,11 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     run.start();
   }
   run.activate_models(timers);
-  CoupledSceneOutput out(run, ctx, timers,
-                         {"time_s", "mean_wp_m_s", "mean_wf_m_s", "slurry_velocity_m_s", "mean_up_m_s", "mean_vp_m_s",
-                          "driving_gradient_pa_m", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
-                         resumed.has_value(), next_out);
+  CoupledSceneOutput out(
+      run, ctx, timers,
+      {"time_s", "mean_wp_m_s", "mean_wf_m_s", "slurry_velocity_m_s", "mean_up_m_s", "mean_vp_m_s",
+       "driving_gradient_pa_m", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
+      resumed.has_value(), next_out);
   auto write_checkpoint = [&] {
     ModelTimers::Scope sc(timers, "checkpoints");
     const Histogram all_y = over_ranks(run, pdf_y), all_w = over_ranks(run, pdf_w);
@@ -144,9 +146,17 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       }
     }
     const auto row = [&]() -> std::vector<double> {
-      return {t, wp, wf, slurry, run.mean_particle_velocity(0), run.mean_particle_velocity(1),
-              run.fluid().mean_pressure_gradient_pa_m(), st.dt_s, static_cast<double>(st.fluid.simple_iterations),
-              run.coupler().totals().min_alpha_f, run.dem().kinetic_energy_j()};
+      return {t,
+              wp,
+              wf,
+              slurry,
+              run.mean_particle_velocity(0),
+              run.mean_particle_velocity(1),
+              run.fluid().mean_pressure_gradient_pa_m(),
+              st.dt_s,
+              static_cast<double>(st.fluid.simple_iterations),
+              run.coupler().totals().min_alpha_f,
+              run.dem().kinetic_energy_j()};
     };
     if (out.after_step(row, write_checkpoint, sb)) {
       exit_code = kExitInterrupted;

@@ -12,8 +12,12 @@ namespace boycott::scenes {
 
 namespace {
 
-bool has_fluid(const CaseParams& p) { return p.scene != "dem_only"; }
-bool has_particles(const CaseParams& p) { return p.particles.count > 0 && p.scene != "channel_flow"; }
+bool has_fluid(const CaseParams& p) {
+  return p.scene != "dem_only";
+}
+bool has_particles(const CaseParams& p) {
+  return p.particles.count > 0 && p.scene != "channel_flow";
+}
 
 // Largest weight a kernel gives one cell, for a particle centred in it (1-D weight cubed).
 // cell and trilinear put everything in one cell; the smoothed (TSC) kernel 0.75 per direction.
@@ -50,20 +54,25 @@ Preflight preflight(const CaseParams& p) {
   }
   if (p.scene == "sediment_transport") {
     if (std::abs(std::cos(p.gravity.angle_deg * kPi / 180.0) - 1.0) > 1e-9)
-      r.errors.push_back(fmt::format("gravity.angle_deg = {} for sediment_transport: must be 0 (gravity along -y)",
-                                     p.gravity.angle_deg));
+      r.errors.push_back(
+          fmt::format("gravity.angle_deg = {} for sediment_transport: must be 0 (gravity along -y)",
+                      p.gravity.angle_deg));
     if (p.domain.periodic_y)
-      r.errors.push_back("domain.periodic_y = true for sediment_transport: must be false (a bed on the wall y = 0)");
+      r.errors.push_back(
+          "domain.periodic_y = true for sediment_transport: must be false (a bed on the wall y = 0)");
     if (p.domain.top_wall != "slip")
-      r.warnings.push_back(fmt::format("domain.top_wall = \"{}\" for sediment_transport: the paper's top is a slip "
-                                       "(mirror) wall; the Shields stress assumes it",
-                                       p.domain.top_wall));
+      r.warnings.push_back(
+          fmt::format("domain.top_wall = \"{}\" for sediment_transport: the paper's top is a slip "
+                      "(mirror) wall; the Shields stress assumes it",
+                      p.domain.top_wall));
   }
   if (!parts) return r;
-  if (p.scene == "inclined_settling" && p.domain.periodic_y && std::abs(std::cos(p.gravity.angle_deg * kPi / 180.0)) > 1e-9)
-    r.errors.push_back(fmt::format("domain.periodic_y = true needs gravity.angle_deg = 90, not {}: in a fully periodic "
-                                   "box only the z driving gradient holds the weight (homogeneous suspension)",
-                                   p.gravity.angle_deg));
+  if (p.scene == "inclined_settling" && p.domain.periodic_y &&
+      std::abs(std::cos(p.gravity.angle_deg * kPi / 180.0)) > 1e-9)
+    r.errors.push_back(
+        fmt::format("domain.periodic_y = true needs gravity.angle_deg = 90, not {}: in a fully periodic "
+                    "box only the z driving gradient holds the weight (homogeneous suspension)",
+                    p.gravity.angle_deg));
 
   const double m = p.particle_mass_kg();
   add("Sg", rho_p / rho_f, "", "density ratio rho_p/rho_f (Eq. 26)");
@@ -80,13 +89,15 @@ Preflight preflight(const CaseParams& p) {
     add("single_particle_peak_solid_fraction", peak, "", "largest share of one cell that one particle fills");
     if (peak >= 1.0)
       r.errors.push_back(fmt::format(
-          "one particle fills {:.2f} of a cell (particles.diameter = {} m, cells {:.3g} x {:.3g} x {:.3g} m, kernel "
+          "one particle fills {:.2f} of a cell (particles.diameter = {} m, cells {:.3g} x {:.3g} x {:.3g} m, "
+          "kernel "
           "{}): the fluid fraction would go negative; must be < 1: use coarser domain.cells or the "
           "trilinear_smoothed kernel",
           peak, d, dx[0], dx[1], dx[2], p.numerics.void_fraction_kernel));
     else if (peak > 0.5)
       r.warnings.push_back(fmt::format(
-          "one particle fills {:.2f} of a cell: the unresolved (volume-averaged) description is doubtful", peak));
+          "one particle fills {:.2f} of a cell: the unresolved (volume-averaged) description is doubtful",
+          peak));
   }
   if (frozen) return r;
   double wt = 0.0;
@@ -106,73 +117,85 @@ Preflight preflight(const CaseParams& p) {
                            ? m_virtual * wt / (std::abs(m - m_f) * g)
                            : m_virtual / (3.0 * kPi * mu * d);  // Stokes when neutrally buoyant
     add("response_time", tau, "s", "particle response time (m + m_added) w_t / ((m - m_f) g)");
-    add("dt_dem_over_response_time", p.time.dt_dem_s / tau, "", "drag is implicit per DEM step: > 1 is stable");
+    add("dt_dem_over_response_time", p.time.dt_dem_s / tau, "",
+        "drag is implicit per DEM step: > 1 is stable");
     if (p.time.dt_dem_s > tau)
-      r.warnings.push_back(fmt::format(
-          "time.dt_dem = {:.3g} s exceeds the particle response time {:.3g} s: the implicit drag keeps it stable, "
-          "but transients shorter than a DEM step are not resolved",
-          p.time.dt_dem_s, tau));
+      r.warnings.push_back(
+          fmt::format("time.dt_dem = {:.3g} s exceeds the particle response time {:.3g} s: the implicit drag "
+                      "keeps it stable, "
+                      "but transients shorter than a DEM step are not resolved",
+                      p.time.dt_dem_s, tau));
     if (p.time.dt_cfd_s > 10.0 * tau)
-      r.warnings.push_back(fmt::format(
-          "time.dt_cfd = {:.3g} s is {:.0f} response times: the fluid sees the drag of particles that relaxed "
-          "within the step (coupling lag); consider a smaller time.dt_cfd",
-          p.time.dt_cfd_s, p.time.dt_cfd_s / tau));
+      r.warnings.push_back(
+          fmt::format("time.dt_cfd = {:.3g} s is {:.0f} response times: the fluid sees the drag of particles "
+                      "that relaxed "
+                      "within the step (coupling lag); consider a smaller time.dt_cfd",
+                      p.time.dt_cfd_s, p.time.dt_cfd_s / tau));
     const double ratio = dx_min / d;
     add("dx_over_d", ratio, "", "smallest cell over particle diameter");
     // The particle's own disturbance in the sampled velocity (measured at Re_p 1.6: +3.3 % in
     // w_t at dx/d = 3, +7.1 % at 2; below 1 % at Re_p >= 50 for dx/d = 5).
     if (re < 10.0 && ratio < 3.0)
       r.warnings.push_back(fmt::format(
-          "smallest cell / particles.diameter = {:.2f} < 3 at Re_p = {:.3g}: the particle's own disturbance in "
+          "smallest cell / particles.diameter = {:.2f} < 3 at Re_p = {:.3g}: the particle's own disturbance "
+          "in "
           "the sampled fluid velocity biases its drag by several percent (no correction is applied)",
           ratio, re));
     // Expected CFL at three terminal speeds (convection in the channel reaches about twice w_t).
     const double cfl = 3.0 * wt * p.time.dt_cfd_s / dx_min;
     add("expected_cfl", cfl, "", "3 w_t dt_cfd / dx_min");
     if (cfl > p.numerics.cfl_max)
-      r.warnings.push_back(fmt::format("expected CFL 3 w_t dt_cfd / dx = {:.2f} exceeds numerics.cfl_max = {}: "
-                                       "the CFD step will be cut below time.dt_cfd",
-                                       cfl, p.numerics.cfl_max));
+      r.warnings.push_back(
+          fmt::format("expected CFL 3 w_t dt_cfd / dx = {:.2f} exceeds numerics.cfl_max = {}: "
+                      "the CFD step will be cut below time.dt_cfd",
+                      cfl, p.numerics.cfl_max));
     const double cell_re = 3.0 * wt * dx_min / nu;
     add("cell_reynolds", cell_re, "", "3 w_t dx_min / nu");
     if (cell_re > 10.0 && p.fluid.subgrid_model == "none" && p.scene == "inclined_settling")
-      r.warnings.push_back(fmt::format("cell Reynolds number 3 w_t dx / nu = {:.3g} > 10 with fluid.subgrid_model = "
-                                       "\"none\": unresolved shear is not modelled",
-                                       cell_re));
+      r.warnings.push_back(
+          fmt::format("cell Reynolds number 3 w_t dx / nu = {:.3g} > 10 with fluid.subgrid_model = "
+                      "\"none\": unresolved shear is not modelled",
+                      cell_re));
   }
 
   // Contacts: resolution of a binary collision and the overlap at the impact speed.
   const double tc = collision_time_s(m, p.contact.stiffness_n_m, p.contact.restitution);
   add("collision_time", tc, "s", "binary collision time of the spring-dashpot");
   add("steps_per_collision", tc / p.time.dt_dem_s, "", "collision time / dt_dem");
-  add("dt_dem_over_spring_limit", p.time.dt_dem_s / p.dem_spring_limit_s(), "", "must be <= 1: (pi/5) sqrt(m/k)");
+  add("dt_dem_over_spring_limit", p.time.dt_dem_s / p.dem_spring_limit_s(), "",
+      "must be <= 1: (pi/5) sqrt(m/k)");
   if (tc / p.time.dt_dem_s < 20.0)
-    r.warnings.push_back(fmt::format(
-        "a collision takes {:.1f} DEM steps (< 20): the rebound restitution is off by a few percent (measured "
-        "+3.6 % for e = 0.1 at 40 steps)",
-        tc / p.time.dt_dem_s));
+    r.warnings.push_back(
+        fmt::format("a collision takes {:.1f} DEM steps (< 20): the rebound restitution is off by a few "
+                    "percent (measured "
+                    "+3.6 % for e = 0.1 at 40 steps)",
+                    tc / p.time.dt_dem_s));
   // Impact speed: the terminal speed in a fluid, a fall across the channel width when dry.
   const double v_imp = wt > 0.0 ? wt : std::sqrt(2.0 * g * W);
   const double overlap = v_imp * std::sqrt(0.5 * m / p.contact.stiffness_n_m) / d;
   add("impact_overlap_over_d", overlap, "", "undamped overlap of a head-on impact at the impact speed / d");
   if (overlap > 0.5)
-    r.errors.push_back(fmt::format("contact.stiffness = {} N/m is too soft: an impact at {:.3g} m/s overlaps {:.2f} d "
-                                   "(must be <= 0.5 d, or spheres pass through each other)",
-                                   p.contact.stiffness_n_m, v_imp, overlap));
+    r.errors.push_back(
+        fmt::format("contact.stiffness = {} N/m is too soft: an impact at {:.3g} m/s overlaps {:.2f} d "
+                    "(must be <= 0.5 d, or spheres pass through each other)",
+                    p.contact.stiffness_n_m, v_imp, overlap));
   else if (overlap > 0.1)
-    r.warnings.push_back(fmt::format("an impact at {:.3g} m/s overlaps {:.2f} d (> 0.1 d): soft contacts compress "
-                                     "the packing",
-                                     v_imp, overlap));
+    r.warnings.push_back(
+        fmt::format("an impact at {:.3g} m/s overlaps {:.2f} d (> 0.1 d): soft contacts compress "
+                    "the packing",
+                    v_imp, overlap));
   if (fluid && rho_p / rho_f < 1.1)
-    r.warnings.push_back(fmt::format("nearly neutrally buoyant particles (rho_p/rho_f = {:.3g}): settling is slow "
-                                     "and the averaging window should be long",
-                                     rho_p / rho_f));
+    r.warnings.push_back(
+        fmt::format("nearly neutrally buoyant particles (rho_p/rho_f = {:.3g}): settling is slow "
+                    "and the averaging window should be long",
+                    rho_p / rho_f));
   return r;
 }
 
 nlohmann::json Preflight::to_json() const {
   nlohmann::json j;
-  for (const auto& it : items) j["items"][it.name] = {{"value", it.value}, {"unit", it.unit}, {"meaning", it.meaning}};
+  for (const auto& it : items)
+    j["items"][it.name] = {{"value", it.value}, {"unit", it.unit}, {"meaning", it.meaning}};
   j["warnings"] = warnings;
   j["errors"] = errors;
   return j;

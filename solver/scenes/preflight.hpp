@@ -14,9 +14,9 @@
 namespace boycott::scenes {
 
 struct PreflightItem {
-  std::string name;   ///< e.g. "Re_p"
+  std::string name;  ///< e.g. "Re_p"
   double value = 0.0;
-  std::string unit;   ///< "" for dimensionless
+  std::string unit;  ///< "" for dimensionless
   std::string meaning;
 };
 

@@ -50,7 +50,8 @@ int run_case(CaseParams params, RunContext& ctx) {
     // (case_id() hashes late keys only when they differ from their defaults).
     if (case_id(case_from_json(stored)) != case_id(params))
       throw CheckpointError(fmt::format("{} holds case {} but this is case {}; use another --out folder",
-                                        ctx.out_dir.string(), case_id(case_from_json(stored)), case_id(params)));
+                                        ctx.out_dir.string(), case_id(case_from_json(stored)),
+                                        case_id(params)));
   } else {
     // One writer: under mpirun every rank runs this, and they would race on the temporary file.
     int rank = 0, initialized = 0;

@@ -54,7 +54,9 @@ void write_file_atomic(const std::filesystem::path& path, const std::string& tex
 }
 
 namespace {
-nlohmann::json num_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+nlohmann::json num_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
 }  // namespace
 
 nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const ModelTimers& timers) {
@@ -94,7 +96,8 @@ CsvWriter::~CsvWriter() {
 
 void CsvWriter::row(const std::vector<double>& values) {
   if (!f_) return;
-  for (std::size_t i = 0; i < values.size() && i < ncol_; ++i) std::fprintf(f_, i ? ",%.10g" : "%.10g", values[i]);
+  for (std::size_t i = 0; i < values.size() && i < ncol_; ++i)
+    std::fprintf(f_, i ? ",%.10g" : "%.10g", values[i]);
   std::fputc('\n', f_);
 }
 

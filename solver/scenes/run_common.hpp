@@ -96,7 +96,8 @@ bool checkpoint_or_stop(bool stop_requested, bool quiet, CheckpointClock& clock,
   }
   if (!stop_requested) return false;
   summary.status = "interrupted";
-  if (!quiet && output_rank()) std::fprintf(stderr, "stopped at t = %g s after writing a checkpoint; run again to resume\n", t_s);
+  if (!quiet && output_rank())
+    std::fprintf(stderr, "stopped at t = %g s after writing a checkpoint; run again to resume\n", t_s);
   return true;
 }
 

@@ -105,7 +105,8 @@ struct Profiles {
     steps = r.scalar("stats.profile.steps");
   }
   void write(const std::filesystem::path& path, double h, double area) const {
-    CsvWriter csv(path, {"y_m", "fluid_w_m_s", "solid_fraction", "particle_w_m_s", "particle_flux_density_m_s"}, false);
+    CsvWriter csv(
+        path, {"y_m", "fluid_w_m_s", "solid_fraction", "particle_w_m_s", "particle_flux_density_m_s"}, false);
     for (std::size_t j = 0; j < fluid_w.size(); ++j) {
       const double n = std::max(steps, 1.0), cell = area * h * n;
       csv.row({(j + 0.5) * h, fluid_w[j] / n, solid_volume[j] / cell,
@@ -114,8 +115,12 @@ struct Profiles {
   }
 };
 
-double wong_parker_q(double tau) { return tau > 0.0495 ? 3.97 * std::pow(tau - 0.0495, 1.5) : 0.0; }
-double nielsen_q(double tau) { return tau > 0.05 ? 12.0 * std::sqrt(tau) * (tau - 0.05) : 0.0; }
+double wong_parker_q(double tau) {
+  return tau > 0.0495 ? 3.97 * std::pow(tau - 0.0495, 1.5) : 0.0;
+}
+double nielsen_q(double tau) {
+  return tau > 0.05 ? 12.0 * std::sqrt(tau) * (tau - 0.05) : 0.0;
+}
 }  // namespace
 
 int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
@@ -161,7 +166,8 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   const double h_bed = is_set(p.sediment.bed_height_m) ? p.sediment.bed_height_m
                                                        : run.particle_volume_m3() / (A * kBedPackedFraction);
   if (h_bed >= H)
-    throw InputError(fmt::format("bed height {:.4g} m fills the channel: must be < domain.width_y = {} m", h_bed, H));
+    throw InputError(
+        fmt::format("bed height {:.4g} m fills the channel: must be < domain.width_y = {} m", h_bed, H));
   if (!resumed) {
     run.start();
     // Start the flow turbulent (see the top of this file), with the bed top as the floor and
@@ -176,18 +182,21 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
     }
   }
   run.activate_models(timers);
-  timers.activate("flux_controller", fmt::format("G(t) holds mean alpha_f w = {} m/s", p.sediment.bulk_velocity_m_s));
+  timers.activate("flux_controller",
+                  fmt::format("G(t) holds mean alpha_f w = {} m/s", p.sediment.bulk_velocity_m_s));
 
   auto transport_rate = [&] {
     double q = 0.0;
-    for (std::size_t i = 0; i < s.n_local; ++i) q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
+    for (std::size_t i = 0; i < s.n_local; ++i)
+      q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
     return run.global_sum(q) / A;  // m^2/s
   };
 
-  CoupledSceneOutput out(run, ctx, timers,
-                         {"time_s", "q_m2_s", "q_star", "driving_gradient_pa_m", "mean_flux_z_m_s", "mean_up_z_m_s",
-                          "mean_vp_m_s", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
-                         resumed.has_value(), next_out);
+  CoupledSceneOutput out(
+      run, ctx, timers,
+      {"time_s", "q_m2_s", "q_star", "driving_gradient_pa_m", "mean_flux_z_m_s", "mean_up_z_m_s",
+       "mean_vp_m_s", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
+      resumed.has_value(), next_out);
   auto write_checkpoint = [&] {
     ModelTimers::Scope sc(timers, "checkpoints");
     const Profiles all_profiles = profiles.over_ranks(run);
@@ -218,9 +227,17 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
       profiles.add(run.fluid(), s, h_y);
     }
     const auto row = [&]() -> std::vector<double> {
-      return {t, q, q / q_scale, G, run.fluid().mean_flux_z(), run.mean_particle_velocity(2),
-              run.mean_particle_velocity(1), st.dt_s, static_cast<double>(st.fluid.simple_iterations),
-              run.coupler().totals().min_alpha_f, run.dem().kinetic_energy_j()};
+      return {t,
+              q,
+              q / q_scale,
+              G,
+              run.fluid().mean_flux_z(),
+              run.mean_particle_velocity(2),
+              run.mean_particle_velocity(1),
+              st.dt_s,
+              static_cast<double>(st.fluid.simple_iterations),
+              run.coupler().totals().min_alpha_f,
+              run.dem().kinetic_energy_j()};
     };
     if (out.after_step(row, write_checkpoint, sb)) {
       exit_code = kExitInterrupted;
@@ -270,8 +287,9 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   j["unconverged_fluid_steps"] = run.unconverged_fluid_steps();
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   if (!ctx.quiet && output_rank())
-    std::printf("sediment_transport: t = %.4g s, q* = %.4g, tau* = %.4g (Wong-Parker q* %.4g, Nielsen %.4g)\n",
-                run.time_s(), q_star, tau_star, qwp, qn);
+    std::printf(
+        "sediment_transport: t = %.4g s, q* = %.4g, tau* = %.4g (Wong-Parker q* %.4g, Nielsen %.4g)\n",
+        run.time_s(), q_star, tau_star, qwp, qn);
   return exit_code;
 }
 

@@ -17,8 +17,8 @@
 #include "core/constants.hpp"
 #include "core/error.hpp"
 #include "core/statistics.hpp"
-#include "coupling/drag_laws.hpp"
 #include "coupling/coupled_system.hpp"
+#include "coupling/drag_laws.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scenes_list.hpp"
 
@@ -29,16 +29,19 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   ModelTimers timers;
   coupling::CoupledSystem run(p, coupling::CoupledOptions{true, true});
   const auto& box = run.dem().config().box;
-  run.dem().add_particle(0, box.lo[0] + 0.5 * box.len[0], box.lo[1] + 0.5 * box.len[1], box.lo[2] + 0.5 * box.len[2],
-                         0.5 * p.particles.diameter_m, p.particles.density_kg_m3);
+  run.dem().add_particle(0, box.lo[0] + 0.5 * box.len[0], box.lo[1] + 0.5 * box.len[1],
+                         box.lo[2] + 0.5 * box.len[2], 0.5 * p.particles.diameter_m,
+                         p.particles.density_kg_m3);
   run.start();
   run.activate_models(timers);
 
   // Without drag there is no terminal velocity (the reference is then left unset).
-  const double vt = p.forces.drag == "none" ? kUnset : coupling::visit_drag_law(p.forces.drag, [&](const auto& law) {
-    return coupling::terminal_slip_speed(law, 1.0, p.particles.diameter_m, p.particles.density_kg_m3,
-                                         p.fluid.density_kg_m3, p.fluid.viscosity_pa_s, p.gravity.magnitude_m_s2);
-  });
+  const double vt =
+      p.forces.drag == "none" ? kUnset : coupling::visit_drag_law(p.forces.drag, [&](const auto& law) {
+        return coupling::terminal_slip_speed(law, 1.0, p.particles.diameter_m, p.particles.density_kg_m3,
+                                             p.fluid.density_kg_m3, p.fluid.viscosity_pa_s,
+                                             p.gravity.magnitude_m_s2);
+      });
   const auto g = p.gravity_vector();
   const double gmag = p.gravity.magnitude_m_s2;
   const double ref_wz = gmag > 0 ? vt * g[2] / gmag : kUnset;  // settles along g in an unbounded fluid
@@ -47,8 +50,8 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   const double acc_ref = (p.forces.pressure_gradient ? (rp - rf) : rp) * g[2] / (rp + cam * rf);
 
   CsvWriter csv(ctx.out_dir / "timeseries.csv",
-                {"time_s", "wp_m_s", "up_m_s", "vp_m_s", "mean_wf_m_s", "slurry_velocity_m_s", "driving_gradient_pa_m",
-                 "reynolds_number"},
+                {"time_s", "wp_m_s", "up_m_s", "vp_m_s", "mean_wf_m_s", "slurry_velocity_m_s",
+                 "driving_gradient_pa_m", "reynolds_number"},
                 false);
   const auto& s = run.dem().particles();
   // The particle lives on one rank: its values as every rank sees them.
@@ -65,16 +68,18 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
     const double vx = particle(s.vx), vy = particle(s.vy), vz = particle(s.vz);
     if (run.steps() == 1) acc0 = vz / st.dt_s;
     if (t > p.time.average_from_s + 1e-12) wp_avg.add(vz);
-    const double slip =
-        std::sqrt(std::pow(vx - particle(s.ufx), 2) + std::pow(vy - particle(s.ufy), 2) + std::pow(vz - particle(s.ufz), 2));
-    csv.row({t, vz, vx, vy, run.mean_fluid_velocity_z(), run.slurry_velocity_z(), run.fluid().mean_pressure_gradient_pa_m(),
-             slip * d / nu});
+    const double slip = std::sqrt(std::pow(vx - particle(s.ufx), 2) + std::pow(vy - particle(s.ufy), 2) +
+                                  std::pow(vz - particle(s.ufz), 2));
+    csv.row({t, vz, vx, vy, run.mean_fluid_velocity_z(), run.slurry_velocity_z(),
+             run.fluid().mean_pressure_gradient_pa_m(), slip * d / nu});
     if (ctx.progress) ctx.progress(t);
     if (ctx.should_stop()) {
       sb.status = "interrupted";
       exit_code = kExitFailure;
       if (output_rank())
-        std::fprintf(stderr, "interrupted at t = %g s; single_particle writes no checkpoint, a rerun starts over\n", t);
+        std::fprintf(stderr,
+                     "interrupted at t = %g s; single_particle writes no checkpoint, a rerun starts over\n",
+                     t);
       break;
     }
   }

@@ -30,7 +30,8 @@ TEST(CaseParams, GravityIsInclinedInTheYZPlane) {
 }
 
 TEST(CaseParams, ParsesTomlAndRejectsUnknownKeys) {
-  auto p = parse_case_string("scene = \"dem_only\"\n[fluid]\nviscosity = 1e-2\n[domain]\ncells = [10, 6, 20]\n");
+  auto p =
+      parse_case_string("scene = \"dem_only\"\n[fluid]\nviscosity = 1e-2\n[domain]\ncells = [10, 6, 20]\n");
   EXPECT_EQ(p.scene, "dem_only");
   EXPECT_DOUBLE_EQ(p.fluid.viscosity_pa_s, 1e-2);
   EXPECT_EQ(p.domain.cells[2], 20);

@@ -37,7 +37,8 @@ TEST(DragLaw, DenseBranchIsTheErgunEquationPerParticle) {
       const double us = U / af, ap = 1.0 - af, vp = kPi * d * d * d / 6.0;
       const double beta = DragDiFelicePaper{}.beta(af, us, d, rho, mu);
       const double dpdl = ap / vp * beta * us / af;
-      const double ergun = 150.0 * mu * ap * ap / (d * d * af * af * af) * U + 1.75 * rho * ap / (d * af * af * af) * U * U;
+      const double ergun =
+          150.0 * mu * ap * ap / (d * d * af * af * af) * U + 1.75 * rho * ap / (d * af * af * af) * U * U;
       EXPECT_NEAR(dpdl / ergun, 1.0, 4.5e-4) << "alpha_f " << af << " U " << U;
     }
   }
@@ -49,7 +50,8 @@ TEST(DragLaw, DiluteBranchTendsToStokesAtLowReynolds) {
   EXPECT_NEAR(beta / (3.0 * kPi * mu * d), 1.0, 1e-5);
   // The voidage correction alpha_f^-zeta raises drag in a suspension: zeta -> 3.7 at low Re.
   const double b09 = DragDiFelicePaper{}.beta(0.9, 1e-9, d, 1000.0, mu);
-  EXPECT_NEAR(b09 / beta, std::pow(0.9, -3.7 + 0.65 * std::exp(-0.5 * std::pow(1.5 + 9 - std::log10(0.6), 2))), 1e-6);
+  EXPECT_NEAR(b09 / beta,
+              std::pow(0.9, -3.7 + 0.65 * std::exp(-0.5 * std::pow(1.5 + 9 - std::log10(0.6), 2))), 1e-6);
 }
 
 TEST(DragLaw, UnknownNameIsAnInputError) {

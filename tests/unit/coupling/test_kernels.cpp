@@ -81,4 +81,6 @@ TEST(Kernel, WallFoldingMirrorsTheOutsidePart) {
   EXPECT_NEAR(w.w[1], 0.5 * (0.5 + dl) * (0.5 + dl), 1e-15);
 }
 
-TEST(Kernel, UnknownNameIsAnInputError) { EXPECT_THROW(kernel_from_name("gaussian"), boycott::InputError); }
+TEST(Kernel, UnknownNameIsAnInputError) {
+  EXPECT_THROW(kernel_from_name("gaussian"), boycott::InputError);
+}

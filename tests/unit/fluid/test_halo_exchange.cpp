@@ -28,8 +28,8 @@ std::pair<double, bool> compare(const Layout& L) {
   const DMBoundaryType by = L.periodic_y ? DM_BOUNDARY_PERIODIC : DM_BOUNDARY_NONE;
   const PetscInt pxy = L.split_x ? PETSC_DECIDE : 1, pz = L.split_x ? PETSC_DECIDE : size;
   DM da;
-  EXPECT_EQ(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, by, DM_BOUNDARY_PERIODIC, L.stencil, L.nx, L.ny, L.nz,
-                         pxy, pxy, pz, 1, L.width, nullptr, nullptr, nullptr, &da),
+  EXPECT_EQ(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, by, DM_BOUNDARY_PERIODIC, L.stencil, L.nx,
+                         L.ny, L.nz, pxy, pxy, pz, 1, L.width, nullptr, nullptr, nullptr, &da),
             0);
   EXPECT_EQ(DMSetUp(da), 0);
   HaloExchange halo(da);
@@ -43,7 +43,8 @@ std::pair<double, bool> compare(const Layout& L) {
   DMDAVecGetArray(da, g, &a);
   for (PetscInt k = zs; k < zs + zm; ++k)
     for (PetscInt j = ys; j < ys + ym; ++j)
-      for (PetscInt i = xs; i < xs + xm; ++i) a[k][j][i] = 1.0 + i + 100.0 * j + 10000.0 * k;  // unique per cell
+      for (PetscInt i = xs; i < xs + xm; ++i)
+        a[k][j][i] = 1.0 + i + 100.0 * j + 10000.0 * k;  // unique per cell
   DMDAVecRestoreArray(da, g, &a);
   // the same background in both, so ghosts neither fills (corners of a star stencil) compare equal
   VecSet(expected, -1.0);

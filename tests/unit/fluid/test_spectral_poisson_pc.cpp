@@ -26,7 +26,8 @@ std::vector<double> apply_operator(const std::vector<double>& p, int nx, int ny,
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) {
         const double pc = at(i, j, k);
-        double a = c[0] * (2 * pc - at(i - 1, j, k) - at(i + 1, j, k)) + c[2] * (2 * pc - at(i, j, k - 1) - at(i, j, k + 1));
+        double a = c[0] * (2 * pc - at(i - 1, j, k) - at(i + 1, j, k)) +
+                   c[2] * (2 * pc - at(i, j, k - 1) - at(i, j, k + 1));
         if (periodic_y || j > 0) a += c[1] * (pc - at(i, j - 1, k));
         if (periodic_y || j < ny - 1) a += c[1] * (pc - at(i, j + 1, k));
         out[static_cast<std::size_t>(i) + nx * (j + static_cast<std::size_t>(ny) * k)] = a;
@@ -52,7 +53,8 @@ double worst_error(int nx, int ny, int nz, bool periodic_y) {
     rmax = std::max(rmax, std::abs(r[q]));
     zmean += z[q];
   }
-  EXPECT_LT(std::abs(zmean) / static_cast<double>(r.size()), 1e-12 * rmax / c[0]) << "M^+ r keeps a constant part";
+  EXPECT_LT(std::abs(zmean) / static_cast<double>(r.size()), 1e-12 * rmax / c[0])
+      << "M^+ r keeps a constant part";
   return err / rmax;
 }
 }  // namespace

@@ -20,15 +20,18 @@ namespace {
 DM make_da(PetscInt nx, PetscInt ny, PetscInt nz, bool periodic_y) {
   DM da;
   const DMBoundaryType by = periodic_y ? DM_BOUNDARY_PERIODIC : DM_BOUNDARY_NONE;
-  EXPECT_EQ(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, by, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR, nx, ny, nz,
-                         PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE, 1, 1, nullptr, nullptr, nullptr, &da),
-            0);
+  EXPECT_EQ(
+      DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, by, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR, nx,
+                   ny, nz, PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE, 1, 1, nullptr, nullptr, nullptr, &da),
+      0);
   EXPECT_EQ(DMSetUp(da), 0);
   return da;
 }
 
 /// A value for (cell, entry) that differs between entries and cells.
-double value(PetscInt i, PetscInt j, PetscInt k, int e) { return 1.0 + 0.37 * e + 0.011 * i + 0.13 * j + 1.7e-3 * k; }
+double value(PetscInt i, PetscInt j, PetscInt k, int e) {
+  return 1.0 + 0.37 * e + 0.011 * i + 0.13 * j + 1.7e-3 * k;
+}
 
 /// Largest |A - B| over all entries after filling both with the same values, one through
 /// MatSetValuesStencil and one through the writer.
@@ -79,7 +82,8 @@ double max_difference(PetscInt nx, PetscInt ny, PetscInt nz, bool periodic_y) {
     for (PetscInt j = ys; j < ys + ym; ++j)
       for (PetscInt i = xs; i < xs + xm; ++i, ++o)
         for (int e = 0; e < 7; ++e) {
-          if (e > 0 && (e - 1) / 2 == 1 && !periodic_y && (j + ((e % 2 == 0) ? 1 : -1) < 0 || j + ((e % 2 == 0) ? 1 : -1) >= ny))
+          if (e > 0 && (e - 1) / 2 == 1 && !periodic_y &&
+              (j + ((e % 2 == 0) ? 1 : -1) < 0 || j + ((e % 2 == 0) ? 1 : -1) >= ny))
             continue;
           W.add(o, e, value(i, j, k, e));
         }
@@ -96,9 +100,13 @@ double max_difference(PetscInt nx, PetscInt ny, PetscInt nz, bool periodic_y) {
   return diff;
 }
 
-TEST(StencilMatrixWriter, MatchesMatSetValuesStencilWithWallsInY) { EXPECT_EQ(max_difference(7, 6, 5, false), 0.0); }
+TEST(StencilMatrixWriter, MatchesMatSetValuesStencilWithWallsInY) {
+  EXPECT_EQ(max_difference(7, 6, 5, false), 0.0);
+}
 
-TEST(StencilMatrixWriter, MatchesMatSetValuesStencilFullyPeriodic) { EXPECT_EQ(max_difference(6, 4, 5, true), 0.0); }
+TEST(StencilMatrixWriter, MatchesMatSetValuesStencilFullyPeriodic) {
+  EXPECT_EQ(max_difference(6, 4, 5, true), 0.0);
+}
 
 TEST(StencilMatrixWriter, AddsBothNeighboursWhereAPeriodicDirectionIsTwoCellsLong) {
   EXPECT_EQ(max_difference(2, 3, 4, false), 0.0);
@@ -107,7 +115,9 @@ TEST(StencilMatrixWriter, AddsBothNeighboursWhereAPeriodicDirectionIsTwoCellsLon
 // ---- StencilOperator: the matrix-free product against its AIJ copy
 
 /// A coefficient for (cell, entry) that differs between entries and cells.
-double coefficient(PetscInt i, PetscInt j, PetscInt k, int e) { return 1.0 + 0.37 * e + 0.011 * i - 0.13 * j + 1.7e-3 * k; }
+double coefficient(PetscInt i, PetscInt j, PetscInt k, int e) {
+  return 1.0 + 0.37 * e + 0.011 * i - 0.13 * j + 1.7e-3 * k;
+}
 
 struct Result {
   double max_difference = 0.0;  ///< max |A_shell x - A_aij x| / max |A_aij x|

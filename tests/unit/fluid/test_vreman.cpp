@@ -28,7 +28,8 @@ TEST(VremanViscosity, VanishesInPlaneShear) {
   EXPECT_EQ(vreman_viscosity(g, {1e-3, 1e-3, 1e-3}), 0.0);
   // any plane shear, e.g. u = s (n . x) t with n = (1,1,0)/sqrt2, t = (1,-1,0)/sqrt2: rank one
   const double s = 5.0;
-  const std::array<std::array<double, 3>, 3> g2 = {{{0.5 * s, -0.5 * s, 0.0}, {0.5 * s, -0.5 * s, 0.0}, {0.0, 0.0, 0.0}}};
+  const std::array<std::array<double, 3>, 3> g2 = {
+      {{0.5 * s, -0.5 * s, 0.0}, {0.5 * s, -0.5 * s, 0.0}, {0.0, 0.0, 0.0}}};
   EXPECT_EQ(vreman_viscosity(g2, {1e-3, 1e-3, 1e-3}), 0.0);
   EXPECT_EQ(vreman_viscosity({}, {1e-3, 1e-3, 1e-3}), 0.0);
 }

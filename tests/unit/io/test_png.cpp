@@ -8,7 +8,9 @@
 
 namespace {
 
-std::uint32_t be32(const unsigned char* p) { return (std::uint32_t(p[0]) << 24) | (p[1] << 16) | (p[2] << 8) | p[3]; }
+std::uint32_t be32(const unsigned char* p) {
+  return (std::uint32_t(p[0]) << 24) | (p[1] << 16) | (p[2] << 8) | p[3];
+}
 
 std::uint32_t crc_bitwise(const unsigned char* p, std::size_t n) {
   std::uint32_t c = 0xffffffffu;

@@ -16,7 +16,8 @@ TEST(ContactKernels, NormalForceIsSpringMinusDashpot) {
   const LinearSpringDashpot cm(3.5, 0.1, 0.5, 0.6, false);
   double hx = 0.0, hy = 0.0, hz = 0.0, ftx, fty, ftz;
   const double delta = 1e-5, vn = -0.02, gn = 1e-4;
-  const double fn = spring_dashpot(cm, 2e-5, 0.0, 0.0, 1.0, delta, 0.0, 0.0, vn, gn, hx, hy, hz, ftx, fty, ftz);
+  const double fn =
+      spring_dashpot(cm, 2e-5, 0.0, 0.0, 1.0, delta, 0.0, 0.0, vn, gn, hx, hy, hz, ftx, fty, ftz);
   EXPECT_DOUBLE_EQ(fn, 3.5 * delta - gn * vn);
   EXPECT_EQ(ftx, 0.0);
   EXPECT_EQ(fty, 0.0);
@@ -29,8 +30,12 @@ TEST(ContactKernels, ClippingForbidsAttractiveNormalForce) {
   double h[3] = {0, 0, 0}, ft[3];
   const double delta = 1e-7, vn = 0.1, gn = 1e-3;  // separating fast: k delta - g vn < 0
   const LinearSpringDashpot free_cm(3.5, 0.1, 0.5, 0.6, false), clip_cm(3.5, 0.1, 0.5, 0.6, true);
-  EXPECT_LT(spring_dashpot(free_cm, 2e-5, 1, 0, 0, delta, vn, 0, 0, gn, h[0], h[1], h[2], ft[0], ft[1], ft[2]), 0.0);
-  EXPECT_EQ(spring_dashpot(clip_cm, 2e-5, 1, 0, 0, delta, vn, 0, 0, gn, h[0], h[1], h[2], ft[0], ft[1], ft[2]), 0.0);
+  EXPECT_LT(
+      spring_dashpot(free_cm, 2e-5, 1, 0, 0, delta, vn, 0, 0, gn, h[0], h[1], h[2], ft[0], ft[1], ft[2]),
+      0.0);
+  EXPECT_EQ(
+      spring_dashpot(clip_cm, 2e-5, 1, 0, 0, delta, vn, 0, 0, gn, h[0], h[1], h[2], ft[0], ft[1], ft[2]),
+      0.0);
 }
 
 // Below the Coulomb limit the tangential spring grows by v_t dt and the force is
@@ -56,7 +61,7 @@ TEST(ContactKernels, TangentialSpringStickThenSlideAtCoulombLimit) {
 // The shear spring is turned into the current tangent plane keeping its length.
 TEST(ContactKernels, ShearSpringRotatesIntoTheTangentPlaneKeepingItsLength) {
   const LinearSpringDashpot cm(3.5, 0.1, 0.5, 1e9, false);  // no sliding
-  double hx = 1e-6, hy = 0.0, hz = 1e-6, ftx, fty, ftz;  // tilted out of the plane z = const
+  double hx = 1e-6, hy = 0.0, hz = 1e-6, ftx, fty, ftz;     // tilted out of the plane z = const
   spring_dashpot(cm, 2e-5, 0, 0, 1, 1e-5, 0, 0, 0, 0.0, hx, hy, hz, ftx, fty, ftz);
   EXPECT_NEAR(hz, 0.0, 1e-22);
   EXPECT_NEAR(std::hypot(hx, hy), std::hypot(1e-6, 1e-6), 1e-20);

@@ -23,8 +23,8 @@ DemConfig gas_config(double L, double dt) {
   return c;
 }
 
-std::set<std::pair<std::int64_t, std::int64_t>> brute_force_pairs(const ParticleStore& s, const BoxGeometry& g,
-                                                                   double cut) {
+std::set<std::pair<std::int64_t, std::int64_t>> brute_force_pairs(const ParticleStore& s,
+                                                                  const BoxGeometry& g, double cut) {
   std::set<std::pair<std::int64_t, std::int64_t>> out;
   for (std::size_t i = 0; i < s.size(); ++i)
     for (std::size_t j = i + 1; j < s.size(); ++j) {
@@ -84,7 +84,8 @@ TEST(NeighborList, HoldsEveryContactAfterManyRebuilds) {
     for (std::size_t i = 0; i < s.size(); ++i)
       for (auto p = nl.offsets[i]; p < nl.offsets[i + 1]; ++p)
         listed.insert({std::min(s.id[i], s.id[nl.neighbors[p]]), std::max(s.id[i], s.id[nl.neighbors[p]])});
-    for (const auto& pr : brute_force_pairs(s, b, 2 * kR)) ASSERT_TRUE(listed.count(pr)) << "missing contact at step " << n;
+    for (const auto& pr : brute_force_pairs(s, b, 2 * kR))
+      ASSERT_TRUE(listed.count(pr)) << "missing contact at step " << n;
   }
   EXPECT_GT(dem.rebuilds(), 20);
 }

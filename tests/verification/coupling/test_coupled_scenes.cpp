@@ -16,7 +16,8 @@
 namespace boycott::scenes {
 namespace {
 
-nlohmann::json run_case_file(const std::string& file, const std::string& tag, const std::vector<std::string>& sets = {}) {
+nlohmann::json run_case_file(const std::string& file, const std::string& tag,
+                             const std::vector<std::string>& sets = {}) {
   CaseParams p = parse_case_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/cases/" + file);
   for (const auto& s : sets) apply_override(p, s);
   RunContext ctx;
@@ -43,10 +44,11 @@ TEST(SingleParticle, TerminalVelocityWithinTwoPercentOfDragLawFromRe0p1To250) {
                                  {std::string("fluid.viscosity=") + r.mu, std::string("time.end=") + r.end,
                                   std::string("time.average_from=") + r.from});
     const double err = j["rel_error"].get<double>();
-    std::printf("[ report ] single particle mu = %s Pa s: Re %.3g, w_t %.6g m/s vs %.6g (%+.2f %%), dx/d %.1f\n", r.mu,
-                j["reynolds_number_reference"].get<double>(), j["terminal_velocity_m_s"].get<double>(),
-                j["terminal_velocity_reference_m_s"].get<double>(), 100.0 * err,
-                j["cell_size_over_diameter"].get<double>());
+    std::printf(
+        "[ report ] single particle mu = %s Pa s: Re %.3g, w_t %.6g m/s vs %.6g (%+.2f %%), dx/d %.1f\n",
+        r.mu, j["reynolds_number_reference"].get<double>(), j["terminal_velocity_m_s"].get<double>(),
+        j["terminal_velocity_reference_m_s"].get<double>(), 100.0 * err,
+        j["cell_size_over_diameter"].get<double>());
     EXPECT_LE(std::abs(err), 0.02) << "mu = " << r.mu;
   }
 }
@@ -75,8 +77,8 @@ TEST(SingleParticle, AddedMassSetsTheStartAcceleration) {
   // without added mass (rho_p - rho_f) g / rho_p.
   for (const char* am : {"true", "false"}) {
     const auto j = run_case_file("single_particle.toml", std::string("am_") + am,
-                                 {"forces.drag=\"none\"", std::string("forces.added_mass=") + am, "time.end=0.002",
-                                  "time.average_from=0.0"});
+                                 {"forces.drag=\"none\"", std::string("forces.added_mass=") + am,
+                                  "time.end=0.002", "time.average_from=0.0"});
     const double a = j["initial_acceleration_z_m_s2"].get<double>();
     const double rp = 2650.0, rf = 1000.0;
     const double expect = -(rp - rf) * 9.81 / (rp + (std::string(am) == "true" ? 0.5 * rf : 0.0));
@@ -90,14 +92,16 @@ TEST(StiffDrag, TinyParticleInViscousFluidSettlesStablyToItsTerminalVelocity) {
   // In creeping flow the particle's own momentum source raises the fluid velocity at its centre
   // by about 0.37 d/dx of its slip (measured: +7.3 % at dx/d = 5, +3.7 % at 10, +1.8 % at 20):
   // cells 20 diameters wide here.
-  const auto j = run_case_file("single_particle.toml", "stiff",
-                               {"particles.diameter=1.0e-4", "numerics.neighbor_skin=3.0e-5", "fluid.viscosity=1.0",
-                                "time.dt_dem=1.0e-5", "domain.length_x=0.02", "domain.width_y=0.02",
-                                "domain.height_z=0.04", "time.end=0.02", "time.average_from=0.01"});
+  const auto j =
+      run_case_file("single_particle.toml", "stiff",
+                    {"particles.diameter=1.0e-4", "numerics.neighbor_skin=3.0e-5", "fluid.viscosity=1.0",
+                     "time.dt_dem=1.0e-5", "domain.length_x=0.02", "domain.width_y=0.02",
+                     "domain.height_z=0.04", "time.end=0.02", "time.average_from=0.01"});
   EXPECT_GT(j["dt_dem_over_response_time"].get<double>(), 5.0);
   EXPECT_LE(std::abs(j["rel_error"].get<double>()), 0.02);
-  std::printf("[ report ] stiff drag: w_t %.5g m/s vs %.5g (%+.2f %%)\n", j["terminal_velocity_m_s"].get<double>(),
-              j["terminal_velocity_reference_m_s"].get<double>(), 100.0 * j["rel_error"].get<double>());
+  std::printf("[ report ] stiff drag: w_t %.5g m/s vs %.5g (%+.2f %%)\n",
+              j["terminal_velocity_m_s"].get<double>(), j["terminal_velocity_reference_m_s"].get<double>(),
+              100.0 * j["rel_error"].get<double>());
 }
 
 TEST(InclinedSettling, SmokeRunHoldsTheSlurryVelocityAtZero) {
@@ -120,8 +124,9 @@ TEST(Ergun, FrictionFactorWithinOnePercentFromRe1To1000) {
   for (const auto& pt : j["points"]) {
     re_min = std::min(re_min, pt["re_star"].get<double>());
     re_max = std::max(re_max, pt["re_star"].get<double>());
-    std::printf("[ report ] Ergun Re* %8.3f  f* %9.4f  Ergun %9.4f  error %+.3f %%\n", pt["re_star"].get<double>(),
-                pt["f_star"].get<double>(), pt["f_star_ergun"].get<double>(), 100.0 * pt["rel_error"].get<double>());
+    std::printf("[ report ] Ergun Re* %8.3f  f* %9.4f  Ergun %9.4f  error %+.3f %%\n",
+                pt["re_star"].get<double>(), pt["f_star"].get<double>(), pt["f_star_ergun"].get<double>(),
+                100.0 * pt["rel_error"].get<double>());
   }
   EXPECT_LE(re_min, 1.5);
   EXPECT_GE(re_max, 900.0);

@@ -9,9 +9,9 @@
 
 #include "core/case_params.hpp"
 #include "core/constants.hpp"
+#include "coupling/coupled_system.hpp"
 #include "coupling/coupler.hpp"
 #include "fluid/fluid_solver.hpp"
-#include "coupling/coupled_system.hpp"
 
 namespace boycott {
 namespace {
@@ -22,7 +22,9 @@ CaseParams make_case(const std::string& toml) {
   return p;
 }
 
-double sphere_volume(double r) { return 4.0 / 3.0 * kPi * r * r * r; }
+double sphere_volume(double r) {
+  return 4.0 / 3.0 * kPi * r * r * r;
+}
 
 TEST(Deposition, ParticleVolumeOnGridEqualsTotalVolumeAcrossWrapAndWalls) {
   // Particles straddling the periodic x and z boundaries and touching both y walls.
@@ -43,7 +45,7 @@ count = 6
     q.numerics.void_fraction_kernel = kernel;
     coupling::CoupledSystem run(q, coupling::CoupledOptions{});
     const double r = 0.3e-3;
-    const double pos[6][3] = {{0.0001, 0.003, 0.004},  {0.0079, 0.0031, 0.0079}, {0.004, 0.0003, 0.00001},
+    const double pos[6][3] = {{0.0001, 0.003, 0.004}, {0.0079, 0.0031, 0.0079},   {0.004, 0.0003, 0.00001},
                               {0.004, 0.0057, 0.004}, {0.00005, 0.0003, 0.00795}, {0.006, 0.0045, 0.002}};
     for (int i = 0; i < 6; ++i) run.dem().add_particle(i, pos[i][0], pos[i][1], pos[i][2], r, 2650.0);
     run.start();
@@ -51,7 +53,8 @@ count = 6
     EXPECT_NEAR(run.coupler().totals().solid_volume_m3 / vs, 1.0, 1e-13) << kernel;
     const auto alpha = run.fluid().gather(5);
     double solid = 0.0;
-    for (double a : alpha) solid += (1.0 - a) * q.domain.length_x_m * q.domain.width_y_m * q.domain.height_z_m / alpha.size();
+    for (double a : alpha)
+      solid += (1.0 - a) * q.domain.length_x_m * q.domain.width_y_m * q.domain.height_z_m / alpha.size();
     EXPECT_NEAR(solid / vs, 1.0, 1e-12) << kernel;
   }
 }
@@ -119,7 +122,8 @@ simple_max_iterations = 200
 )");
   coupling::CoupledSystem run(p, coupling::CoupledOptions{true, true});
   const auto& b = run.dem().config().box;
-  run.dem().insert_random(200, 0.3e-3, 2650.0, b.lo, {b.lo[0] + b.len[0], b.lo[1] + b.len[1], b.lo[2] + b.len[2]}, 7);
+  run.dem().insert_random(200, 0.3e-3, 2650.0, b.lo,
+                          {b.lo[0] + b.len[0], b.lo[1] + b.len[1], b.lo[2] + b.len[2]}, 7);
   run.start();
   const double rho = 1000.0, V = 0.008 * 0.008 * 0.008, g = -9.81;
   const double vcell = V / 512.0;
@@ -165,10 +169,11 @@ simple_max_iterations = 200
   }
   const double change = (Q(N) - Q(1)) + (P[N] - P[1]);
   const double residual = change - (impulse - lag_sum);
-  std::printf("[ report ] momentum over %d steps: change %.6e, impulse %.6e, lag %.3e (%.2e of the change), "
-              "residual %.3e N s (%.2e of the particle momentum change %.3e)\n",
-              N - 1, change, impulse, lag_sum, std::abs(lag_sum / change), residual,
-              std::abs(residual / (P[N] - P[1])), P[N] - P[1]);
+  std::printf(
+      "[ report ] momentum over %d steps: change %.6e, impulse %.6e, lag %.3e (%.2e of the change), "
+      "residual %.3e N s (%.2e of the particle momentum change %.3e)\n",
+      N - 1, change, impulse, lag_sum, std::abs(lag_sum / change), residual,
+      std::abs(residual / (P[N] - P[1])), P[N] - P[1]);
   EXPECT_LE(std::abs(residual), 1e-6 * scale);
 }
 
@@ -216,7 +221,8 @@ added_mass = false
     for (int k = 0; k < 2000; ++k) {
       run.step();
       const double u = run.fluid().mean_flux_z();
-      if (std::getenv("BOYCOTT_DEBUG")) std::printf("step %d U %.6g min alpha %.4f\n", k, u, run.coupler().totals().min_alpha_f);
+      if (std::getenv("BOYCOTT_DEBUG"))
+        std::printf("step %d U %.6g min alpha %.4f\n", k, u, run.coupler().totals().min_alpha_f);
       if (k > 20 && std::abs(u - u_old) < 1e-9 * std::abs(u)) break;
       u_old = u;
     }
@@ -235,9 +241,10 @@ added_mass = false
       sum += ergun(1.0 - ap) / 20.0;
       amean += (1.0 - ap) / 20.0;
     }
-    std::printf("[ report ] two-layer bed, G = %.3g Pa/m: U = %.5g m/s, layered Ergun %.5g Pa/m (error %+.3f %%), "
-                "Ergun at the mean porosity %.4f: %.5g Pa/m (%+.2f %%)\n",
-                G, U, sum, 100.0 * (G - sum) / sum, amean, ergun(amean), 100.0 * (G - ergun(amean)) / ergun(amean));
+    std::printf(
+        "[ report ] two-layer bed, G = %.3g Pa/m: U = %.5g m/s, layered Ergun %.5g Pa/m (error %+.3f %%), "
+        "Ergun at the mean porosity %.4f: %.5g Pa/m (%+.2f %%)\n",
+        G, U, sum, 100.0 * (G - sum) / sum, amean, ergun(amean), 100.0 * (G - ergun(amean)) / ergun(amean));
     EXPECT_NEAR(G / sum, 1.0, 0.02);
   }
 }

@@ -55,7 +55,9 @@ inline FluidSettings wavy_channel() {
 }
 
 inline void perturb_wavy_channel(FluidSolver& f) {
-  f.set_velocity(0, [](double x, double y, double z) { return 0.2 * std::sin(M_PI * x) * std::cos(M_PI * z) * y * (1 - y); });
+  f.set_velocity(0, [](double x, double y, double z) {
+    return 0.2 * std::sin(M_PI * x) * std::cos(M_PI * z) * y * (1 - y);
+  });
   f.set_velocity(2, [](double x, double y, double z) {
     return y * (1 - y) * (1.0 - 0.2 * std::cos(M_PI * x) * std::sin(M_PI * z));
   });

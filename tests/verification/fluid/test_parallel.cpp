@@ -103,11 +103,17 @@ void compare_ranks(bool piso, int nz = 8) {
   }
 }
 
-TEST(ParallelFluid, OneAndTwoRanksGiveTheSameField) { compare_ranks(false); }
+TEST(ParallelFluid, OneAndTwoRanksGiveTheSameField) {
+  compare_ranks(false);
+}
 
-TEST(ParallelFluid, OneAndTwoRanksGiveTheSameFieldWithPiso) { compare_ranks(true); }
+TEST(ParallelFluid, OneAndTwoRanksGiveTheSameFieldWithPiso) {
+  compare_ranks(true);
+}
 
-TEST(ParallelFluid, OneAndTwoRanksGiveTheSameFieldWhereTheSlabsDoNotFit) { compare_ranks(false, 3); }
+TEST(ParallelFluid, OneAndTwoRanksGiveTheSameFieldWhereTheSlabsDoNotFit) {
+  compare_ranks(false, 3);
+}
 
 }  // namespace
 }  // namespace boycott::fluid

@@ -71,7 +71,8 @@ TEST(PisoCoupling, TaylorGreenDecayRateWithinOnePercent) {
   const double t1 = f.time_s(), e1 = kinetic_energy(f);
   while (f.time_s() < 1.0 - 1e-9) f.step(0.02);
   const double rate = std::log(e1 / kinetic_energy(f)) / (f.time_s() - t1);
-  std::printf("PISO energy decay rate %.6f, exact %.6f (rel. error %.3g)\n", rate, 4.0 * nu, rate / (4.0 * nu) - 1.0);
+  std::printf("PISO energy decay rate %.6f, exact %.6f (rel. error %.3g)\n", rate, 4.0 * nu,
+              rate / (4.0 * nu) - 1.0);
   EXPECT_NEAR(rate / (4.0 * nu), 1.0, 0.01);
 }
 
@@ -91,7 +92,8 @@ TEST(PisoCoupling, SecondOrderInTimeOnTaylorGreen) {
   for (bool use_piso : {false, true}) {
     const auto a = run(use_piso, 0.04), b = run(use_piso, 0.02), c = run(use_piso, 0.01);
     const double e1 = max_diff(a, b), e2 = max_diff(b, c), order = std::log2(e1 / e2);
-    std::printf("%s: temporal differences %.3g %.3g, observed order %.3f\n", use_piso ? "PISO" : "SIMPLE", e1, e2, order);
+    std::printf("%s: temporal differences %.3g %.3g, observed order %.3f\n", use_piso ? "PISO" : "SIMPLE", e1,
+                e2, order);
     if (use_piso) {
       EXPECT_GE(order, 1.8);
     }
@@ -142,8 +144,9 @@ TEST(PisoCoupling, MovingFluidFractionStaysCloseToSimpleAndConservesVolume) {
     dt_err = std::max(dt_err, max_diff(simple1.first[c], simple2.first[c]));
     for (double v : simple1.first[c]) ref = std::max(ref, std::abs(v));
   }
-  std::printf("max |PISO - SIMPLE| / max|u|: dt 0.01 %.3g, dt 0.005 %.3g (order %.2f); SIMPLE dt vs dt/2 %.3g\n",
-              d1 / ref, d2 / ref, std::log2(d1 / d2), dt_err / ref);
+  std::printf(
+      "max |PISO - SIMPLE| / max|u|: dt 0.01 %.3g, dt 0.005 %.3g (order %.2f); SIMPLE dt vs dt/2 %.3g\n",
+      d1 / ref, d2 / ref, std::log2(d1 / d2), dt_err / ref);
   std::printf("worst continuity defect: PISO %.3g 1/s, SIMPLE %.3g 1/s\n", piso1.second, simple1.second);
   EXPECT_GE(std::log2(d1 / d2), 1.8);
   EXPECT_LE(d1, dt_err);
@@ -156,7 +159,8 @@ TEST(PisoCoupling, FluxControllerHoldsTarget) {
   s.target_mean_flux_z_m_s = 0.05;
   s.dt_max_s = 0.05;
   FluidSolver f(s);
-  f.set_fluid_fraction([](double x, double, double z) { return 0.8 + 0.1 * std::sin(M_PI * x) * std::cos(M_PI * z); });
+  f.set_fluid_fraction(
+      [](double x, double, double z) { return 0.8 + 0.1 * std::sin(M_PI * x) * std::cos(M_PI * z); });
   double worst = 0.0;
   for (int n = 0; n < 40; ++n) {
     f.step(0.05);

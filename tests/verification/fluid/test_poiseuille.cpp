@@ -14,7 +14,7 @@ FluidSettings channel(int ny, double dt) {
   s.grid.length_m = {4.0, 1.0, 4.0};  // W = 1 m
   s.grid.periodic = {true, false, true};
   s.density_kg_m3 = 1.0;
-  s.viscosity_pa_s = 1.0;  // nu = 1 m^2/s
+  s.viscosity_pa_s = 1.0;                      // nu = 1 m^2/s
   s.body_acceleration_m_s2 = {0.0, 0.0, 8.0};  // centreline g W^2 / (8 nu) = 1 m/s
   s.dt_max_s = dt;
   s.simple_tolerance = 1e-10;
@@ -86,7 +86,8 @@ TEST(PoiseuilleStartup, FollowsSeriesSolutionAtSeveralTimes) {
     while (f.time_s() < t_check - 1e-9) f.step(1.25e-3);
     const auto w = f.profile_y(2);
     double err = 0.0;
-    for (int j = 0; j < ny; ++j) err = std::max(err, std::abs(w[j] - startup_exact((j + 0.5) / ny, f.time_s())));
+    for (int j = 0; j < ny; ++j)
+      err = std::max(err, std::abs(w[j] - startup_exact((j + 0.5) / ny, f.time_s())));
     std::printf("t = %.3f: max error / centreline %.3g\n", f.time_s(), err);
     EXPECT_LE(err, 0.003) << "t = " << t_check;
   }
@@ -99,7 +100,8 @@ TEST(PoiseuilleStartup, SecondOrderInTime) {
   const auto a = startup_profile(ny, 0.01, t_end), b = startup_profile(ny, 0.005, t_end),
              c = startup_profile(ny, 0.0025, t_end);
   double e1 = 0.0, e2 = 0.0;
-  for (int j = 0; j < ny; ++j) e1 = std::max(e1, std::abs(a[j] - b[j])), e2 = std::max(e2, std::abs(b[j] - c[j]));
+  for (int j = 0; j < ny; ++j)
+    e1 = std::max(e1, std::abs(a[j] - b[j])), e2 = std::max(e2, std::abs(b[j] - c[j]));
   const double order = std::log2(e1 / e2);
   std::printf("temporal differences %.3g %.3g, observed order %.3f\n", e1, e2, order);
   EXPECT_GE(order, 1.8);

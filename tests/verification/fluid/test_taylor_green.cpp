@@ -15,7 +15,9 @@ constexpr double kNu = 0.05;  // m^2/s; U = 1 m/s, L = 2 pi m: Re = U L / nu = 1
 
 using testing::init_taylor_green;
 using testing::kinetic_energy;
-FluidSettings tg_settings(int n, double dt, double nu = kNu) { return testing::taylor_green_settings(n, dt, nu); }
+FluidSettings tg_settings(int n, double dt, double nu = kNu) {
+  return testing::taylor_green_settings(n, dt, nu);
+}
 
 /// max |u - u_exact| / U at time t_end.
 double tg_error(int n, double dt, double t_end, double nu) {

@@ -62,8 +62,8 @@ TEST(TurbulentStart, FromRestTheFlowStaysAStokesLayer) {
   FluidSolver rest(channel());
   const History a = run(rest);
   const double stokes = kRho * kNu * kU / std::sqrt(M_PI * kNu * a.t.back());
-  std::printf("wall stress at %.3f s: %.4f Pa, Stokes layer %.4f Pa; rms u %.3g m/s\n", a.t.back(), a.wall_stress.back(),
-              stokes, a.u_rms_end);
+  std::printf("wall stress at %.3f s: %.4f Pa, Stokes layer %.4f Pa; rms u %.3g m/s\n", a.t.back(),
+              a.wall_stress.back(), stokes, a.u_rms_end);
   EXPECT_NEAR(a.wall_stress.back(), stokes, 0.25 * stokes);
   EXPECT_LT(a.u_rms_end, 1e-6 * kU);
 }
@@ -77,7 +77,8 @@ TEST(TurbulentStart, ReachesDeansWallStress) {
   FluidSolver turbulent(channel());
   boycott::fluid::TurbulentStartSettings ts;
   ts.bulk_velocity_m_s = kU;
-  ts.roughness_m = 1.1e-4;  // smooth wall: k_s = 30 z0 with the smooth log law's z0 = nu / (9 u*), u* ~ 0.03 m/s
+  ts.roughness_m =
+      1.1e-4;  // smooth wall: k_s = 30 z0 with the smooth log law's z0 = nu / (9 u*), u* ~ 0.03 m/s
   boycott::fluid::start_turbulent_channel(turbulent, ts);
   const History b = run(turbulent);
   double sum = 0.0;
@@ -86,8 +87,8 @@ TEST(TurbulentStart, ReachesDeansWallStress) {
     if (b.t[k] > 0.5) sum += b.wall_stress[k], ++n;
   const double mean_stress = sum / n;
   const double dean = 0.5 * kRho * kU * kU * 0.073 * std::pow(2.0 * kH * kU / kNu, -0.25);
-  std::printf("mean wall stress over 0.5-%.2f s: %.4f Pa, Dean %.4f Pa; rms u at the end %.4f m/s\n", b.t.back(),
-              mean_stress, dean, b.u_rms_end);
+  std::printf("mean wall stress over 0.5-%.2f s: %.4f Pa, Dean %.4f Pa; rms u at the end %.4f m/s\n",
+              b.t.back(), mean_stress, dean, b.u_rms_end);
   EXPECT_GT(mean_stress, dean / 1.5);
   EXPECT_LT(mean_stress, dean * 1.5);
   EXPECT_GT(b.u_rms_end, 0.01 * kU);

@@ -12,7 +12,9 @@ namespace boycott::fluid {
 namespace {
 
 using testing::wavy_channel;
-void perturb(FluidSolver& f) { testing::perturb_wavy_channel(f); }
+void perturb(FluidSolver& f) {
+  testing::perturb_wavy_channel(f);
+}
 
 TEST(VolumeAveragedEquations, UniformFluidFractionGivesTheSameFlow) {
   // Set II with constant alpha_f: every term but the (unchanged) source scales with alpha_f.
@@ -23,7 +25,8 @@ TEST(VolumeAveragedEquations, UniformFluidFractionGivesTheSameFlow) {
   double diff = 0.0, ref = 0.0;
   for (int c = 0; c < 3; ++c) {
     const auto ua = a.gather(c), ub = b.gather(c);
-    for (std::size_t i = 0; i < ua.size(); ++i) diff = std::max(diff, std::abs(ua[i] - ub[i])), ref = std::max(ref, std::abs(ua[i]));
+    for (std::size_t i = 0; i < ua.size(); ++i)
+      diff = std::max(diff, std::abs(ua[i] - ub[i])), ref = std::max(ref, std::abs(ua[i]));
   }
   std::printf("max |u(alpha 0.55) - u(alpha 1)| / max|u| = %.3g\n", diff / ref);
   EXPECT_LE(diff / ref, 1e-7);
@@ -60,16 +63,23 @@ TEST(VolumeAveragedEquations, MovingFluidFractionConservesFluidVolume) {
           for (int i = 0; i < nx; ++i) {
             const double a0 = alpha(0.0)((i + 0.5) * h[0], (j + 0.5) * h[1], (k + 0.5) * h[2]);
             const double rate = (a1[id(i, j, k)] - a0) / 0.01;
-            auto fx = [&](int ii) { return 0.5 * (a1[id(ii, j, k)] + a1[id(ii - 1, j, k)]) * u[id(ii, j, k)]; };
-            auto fz = [&](int kk) { return 0.5 * (a1[id(i, j, kk)] + a1[id(i, j, kk - 1)]) * w[id(i, j, kk)]; };
-            auto fy = [&](int jj) {
-              return (jj == 0 || jj == ny) ? 0.0 : 0.5 * (a1[id(i, jj, k)] + a1[id(i, jj - 1, k)]) * v[id(i, jj, k)];
+            auto fx = [&](int ii) {
+              return 0.5 * (a1[id(ii, j, k)] + a1[id(ii - 1, j, k)]) * u[id(ii, j, k)];
             };
-            const double r = rate + (fx(i + 1) - fx(i)) / h[0] + (fy(j + 1) - fy(j)) / h[1] + (fz(k + 1) - fz(k)) / h[2];
+            auto fz = [&](int kk) {
+              return 0.5 * (a1[id(i, j, kk)] + a1[id(i, j, kk - 1)]) * w[id(i, j, kk)];
+            };
+            auto fy = [&](int jj) {
+              return (jj == 0 || jj == ny)
+                         ? 0.0
+                         : 0.5 * (a1[id(i, jj, k)] + a1[id(i, jj - 1, k)]) * v[id(i, jj, k)];
+            };
+            const double r =
+                rate + (fx(i + 1) - fx(i)) / h[0] + (fy(j + 1) - fy(j)) / h[1] + (fz(k + 1) - fz(k)) / h[2];
             dmax = std::max(dmax, std::abs(r)), rate_max = std::max(rate_max, std::abs(rate));
           }
-      std::printf("first step: max |d alpha/dt| = %.3g 1/s, max |d alpha/dt + div(alpha u)| = %.3g 1/s\n", rate_max,
-                  dmax);
+      std::printf("first step: max |d alpha/dt| = %.3g 1/s, max |d alpha/dt + div(alpha u)| = %.3g 1/s\n",
+                  rate_max, dmax);
       EXPECT_GT(rate_max, 1.0);
       EXPECT_LE(dmax, 1e-7);
     }
@@ -87,7 +97,8 @@ TEST(FluxController, HoldsTargetThroughMeanPressureGradient) {
   {
     // non-uniform alpha_f: the target is held every step
     FluidSolver f(s);
-    f.set_fluid_fraction([](double x, double, double z) { return 0.8 + 0.1 * std::sin(M_PI * x) * std::cos(M_PI * z); });
+    f.set_fluid_fraction(
+        [](double x, double, double z) { return 0.8 + 0.1 * std::sin(M_PI * x) * std::cos(M_PI * z); });
     for (int n = 0; n < 40; ++n) {
       f.step(0.05);
       ASSERT_NEAR(f.mean_flux_z() / 0.05, 1.0, 1e-6) << "step " << n;
@@ -107,7 +118,8 @@ TEST(FluxController, HoldsTargetThroughMeanPressureGradient) {
   const auto w = f.profile_y(2);
   const double h = 1.0 / 6, nu = 0.05;
   const double G_balance = -1.0 - nu * (2.0 * w[0] / h + 2.0 * w[5] / h);  // rho = 1, W = 1
-  std::printf("G = %.10g Pa/m, from the wall-shear balance %.10g Pa/m\n", f.mean_pressure_gradient_pa_m(), G_balance);
+  std::printf("G = %.10g Pa/m, from the wall-shear balance %.10g Pa/m\n", f.mean_pressure_gradient_pa_m(),
+              G_balance);
   EXPECT_NEAR(f.mean_pressure_gradient_pa_m() / G_balance, 1.0, 1e-6);
 }
 

@@ -21,7 +21,8 @@ namespace {
 namespace fs = std::filesystem;
 
 CaseParams small_case() {
-  CaseParams p = parse_case_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/cases/inclined_settling_smoke.toml");
+  CaseParams p =
+      parse_case_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/cases/inclined_settling_smoke.toml");
   apply_override(p, "time.end=0.06");
   apply_override(p, "time.average_from=0.02");
   apply_override(p, "time.checkpoint_every=0.025");
@@ -63,7 +64,8 @@ void expect_resume_is_bitwise(const CaseParams& p, const std::string& tag) {
   const auto sa = summary(a), sb = summary(b);
   EXPECT_EQ(sb["resumed_from_checkpoint"], true);
   EXPECT_EQ(sa["mean_settling_velocity_m_s"].get<double>(), sb["mean_settling_velocity_m_s"].get<double>());
-  EXPECT_EQ(sa["settling_velocity_stderr_m_s"].get<double>(), sb["settling_velocity_stderr_m_s"].get<double>());
+  EXPECT_EQ(sa["settling_velocity_stderr_m_s"].get<double>(),
+            sb["settling_velocity_stderr_m_s"].get<double>());
   EXPECT_EQ(sa["cfd_steps"], sb["cfd_steps"]);
   // The final states: every particle array, every fluid field, the statistics.
   const auto fa = io::latest_checkpoint(a), fb = io::latest_checkpoint(b);

@@ -4,10 +4,10 @@
 
 namespace boycott::particles::testing {
 
-inline constexpr double kD = 0.6e-3;      // m, Table III diameter
-inline constexpr double kR = 0.3e-3;      // m
-inline constexpr double kRho = 2650.0;    // kg/m^3
-inline constexpr double kKn = 3.5;        // N/m
+inline constexpr double kD = 0.6e-3;    // m, Table III diameter
+inline constexpr double kR = 0.3e-3;    // m
+inline constexpr double kRho = 2650.0;  // kg/m^3
+inline constexpr double kKn = 3.5;      // N/m
 
 /// A cube of side L, periodic in x, z (and y unless `walls`), no gravity, Table III contact.
 inline DemConfig make_config(double L, bool walls, double e, double mu, double mu_r, double dt,
@@ -28,6 +28,8 @@ inline DemConfig make_config(double L, bool walls, double e, double mu, double m
   return c;
 }
 
-inline double particle_mass() { return kRho * 4.0 / 3.0 * kPi * kR * kR * kR; }
+inline double particle_mass() {
+  return kRho * 4.0 / 3.0 * kPi * kR * kR * kR;
+}
 
 }  // namespace boycott::particles::testing

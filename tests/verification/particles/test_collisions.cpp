@@ -59,7 +59,9 @@ double clipped_restitution_analytic(double e, double m_eff) {
   const double w = std::sqrt(kKn / m_eff), zeta = gamma / (2.0 * std::sqrt(m_eff * kKn));
   const double wd = w * std::sqrt(1.0 - zeta * zeta);
   auto delta = [&](double t) { return std::exp(-zeta * w * t) * std::sin(wd * t) / wd; };
-  auto ddelta = [&](double t) { return std::exp(-zeta * w * t) * (std::cos(wd * t) - zeta * w / wd * std::sin(wd * t)); };
+  auto ddelta = [&](double t) {
+    return std::exp(-zeta * w * t) * (std::cos(wd * t) - zeta * w / wd * std::sin(wd * t));
+  };
   auto force = [&](double t) { return kKn * delta(t) + gamma * ddelta(t); };
   double a = 1e-9, b = kPi / wd;  // force > 0 just after impact, < 0 at the overlap's end
   for (int it = 0; it < 200; ++it) {
@@ -75,7 +77,9 @@ double clipped_restitution_analytic(double e, double m_eff) {
 /// 0.9 to 0.05 %; for e = 0.1 the strong damping makes the force jump by gamma v at the first and
 /// last step of the contact, and where inside a step the contact begins then moves e by up to
 /// 4.5 % at 100 steps (3 % at 150), so that case is resolved with 200 steps.
-int steps_per_contact(double e) { return e < 0.3 ? 200 : 100; }
+int steps_per_contact(double e) {
+  return e < 0.3 ? 200 : 100;
+}
 
 class RestitutionTest : public ::testing::TestWithParam<double> {};
 
@@ -90,8 +94,10 @@ TEST_P(RestitutionTest, PairReboundsWithRestitution) {
     worst = std::max(worst, std::abs(got - e) / e);
   }
   const double prod = pair_restitution(e, 20e-6, false);
-  std::printf("[ report ] pair e = %.2f: worst error %.3f %% at tc/%d, %.5f at dt = 20 us (%.2f %% error, %.0f steps per contact)\n",
-              e, 100 * worst, steps_per_contact(e), prod, 100.0 * (prod - e) / e, tc / 20e-6);
+  std::printf(
+      "[ report ] pair e = %.2f: worst error %.3f %% at tc/%d, %.5f at dt = 20 us (%.2f %% error, %.0f steps "
+      "per contact)\n",
+      e, 100 * worst, steps_per_contact(e), prod, 100.0 * (prod - e) / e, tc / 20e-6);
 }
 
 TEST_P(RestitutionTest, WallReboundsWithRestitution) {
@@ -104,8 +110,8 @@ TEST_P(RestitutionTest, WallReboundsWithRestitution) {
     worst = std::max(worst, std::abs(got - e) / e);
   }
   const double prod = wall_restitution(e, 20e-6, false);
-  std::printf("[ report ] wall e = %.2f: worst error %.3f %% at tc/%d, %.5f at dt = 20 us (%.2f %% error)\n", e,
-              100 * worst, steps_per_contact(e), prod, 100.0 * (prod - e) / e);
+  std::printf("[ report ] wall e = %.2f: worst error %.3f %% at tc/%d, %.5f at dt = 20 us (%.2f %% error)\n",
+              e, 100 * worst, steps_per_contact(e), prod, 100.0 * (prod - e) / e);
 }
 
 TEST_P(RestitutionTest, ClippedNormalForceReboundsWithItsAnalyticRestitution) {

@@ -39,7 +39,8 @@ TEST(ElasticGas, ConservesEnergyAndMomentum) {
   double max_drift = 0.0;
   for (int n = 1; n <= 100000; ++n) {
     dem.step();
-    if (n % 1000 == 0) max_drift = std::max(max_drift, std::abs(dem.kinetic_energy_j() + dem.spring_energy_j() - e0) / e0);
+    if (n % 1000 == 0)
+      max_drift = std::max(max_drift, std::abs(dem.kinetic_energy_j() + dem.spring_energy_j() - e0) / e0);
   }
   std::printf("[ report ] elastic gas: max |dE|/E over 1e5 steps = %.3e, %lld rebuilds\n", max_drift,
               static_cast<long long>(dem.rebuilds()));

@@ -51,8 +51,8 @@ std::map<std::int64_t, State> run(const DemConfig& cfg, const std::function<void
   const auto& s = dem.particles();
   std::vector<double> mine;
   for (std::size_t i = 0; i < s.n_local; ++i)
-    mine.insert(mine.end(), {static_cast<double>(s.id[i]), s.x[i], s.y[i], s.z[i], s.vx[i], s.vy[i], s.vz[i], s.wx[i],
-                             s.wy[i], s.wz[i]});
+    mine.insert(mine.end(), {static_cast<double>(s.id[i]), s.x[i], s.y[i], s.z[i], s.vx[i], s.vy[i], s.vz[i],
+                             s.wx[i], s.wy[i], s.wz[i]});
   std::vector<double> all = mine;
   if (parallel) {
     const int n = static_cast<int>(mine.size());
@@ -62,13 +62,14 @@ std::map<std::int64_t, State> run(const DemConfig& cfg, const std::function<void
     int total = 0;
     for (int r = 0; r < size; ++r) displs[r] = total, total += counts[r];
     all.resize(static_cast<std::size_t>(total));
-    MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, MPI_COMM_WORLD);
+    MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE,
+                   MPI_COMM_WORLD);
     if (migrations) *migrations = global_sum(MPI_COMM_WORLD, dem.migrations());
   }
   std::map<std::int64_t, State> out;
   for (std::size_t k = 0; k + 10 <= all.size(); k += 10)
-    out[static_cast<std::int64_t>(all[k])] =
-        State{all[k + 1], all[k + 2], all[k + 3], all[k + 4], all[k + 5], all[k + 6], all[k + 7], all[k + 8], all[k + 9]};
+    out[static_cast<std::int64_t>(all[k])] = State{all[k + 1], all[k + 2], all[k + 3], all[k + 4], all[k + 5],
+                                                   all[k + 6], all[k + 7], all[k + 8], all[k + 9]};
   return out;
 }
 

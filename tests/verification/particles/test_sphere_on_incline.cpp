@@ -15,9 +15,9 @@ namespace {
 constexpr double kG = 9.81, kMu = 0.6, kMuR = 0.1;
 
 struct InclineRun {
-  double accel_m_s2;        ///< mean acceleration along the slope over [t1, t2]
-  double displacement_m;    ///< distance travelled along the slope over [t1, t2]
-  double max_speed_m_s;     ///< largest |v| over [t1, t2]
+  double accel_m_s2;      ///< mean acceleration along the slope over [t1, t2]
+  double displacement_m;  ///< distance travelled along the slope over [t1, t2]
+  double max_speed_m_s;   ///< largest |v| over [t1, t2]
 };
 
 /// The wall y = 0 is the plane; gravity (0, -g cos th, -g sin th) pulls down the slope (-z).
@@ -53,8 +53,8 @@ InclineRun run_incline(double tan_theta, double t1, double t2) {
 TEST(SphereOnIncline, StaysAtRestBelowRollingFriction) {
   // tan(theta) = 0.05 < mu_r = 0.1: the rolling torque can hold the sphere.
   const auto r = run_incline(0.05, 0.1, 0.6);
-  std::printf("[ report ] tan th = 0.05: displacement %.3e m, max speed %.3e m/s over 0.5 s\n", r.displacement_m,
-              r.max_speed_m_s);
+  std::printf("[ report ] tan th = 0.05: displacement %.3e m, max speed %.3e m/s over 0.5 s\n",
+              r.displacement_m, r.max_speed_m_s);
   // At rest: over 0.5 s it moves less than 1e-3 of a diameter (it would roll 1.6e-1 m at the
   // rolling acceleration of tan th = 0.5 in the same time).
   EXPECT_LT(std::abs(r.displacement_m), 1e-3 * kD);
@@ -102,6 +102,7 @@ TEST(RollingFriction, SpinningPairDeceleratesAtEq11Rate) {
   const double w_half = s.wz[i0];
   for (long long n = 0; n < 2 * n_half; ++n) dem.step();
   EXPECT_LT(std::abs(s.wz[i0]), 1e-3 * W0) << "rotation did not come to rest";
-  std::printf("[ report ] spinning pair: w(t_stop/2) = %.4f rad/s (Eq. 11: %.4f), w(1.5 t_stop) = %.2e rad/s\n",
-              w_half, expect_half, s.wz[i0]);
+  std::printf(
+      "[ report ] spinning pair: w(t_stop/2) = %.4f rad/s (Eq. 11: %.4f), w(1.5 t_stop) = %.2e rad/s\n",
+      w_half, expect_half, s.wz[i0]);
 }

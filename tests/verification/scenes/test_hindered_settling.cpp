@@ -18,7 +18,8 @@
 namespace boycott::scenes {
 namespace {
 
-nlohmann::json run_file(const std::string& file, const std::string& tag, const std::vector<std::string>& sets) {
+nlohmann::json run_file(const std::string& file, const std::string& tag,
+                        const std::vector<std::string>& sets) {
   CaseParams p = parse_case_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/cases/" + file);
   for (const auto& s : sets) apply_override(p, s);
   RunContext ctx;
@@ -34,13 +35,16 @@ TEST(HinderedSettling, PeriodicSuspensionWithinFifteenPercentOfRichardsonZaki) {
   // 1 x 1 x 2 cm periodic box (studies/cases/hindered_settling.toml), 0.3 s averaged over
   // 0.1-0.3 s: <w_p> is steady after ~0.05 s (response time 0.018 s).
   for (const char* a : {"0.05", "0.1", "0.15"}) {
-    const auto j = run_file("hindered_settling.toml", a,
-                            {std::string("particles.volume_fraction=") + a, "time.end=0.3", "time.average_from=0.1"});
+    const auto j =
+        run_file("hindered_settling.toml", a,
+                 {std::string("particles.volume_fraction=") + a, "time.end=0.3", "time.average_from=0.1"});
     const double err = j["hindered_settling_rel_error"].get<double>();
-    std::printf("[ report ] alpha_p %s: N %d, <<w_p>> %.5f +- %.5f m/s, Richardson-Zaki %.5f m/s (%+.1f %%), wall %.1f s\n",
-                a, j["particle_count"].get<int>(), j["mean_settling_velocity_m_s"].get<double>(),
-                j["settling_velocity_stderr_m_s"].get<double>(), j["hindered_settling_reference_m_s"].get<double>(),
-                100.0 * err, j["wall_time_s"].get<double>());
+    std::printf(
+        "[ report ] alpha_p %s: N %d, <<w_p>> %.5f +- %.5f m/s, Richardson-Zaki %.5f m/s (%+.1f %%), wall "
+        "%.1f s\n",
+        a, j["particle_count"].get<int>(), j["mean_settling_velocity_m_s"].get<double>(),
+        j["settling_velocity_stderr_m_s"].get<double>(), j["hindered_settling_reference_m_s"].get<double>(),
+        100.0 * err, j["wall_time_s"].get<double>());
     EXPECT_LE(std::abs(err), 0.15) << "alpha_p = " << a;
     EXPECT_LT(std::abs(j["mean_slurry_velocity_m_s"].get<double>()), 1e-8);
   }
@@ -56,9 +60,10 @@ TEST(HinderedSettling, NarrowVerticalChannelReportedBesideRichardsonZaki) {
   const double r = std::pow(re, 0.9), n = (5.1 + 0.27 * r) / (1.0 + 0.1 * r);
   const double rz = vt * std::pow(1.0 - j["solid_fraction"].get<double>(), n);
   const double wp = j["mean_settling_velocity_m_s"].get<double>();
-  std::printf("[ report ] narrow vertical channel alpha_p %.3f: <<w_p>> %.5f m/s against Richardson-Zaki %.5f m/s "
-              "(ratio %.3f)\n",
-              j["solid_fraction"].get<double>(), wp, -rz, std::abs(wp) / rz);
+  std::printf(
+      "[ report ] narrow vertical channel alpha_p %.3f: <<w_p>> %.5f m/s against Richardson-Zaki %.5f m/s "
+      "(ratio %.3f)\n",
+      j["solid_fraction"].get<double>(), wp, -rz, std::abs(wp) / rz);
   EXPECT_LT(wp, 0.0);
 }
 

@@ -36,9 +36,10 @@ TEST(SedimentTransport, BulkVelocityHeldBedPouredAndTransportDownstream) {
   std::ifstream in(ctx.out_dir / "summary.json");
   const auto j = nlohmann::json::parse(in);
   const double tau = j["shields_stress"].get<double>(), q = j["q_star"].get<double>();
-  std::printf("[ report ] 20 ms after the start: q* %.4g, tau* %.4g, bed height %.4g m, poured %.3g s, wall %.1f s\n", q,
-              tau, j["bed_height_m"].get<double>(), j["bed_pouring_time_s"].get<double>(),
-              j["wall_time_s"].get<double>());
+  std::printf(
+      "[ report ] 20 ms after the start: q* %.4g, tau* %.4g, bed height %.4g m, poured %.3g s, wall %.1f s\n",
+      q, tau, j["bed_height_m"].get<double>(), j["bed_pouring_time_s"].get<double>(),
+      j["wall_time_s"].get<double>());
   EXPECT_NEAR(j["mean_flux_z_m_s"].get<double>(), 0.8, 1e-6);
   EXPECT_LT(j["bed_pouring_time_s"].get<double>(), 2.0);  // the bed came to rest
   EXPECT_GT(q, 0.0);
@@ -59,7 +60,8 @@ TEST(SedimentTransport, BulkVelocityHeldBedPouredAndTransportDownstream) {
   double q_sum = 0.0, solid = 0.0, y, w, a, wp, f;
   char c;
   int rows = 0;
-  while (prof >> y >> c >> w >> c >> a >> c >> wp >> c >> f) q_sum += f * 1e-3, solid += a * 1e-3 * 0.005 * 0.01, ++rows;
+  while (prof >> y >> c >> w >> c >> a >> c >> wp >> c >> f)
+    q_sum += f * 1e-3, solid += a * 1e-3 * 0.005 * 0.01, ++rows;
   EXPECT_EQ(rows, 40);
   EXPECT_NEAR(q_sum, j["transport_rate_m2_s"].get<double>(), 1e-9 * std::abs(q_sum));
   EXPECT_NEAR(solid, vp, 1e-9 * vp);
@@ -67,9 +69,9 @@ TEST(SedimentTransport, BulkVelocityHeldBedPouredAndTransportDownstream) {
 
 TEST(SedimentTransport, StoppedAndResumedRunEqualsTheUninterruptedOneBitwise) {
   CaseParams p = parse_case_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/cases/sediment_transport.toml");
-  for (const char* s : {"domain.length_x=0.005", "domain.height_z=0.01", "domain.cells=[5, 40, 10]",
-                        "particles.count=2000", "time.end=0.01", "time.average_from=0.004",
-                        "time.checkpoint_every=1.0"})
+  for (const char* s :
+       {"domain.length_x=0.005", "domain.height_z=0.01", "domain.cells=[5, 40, 10]", "particles.count=2000",
+        "time.end=0.01", "time.average_from=0.004", "time.checkpoint_every=1.0"})
     apply_override(p, s);
   auto summary = [](const std::filesystem::path& d) {
     std::ifstream in(d / "summary.json");
@@ -96,8 +98,8 @@ TEST(SedimentTransport, StoppedAndResumedRunEqualsTheUninterruptedOneBitwise) {
   ASSERT_EQ(run_case(p, b), 0);
   const auto ja = summary(a.out_dir), jb = summary(b.out_dir);
   EXPECT_TRUE(jb["resumed_from_checkpoint"].get<bool>());
-  for (const char* k : {"q_star", "q_star_stderr", "shields_stress", "mean_flux_z_m_s", "mean_settling_velocity_m_s",
-                        "bed_pouring_time_s", "max_kinetic_energy_j"})
+  for (const char* k : {"q_star", "q_star_stderr", "shields_stress", "mean_flux_z_m_s",
+                        "mean_settling_velocity_m_s", "bed_pouring_time_s", "max_kinetic_energy_j"})
     EXPECT_EQ(ja[k].get<double>(), jb[k].get<double>()) << k;
   auto text = [](const std::filesystem::path& f) {
     std::ifstream in(f);
@@ -109,7 +111,8 @@ TEST(SedimentTransport, StoppedAndResumedRunEqualsTheUninterruptedOneBitwise) {
 
 TEST(SedimentTransport, RefusesAnInclinedOrPeriodicChannel) {
   for (const char* bad : {"gravity.angle_deg=30.0", "domain.periodic_y=true"}) {
-    CaseParams p = parse_case_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/cases/sediment_transport.toml");
+    CaseParams p =
+        parse_case_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/cases/sediment_transport.toml");
     apply_override(p, bad);
     RunContext ctx;
     ctx.quiet = true;

@@ -3,9 +3,9 @@
 // are refused before anything is written, naming the limit; a NaN stops the run before it is
 // checkpointed. Reduced boxes (a few hundred to two thousand particles, 0.1 s) so that the whole
 // suite takes about a minute.
-#include <algorithm>
 #include <gtest/gtest.h>
 #include <hdf5.h>
+#include <algorithm>
 
 #include <atomic>
 #include <cmath>
@@ -67,7 +67,8 @@ nlohmann::json read_summary(const fs::path& dir) {
 double terminal_speed(const CaseParams& p) {
   return coupling::visit_drag_law(p.forces.drag, [&](const auto& law) {
     return coupling::terminal_slip_speed(law, 1.0, p.particles.diameter_m, p.particles.density_kg_m3,
-                                         p.fluid.density_kg_m3, p.fluid.viscosity_pa_s, p.gravity.magnitude_m_s2);
+                                         p.fluid.density_kg_m3, p.fluid.viscosity_pa_s,
+                                         p.gravity.magnitude_m_s2);
   });
 }
 
@@ -83,11 +84,13 @@ void expect_stable(const std::string& tag, const std::vector<std::string>& sets)
   const auto j = read_summary(ctx.out_dir);
   const double wt = terminal_speed(p);
   const double bound = p.particles.count * 0.5 * p.particle_mass_kg() * (10.0 * wt) * (10.0 * wt);
-  std::printf("[ report ] %-22s N %6lld  w_t %.4g m/s  <<w_p>> %+.4g m/s  alpha_f [%.4f, %.4f]  KE_max/bound %.3g  "
-              "wall %.1f s\n",
-              tag.c_str(), static_cast<long long>(p.particles.count), wt, j["mean_settling_velocity_m_s"].get<double>(),
-              j["min_fluid_fraction"].get<double>(), j["max_fluid_fraction"].get<double>(),
-              j["max_kinetic_energy_j"].get<double>() / bound, j["wall_time_s"].get<double>());
+  std::printf(
+      "[ report ] %-22s N %6lld  w_t %.4g m/s  <<w_p>> %+.4g m/s  alpha_f [%.4f, %.4f]  KE_max/bound %.3g  "
+      "wall %.1f s\n",
+      tag.c_str(), static_cast<long long>(p.particles.count), wt,
+      j["mean_settling_velocity_m_s"].get<double>(), j["min_fluid_fraction"].get<double>(),
+      j["max_fluid_fraction"].get<double>(), j["max_kinetic_energy_j"].get<double>() / bound,
+      j["wall_time_s"].get<double>());
   EXPECT_EQ(j["status"], "completed") << tag;
   EXPECT_NEAR(j["simulated_time_s"].get<double>(), p.time.end_s, 1e-9) << tag;
   EXPECT_GT(j["min_fluid_fraction"].get<double>(), 0.0) << tag;
@@ -108,9 +111,9 @@ TEST(StiffAndExtremeCases, LowViscosityWithSubgridModel) {
 TEST(StiffAndExtremeCases, ViscousFluidWithTinyParticles) {
   // 1 Pa s, d = 0.1 mm: response time ~1 us against dt_dem = 10 us (spring limit 12.5 us); a
   // 2 x 6 x 2 mm channel, cells 2 d wide, 5180 particles (the base solid fraction).
-  expect_stable("viscous_tiny", {"fluid.viscosity=1.0", "particles.diameter=1.0e-4",
-                                 "domain.length_x=0.002", "domain.height_z=0.002", "numerics.neighbor_skin=5.0e-5",
-                                 "time.dt_dem=1.0e-5"});
+  expect_stable("viscous_tiny",
+                {"fluid.viscosity=1.0", "particles.diameter=1.0e-4", "domain.length_x=0.002",
+                 "domain.height_z=0.002", "numerics.neighbor_skin=5.0e-5", "time.dt_dem=1.0e-5"});
 }
 
 TEST(StiffAndExtremeCases, NearlyNeutrallyBuoyantParticles) {
@@ -123,8 +126,8 @@ TEST(StiffAndExtremeCases, HeavyParticles) {
 
 TEST(StiffAndExtremeCases, LargeParticlesAQuarterOfTheChannelWidth) {
   // d = 1.5 mm in W = 6 mm (d/W = 0.25): one particle fills 0.74 of a 1 mm cell (a warning).
-  expect_stable("large_particles", {"particles.diameter=1.5e-3", "domain.length_x=0.02", "domain.height_z=0.02",
-                                    "domain.cells=[20, 6, 20]"});
+  expect_stable("large_particles", {"particles.diameter=1.5e-3", "domain.length_x=0.02",
+                                    "domain.height_z=0.02", "domain.cells=[20, 6, 20]"});
 }
 
 TEST(StiffAndExtremeCases, DenseBedAtHalfSolidFraction) {
@@ -139,7 +142,8 @@ TEST(StiffAndExtremeCases, HorizontalAndVerticalChannel) {
 TEST(StiffAndExtremeCases, CappedSimpleIterationsAreCountedInTheSummary) {
   // A run with SIMPLE capped below convergence says so (the fluid steps it did not converge),
   // and the count survives a resume; the default run converges every step.
-  const CaseParams capped = small_case({"numerics.simple_max_iterations=1", "time.end=0.02", "time.average_from=0.01", "time.checkpoint_every=0.01"});
+  const CaseParams capped = small_case({"numerics.simple_max_iterations=1", "time.end=0.02",
+                                        "time.average_from=0.01", "time.checkpoint_every=0.01"});
   RunContext ctx;
   ctx.quiet = true;
   ctx.out_dir = fresh_dir("capped_simple");
@@ -168,7 +172,8 @@ TEST(StiffAndExtremeCases, CappedSimpleIterationsAreCountedInTheSummary) {
 
 // ---- refusals: at once, naming the limit, nothing written ----
 
-void expect_refused(const std::string& tag, const std::vector<std::string>& sets, const std::string& must_name) {
+void expect_refused(const std::string& tag, const std::vector<std::string>& sets,
+                    const std::string& must_name) {
   const auto dir = fresh_dir(tag);
   std::string message;
   try {
@@ -197,8 +202,8 @@ TEST(StiffAndExtremeCases, ImpossibleCasesAreRefusedNamingTheLimit) {
   expect_refused("negative_particle_density", {"particles.density=-2650.0"}, "particles.density");
   // Pre-flight: one particle would fill more than a cell with the one-cell kernel.
   expect_refused("particle_fills_a_cell",
-                 {"particles.diameter=1.5e-3", "domain.cells=[40, 6, 40]", "numerics.void_fraction_kernel=\"cell\"",
-                  "particles.count=10"},
+                 {"particles.diameter=1.5e-3", "domain.cells=[40, 6, 40]",
+                  "numerics.void_fraction_kernel=\"cell\"", "particles.count=10"},
                  "fills");
 }
 
