@@ -1,5 +1,6 @@
 #include "coupling/coupled_system.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -9,11 +10,13 @@
 
 #include "core/constants.hpp"
 #include "core/error.hpp"
+#include "core/timers.hpp"
 #include "coupling/slab_exchange.hpp"
 
 namespace boycott::coupling {
 
-CoupledSystem::CoupledSystem(const CaseParams& p, const CoupledOptions& opt) : p_(p), opt_(opt) {
+CoupledSystem::CoupledSystem(const CaseParams& p, const CoupledOptions& opt, MPI_Comm comm)
+    : p_(p), opt_(opt) {
   auto dc = particles::DemConfig::from_case(p);
   dc.track_drag_impulse = true;
   dem_ = std::make_unique<particles::DemSystem>(dc);
@@ -21,9 +24,17 @@ CoupledSystem::CoupledSystem(const CaseParams& p, const CoupledOptions& opt) : p
   // The fluid feels gravity (alpha_f rho_f g in set II) and, in z, the driving gradient G.
   fs.body_acceleration_m_s2 = p.gravity_vector();
   if (std::isfinite(opt.target_mean_flux_z_m_s)) fs.target_mean_flux_z_m_s = opt.target_mean_flux_z_m_s;
-  const MPI_Comm comm = PETSC_COMM_WORLD;
   MPI_Comm_size(comm, &ranks_);
-  if (ranks_ > 1) check_rank_count(fs.grid, ranks_);
+  if (ranks_ > 1) {
+    check_rank_count(fs.grid, ranks_);
+    // A particle reaches at most half the skin past its slab before it moves rank: within the
+    // one cell the coupling's window allows for.
+    if (!(0.5 * p.numerics.neighbor_skin_m < fs.grid.dx(2)))
+      throw InputError(
+          fmt::format("numerics.neighbor_skin = {} m: on several ranks half of it must be below the "
+                      "cell height {} m",
+                      p.numerics.neighbor_skin_m, fs.grid.dx(2)));
+  }
   fluid_ = std::make_unique<fluid::FluidSolver>(fs, comm);
   std::shared_ptr<const SlabExchange> window;
   if (ranks_ > 1) {
@@ -146,10 +157,17 @@ CoupledStep CoupledSystem::step() {
       q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
     fluid_->set_target_mean_flux_z(-global_sum(q) / p_.box_volume_m3());
   }
+  if (ranks_ > 1) {
+    // The particle phases end here on every rank; the time a rank waits for the slowest one is
+    // its share of the load imbalance (the fluid's own collectives would hide it otherwise).
+    const auto tw = std::chrono::steady_clock::now();
+    MPI_Barrier(fluid_->comm());
+    seconds_wait_ += seconds_since(tw);
+  }
   const auto t0 = std::chrono::steady_clock::now();
   st.fluid = fluid_->step(dt);
   if (!st.fluid.converged) ++unconverged_;
-  seconds_fluid_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  seconds_fluid_ += seconds_since(t0);
   dt_prev_ = dt;
   time_ += dt;
   ++steps_;
@@ -221,6 +239,41 @@ void CoupledSystem::restore_counters(const CoupledCounters& c) {
   steps_ = c.steps;
   unconverged_ = c.unconverged_fluid_steps;
   fallbacks_before_ = c.pressure_fallbacks - fluid_->pressure_fallbacks();
+}
+
+nlohmann::json CoupledSystem::rank_report() const {
+  const std::vector<std::pair<const char*, double>> phases = {{"fluid", seconds_fluid_},
+                                                              {"coupling_sample", coupler_->seconds_sample},
+                                                              {"coupling_deposit", coupler_->seconds_deposit},
+                                                              {"dem_contacts", dem_->seconds_force},
+                                                              {"neighbor_search", dem_->seconds_neighbor},
+                                                              {"integration", dem_->seconds_integrate},
+                                                              {"ghost_refresh", dem_->seconds_ghosts},
+                                                              {"waiting", seconds_wait_}};
+  std::vector<double> mine{static_cast<double>(dem_->particles().n_local)};
+  for (const auto& ph : phases) mine.push_back(ph.second);
+  const int n = static_cast<int>(mine.size());
+  std::vector<double> all(static_cast<std::size_t>(n) * ranks_);
+  if (ranks_ > 1)
+    MPI_Allgather(mine.data(), n, MPI_DOUBLE, all.data(), n, MPI_DOUBLE, fluid_->comm());
+  else
+    all = mine;
+  nlohmann::json j;
+  j["count"] = ranks_;
+  double pmin = all[0], pmax = all[0], psum = 0.0;
+  nlohmann::json per = nlohmann::json::array();
+  for (int r = 0; r < ranks_; ++r) {
+    const double* v = all.data() + static_cast<std::size_t>(r) * n;
+    pmin = std::min(pmin, v[0]), pmax = std::max(pmax, v[0]), psum += v[0];
+    nlohmann::json pr;
+    pr["rank"] = r;
+    pr["particles"] = static_cast<std::int64_t>(v[0]);
+    for (std::size_t k = 0; k < phases.size(); ++k) pr["seconds"][phases[k].first] = v[1 + k];
+    per.push_back(pr);
+  }
+  j["particles"] = {{"min", pmin}, {"mean", psum / ranks_}, {"max", pmax}};
+  j["per_rank"] = per;
+  return j;
 }
 
 void CoupledSystem::report_timers(ModelTimers& t) const {

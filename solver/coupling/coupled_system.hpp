@@ -8,6 +8,8 @@
 #include <limits>
 #include <memory>
 
+#include <nlohmann/json.hpp>
+
 #include "core/case_params.hpp"
 #include "core/timers.hpp"
 #include "coupling/coupler.hpp"
@@ -40,7 +42,8 @@ struct CoupledCounters {
 
 class CoupledSystem {
  public:
-  CoupledSystem(const CaseParams& p, const CoupledOptions& opt);
+  /// comm: the ranks that share the case (PETSc's world by default).
+  CoupledSystem(const CaseParams& p, const CoupledOptions& opt, MPI_Comm comm = PETSC_COMM_WORLD);
 
   particles::DemSystem& dem() { return *dem_; }
   const particles::DemSystem& dem() const { return *dem_; }
@@ -83,6 +86,10 @@ class CoupledSystem {
   /// Restores the counters of a checkpoint (the engines' states are imported separately).
   void restore_counters(const CoupledCounters& c);
 
+  /// Particles per rank (min, mean, max) and each rank's seconds per phase in this process,
+  /// communication inside them; "waiting" is the time a rank waited for the others at the end
+  /// of the particle phases. Collective; the same on every rank.
+  nlohmann::json rank_report() const;
   /// Adds the wall time of each part to the timers (call once at the end).
   void report_timers(ModelTimers& t) const;
   /// Registers the active models in the timers (what this run switches on).
@@ -104,7 +111,7 @@ class CoupledSystem {
   double time_ = 0.0, dt_prev_ = 0.0;
   std::int64_t steps_ = 0;
   std::int64_t unconverged_ = 0, fallbacks_before_ = 0;  // counts before this process: from the checkpoint
-  double seconds_fluid_ = 0.0;
+  double seconds_fluid_ = 0.0, seconds_wait_ = 0.0;
 };
 
 }  // namespace boycott::coupling

@@ -102,6 +102,7 @@ int run_ergun(const CaseParams& p, RunContext& ctx) {
   sb.wall_time_s = clock.seconds();
   sb.particle_steps = 0.0;
   auto j = make_summary(p, sb, timers);
+  j["ranks"] = run.rank_report();
   j["points"] = points;
   j["max_rel_error_f_star"] = max_err;
   j["porosity"] = porosity;

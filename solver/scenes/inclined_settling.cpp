@@ -179,6 +179,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   sb.mean_settling_velocity_m_s = wp_avg.count() ? wp_avg.mean() : kUnset;
   sb.settling_velocity_stderr_m_s = wp_avg.stderr_of_mean();
   auto j = make_summary(p, sb, timers);
+  j["ranks"] = run.rank_report();
   j["mean_fluid_velocity_m_s"] = wf_avg.count() ? wf_avg.mean() : kUnset;
   j["mean_slurry_velocity_m_s"] = slurry_avg.count() ? slurry_avg.mean() : kUnset;
   j["max_abs_slurry_velocity_m_s"] = slurry_max;

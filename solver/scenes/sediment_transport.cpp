@@ -255,6 +255,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   sb.mean_settling_velocity_m_s = vp_avg.count() ? vp_avg.mean() : kUnset;
   sb.settling_velocity_stderr_m_s = vp_avg.stderr_of_mean();
   auto j = make_summary(p, sb, timers);
+  j["ranks"] = run.rank_report();
   const double q = q_avg.count() ? q_avg.mean() : kUnset;
   const double Gm = g_avg.count() ? g_avg.mean() : kUnset;
   const double tau_b = -Gm * (H - h_bed);

@@ -93,6 +93,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   sb.mean_settling_velocity_m_s = wt;
   sb.settling_velocity_stderr_m_s = wp_avg.stderr_of_mean();
   auto j = make_summary(p, sb, timers);
+  j["ranks"] = run.rank_report();
   j["terminal_velocity_m_s"] = wt;
   j["terminal_velocity_reference_m_s"] = ref_wz;
   j["rel_error"] = is_set(ref_wz) && ref_wz != 0.0 ? (wt - ref_wz) / ref_wz : kUnset;
