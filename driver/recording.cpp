@@ -34,6 +34,19 @@ std::string last_line(const fs::path& log, std::uintmax_t offset_bytes) {
   return last;
 }
 
+/// Whether this attempt wrote a summary.json of its case with status "interrupted".
+bool wrote_interrupted_summary(const RunningCase& run) {
+  std::error_code ec;
+  const auto mtime = fs::last_write_time(run.dir / "summary.json", ec);
+  if (ec || (run.summary_before && *run.summary_before == mtime)) return false;
+  try {
+    const auto summary = nlohmann::json::parse(read_text(run.dir / "summary.json"));
+    return summary.value("status", "") == "interrupted" && summary.value("case_id", "") == run.c->id;
+  } catch (const nlohmann::json::exception&) {
+    return false;
+  }
+}
+
 }  // namespace
 
 AttemptEnd record_attempt_end(Database& db, const RunningCase& run, int exit_code) {
@@ -53,6 +66,9 @@ AttemptEnd record_attempt_end(Database& db, const RunningCase& run, int exit_cod
     finish_attempt(db, run.attempt, 1, why);
     return {AttemptEnd::Kind::kFailed, 1, why};
   }
+  // A case run under mpirun that stopped on the driver's signal: mpirun, signalled too, exits
+  // with 1 whatever its ranks returned; the summary this attempt wrote says what happened.
+  if (exit_code != kExitInterrupted && wrote_interrupted_summary(run)) exit_code = kExitInterrupted;
   if (exit_code == kExitInterrupted || exit_code == 128 + SIGTERM || exit_code == 128 + SIGINT) {
     finish_attempt(db, run.attempt, exit_code,
                    exit_code == kExitInterrupted ? "interrupted after a checkpoint"

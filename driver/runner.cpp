@@ -85,14 +85,14 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
         run_folder_unheld(fs::path(runs_root(db_path)) / c.id))
       st = "interrupted";
     ++counts[st];
-    lines +=
-        fmt::format("{:<16} {:<12} {:6.1f} {:<12} {}\n", c.id, c.group, c.params.gravity.angle_deg, st,
-                    it != known.end() && it->second.status != CaseStatus::kDone ? it->second.last_error : "");
+    const std::string ranks = it != known.end() && it->second.ranks > 0 ? std::to_string(it->second.ranks) : "-";
+    lines += fmt::format("{:<16} {:<12} {:6.1f} {:<12} {:>5} {}\n", c.id, c.group, c.params.gravity.angle_deg, st,
+                         ranks, it != known.end() && it->second.status != CaseStatus::kDone ? it->second.last_error : "");
   }
   std::printf("study %s: %zu cases: %d done, %d running, %d failed, %d interrupted, %d pending\n",
               study.name.c_str(), study.cases.size(), counts["done"], counts["running"], counts["failed"],
               counts["interrupted"], counts["pending"]);
-  std::printf("%-16s %-12s %6s %-12s %s\n", "case", "group", "angle", "status", "last error");
+  std::printf("%-16s %-12s %6s %-12s %5s %s\n", "case", "group", "angle", "status", "ranks", "last error");
   std::fputs(lines.c_str(), stdout);
   return 0;
 }

@@ -115,6 +115,9 @@ bool Scheduler::start(const StudyCase* c) {
   const fs::path log = j.dir / "solver.log";
   j.log_offset_bytes = fs::exists(log) ? fs::file_size(log) : 0;
   j.t_start_s = simulated_time_s(j.dir);
+  std::error_code ec;
+  const auto mtime = fs::last_write_time(j.dir / "summary.json", ec);
+  if (!ec) j.summary_before = mtime;
   const auto argv = case_command(solver_, opt_.ranks, case_file.string(), j.dir.string());
   j.pid = start_solver(argv, log, j.lock_fd);
   j.started = Clock::now();

@@ -25,6 +25,9 @@ struct RunningCase {
   std::uintmax_t log_offset_bytes = 0;  ///< size of solver.log before this attempt wrote to it
   std::chrono::steady_clock::time_point started;
   double t_start_s = 0;  ///< simulated time when this attempt started (resume)
+  /// summary.json's modification time before this attempt (none: there was none), to tell a
+  /// summary this attempt wrote from an older one.
+  std::optional<std::filesystem::file_time_type> summary_before;
 };
 
 /// The solver command line: `configured` split at spaces; empty: $BOYCOTT_SOLVER_COMMAND, else

@@ -203,7 +203,8 @@ std::vector<CaseState> case_states(Database& db, const std::string& study, int r
       "    LIMIT 1), "
       " (SELECT a.error_text FROM attempts a WHERE a.case_id = c.id AND a.ended_at IS NOT NULL ORDER BY a.id "
       "DESC "
-      "    LIMIT 1) "
+      "    LIMIT 1), "
+      " (SELECT a.ranks FROM attempts a WHERE a.case_id = c.id ORDER BY a.id DESC LIMIT 1) "
       "FROM study_cases sc JOIN cases c ON c.id = sc.case_id "
       "WHERE (?1 = '' OR sc.study = ?1) ORDER BY sc.study, sc.position");
   // A case the solver refused as bad input is final only for this program version: a newer solver
@@ -221,6 +222,7 @@ std::vector<CaseState> case_states(Database& db, const std::string& study, int r
     const bool open = st.integer(7) != 0;
     c.last_exit = st.is_null(8) ? -1 : static_cast<int>(st.integer(8));
     c.last_error = st.text(9);
+    c.ranks = st.is_null(10) ? 0 : static_cast<int>(st.integer(10));
     if (done)
       c.status = CaseStatus::kDone;
     else if (open)

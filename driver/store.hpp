@@ -37,6 +37,7 @@ struct CaseState {
   int last_exit = -1;  ///< -1: none
   std::string last_error;
   bool input_error = false;  ///< an attempt exited 2: retrying cannot help
+  int ranks = 0;             ///< MPI ranks of the latest attempt (0: none yet)
 };
 
 /// Cases of one study (or all, study empty) with their status; `retries` decides when a failing

@@ -1,8 +1,7 @@
 #!/usr/bin/env bash
 # `boycott study run --ranks 2` launches each case under mpirun with 2 ranks: the attempts record
 # 2 ranks, each summary says it ran on 2 MPI ranks, and the flow equals the 1-rank run's to the
-# iteration tolerance (plane Poiseuille; SIMPLE stops at a relative change of 1e-6, and the
-# pressure is solved with BoomerAMG on one rank and GAMG on two, to 1e-8).
+# iteration tolerance (plane Poiseuille; SIMPLE stops at a relative change of 1e-6).
 set -euo pipefail
 bin=$1; study=$2
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
