@@ -11,8 +11,10 @@ enum ExitCode : int {
   kExitFailure = 1,          ///< unexpected internal failure
   kExitInputError = 2,       ///< the case or study file is wrong; nothing ran
   kExitPhysicsError = 3,     ///< the run became unphysical (NaN, alpha_f outside (0,1], ...)
-  kExitCheckpointError = 4,  ///< a checkpoint exists but cannot be used (corrupt, other parameters)
-  kExitInterrupted = 75,     ///< stopped by SIGINT/SIGTERM after writing a checkpoint (EX_TEMPFAIL)
+  kExitCheckpointError = 4,  ///< a checkpoint or run folder exists but cannot be used (corrupt, other case)
+  kExitStorageError =
+      74,  ///< a write failed (disk full, I/O error); the last good checkpoint is kept (EX_IOERR)
+  kExitInterrupted = 75,  ///< stopped by SIGINT/SIGTERM after writing a checkpoint (EX_TEMPFAIL)
 };
 
 /// Bad input: names the field, the value and the limit.
@@ -29,6 +31,13 @@ class PhysicsError : public std::runtime_error {
 
 /// A checkpoint that cannot be resumed from.
 class CheckpointError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A write that failed for a reason of the storage (disk full, I/O error), not of the data: the
+/// same run succeeds once there is room again.
+class StorageError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };

@@ -1,0 +1,20 @@
+#pragma once
+// The status a run's summary.json carries, one vocabulary for the solver, the driver and the
+// driver's test double; with the exit codes of error.hpp.
+#include <string_view>
+
+namespace boycott {
+
+inline constexpr std::string_view kStatusCompleted = "completed";  ///< reached time.end (exit 0)
+inline constexpr std::string_view kStatusConverged =
+    "converged";  ///< met time.target_rel_error first (exit 0)
+inline constexpr std::string_view kStatusInterrupted =
+    "interrupted";                                           ///< stopped after a checkpoint (exit 75)
+inline constexpr std::string_view kStatusFailed = "failed";  ///< stopped by an error (exit 1-4, 74)
+
+/// A run with a result to record: completed or converged.
+inline bool is_finished_status(std::string_view s) {
+  return s == kStatusCompleted || s == kStatusConverged;
+}
+
+}  // namespace boycott
