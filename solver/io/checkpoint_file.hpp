@@ -1,11 +1,15 @@
 #pragma once
 // Restart checkpoints as HDF5 files of named datasets (design brief section 7, issue 5).
 //
-// One file per checkpoint, DIR/checkpoints/ckpt_<step>.h5. A writer fills "<name>.h5.tmp",
-// writes the attribute `complete` last, flushes, fsyncs and renames: a kill during a write leaves
-// only a stray .tmp and the previous checkpoint intact. A reader refuses a file without the
-// marker (truncated or half written) and one whose case hash differs, with a CheckpointError
-// naming the file; nothing is ever deleted or overwritten on such an error.
+// One file per checkpoint, DIR/checkpoints/ckpt_<step>.h5. A writer builds the file in memory,
+// writes the attribute `complete` last, then writes the image to "<name>.h5.tmp" followed by the
+// SHA-256 of every byte of it (a footer after HDF5's end of file, which HDF5 ignores), fsyncs and
+// renames: a kill during a write leaves only a stray .tmp and the previous checkpoint intact,
+// and a file in place is one whose hash was written with it. A reader checks the hash before HDF5 opens the
+// file, so damage to the data and to HDF5's own metadata are both refused (CheckpointError naming the file);
+// files written before checkpoints carried a hash open as unverified. Nothing is ever deleted or
+// overwritten on such an error. A failed write is a StorageError (disk full, I/O error) with the
+// system's own words; the .tmp is removed.
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -17,7 +21,7 @@ namespace boycott::io {
 
 class CheckpointWriter {
  public:
-  /// Starts `final_path` (written as final_path + ".tmp" until commit).
+  /// Starts `final_path` (in memory; written as final_path + ".tmp" and renamed by commit).
   explicit CheckpointWriter(std::filesystem::path final_path);
   ~CheckpointWriter();
   CheckpointWriter(const CheckpointWriter&) = delete;
@@ -32,7 +36,8 @@ class CheckpointWriter {
   void put_3d(const std::string& name, const std::array<std::size_t, 3>& dims, const std::vector<double>& v);
   /// Creates a group (for names "group/dataset").
   void put_group(const std::string& name);
-  /// Marks the file complete, flushes, renames it into place.
+  /// Marks the file complete, writes it with its hash, fsyncs and renames it into place.
+  /// StorageError (the .tmp removed) when the storage fails.
   void commit();
 
  private:
@@ -41,10 +46,26 @@ class CheckpointWriter {
   bool committed_ = false;
 };
 
+/// What the hash footer of a checkpoint file says about it.
+enum class Integrity {
+  kVerified,    ///< its SHA-256 footer matches every byte before it
+  kUnverified,  ///< no footer and no claim to one: written before checkpoints carried a hash
+  kNotChecked,  ///< opened without checking (CheckpointReader::Verify::kNo)
+};
+
+/// Appends the SHA-256 footer of the file's bytes and fsyncs it; StorageError when that fails.
+/// The writer's last step before the rename (public for tests that alter a file on purpose).
+void seal_file(const std::filesystem::path& path);
+/// Checks a file's footer: kVerified, kUnverified (none), or CheckpointError (a footer that does
+/// not match the bytes before it, or an unreadable file), naming the file.
+Integrity verify_file(const std::filesystem::path& path);
+
 class CheckpointReader {
  public:
-  /// Opens and checks the completeness marker; throws CheckpointError otherwise.
-  explicit CheckpointReader(std::filesystem::path path);
+  enum class Verify { kYes, kNo };
+  /// Checks the hash (with Verify::kYes), opens the file and checks the completeness marker;
+  /// throws CheckpointError otherwise, also for a file written with a hash that has lost it.
+  explicit CheckpointReader(std::filesystem::path path, Verify verify = Verify::kYes);
   ~CheckpointReader();
   CheckpointReader(const CheckpointReader&) = delete;
   CheckpointReader& operator=(const CheckpointReader&) = delete;
@@ -56,16 +77,23 @@ class CheckpointReader {
   std::int64_t integer(const std::string& name) const;
   std::string string(const std::string& name) const;
   const std::filesystem::path& path() const { return path_; }
+  Integrity integrity() const { return integrity_; }
 
  private:
   std::filesystem::path path_;
   long long file_ = -1;
+  Integrity integrity_ = Integrity::kNotChecked;
 };
 
 /// ckpt_<step, zero padded>.h5 in dir/checkpoints.
 std::filesystem::path checkpoint_path(const std::filesystem::path& run_dir, std::int64_t step);
 /// The newest checkpoint file of a run folder (by step), or none. Does not open it.
 std::optional<std::filesystem::path> latest_checkpoint(const std::filesystem::path& run_dir);
+/// The checkpoint files of a run folder, newest first. Does not open them.
+std::vector<std::filesystem::path> checkpoints_newest_first(const std::filesystem::path& run_dir);
+/// Renames a refused checkpoint to <name>.bad (or .bad2, ...), out of the way of later
+/// checkpoints of the same step and of pruning; returns the new path. Never deletes it.
+std::filesystem::path set_aside(const std::filesystem::path& checkpoint);
 /// Deletes all but the newest `keep` checkpoints (only complete, older ones).
 void prune_checkpoints(const std::filesystem::path& run_dir, int keep);
 

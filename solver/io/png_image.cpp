@@ -4,7 +4,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
+#include <string_view>
+
+#include "io/atomic_file.hpp"
 
 namespace boycott::io {
 
@@ -103,12 +105,7 @@ void write_particle_png(const std::filesystem::path& path, const ParticleView& v
       }
   }
   const auto bytes = encode_png(w, h, img);
-  const auto tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  }
-  std::filesystem::rename(tmp, path);
+  write_file_atomic(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 }  // namespace boycott::io

@@ -1,0 +1,12 @@
+#pragma once
+// Whole-file writes that a reader (or a kill) never sees half done: a temporary file beside the
+// target, fsync, rename. A failure is the storage's (disk full, I/O error): StorageError naming
+// the file and the system's own words; the temporary is removed and the target left as it was.
+#include <filesystem>
+#include <string_view>
+
+namespace boycott::io {
+
+void write_file_atomic(const std::filesystem::path& path, std::string_view bytes);
+
+}  // namespace boycott::io
