@@ -28,14 +28,18 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
   if (f == CurveFormat::kCsv) {
     s = "group,angle_deg,mean_settling_velocity_m_s,stderr_m_s,r_acc,r_acc_err,case_id,setting\n";
     for (const auto& p : pts)
-      s += fmt::format("{},{:g},{:.9g},{:.9g},{},{},{},{}\n", p.group, p.angle_deg, p.w_m_s, p.w_err_m_s,
-                       opt(p.r_acc), opt(p.r_acc_err), p.case_id, report::csv_field(p.setting));
+      s += fmt::format("{},{:g},{:.9g},{},{},{},{},{}\n", p.group, p.angle_deg, p.w_m_s,
+                       p.w_err_m_s ? fmt::format("{:.9g}", *p.w_err_m_s) : std::string(), opt(p.r_acc),
+                       opt(p.r_acc_err), p.case_id, report::csv_field(p.setting));
   } else if (f == CurveFormat::kJson) {
     nlohmann::json j = nlohmann::json::array();
     for (const auto& p : pts) {
-      nlohmann::json e = {
-          {"group", p.group},          {"angle_deg", p.angle_deg}, {"mean_settling_velocity_m_s", p.w_m_s},
-          {"stderr_m_s", p.w_err_m_s}, {"case_id", p.case_id},     {"setting", p.setting}};
+      nlohmann::json e = {{"group", p.group},
+                          {"angle_deg", p.angle_deg},
+                          {"mean_settling_velocity_m_s", p.w_m_s},
+                          {"case_id", p.case_id},
+                          {"setting", p.setting}};
+      e["stderr_m_s"] = p.w_err_m_s ? nlohmann::json(*p.w_err_m_s) : nlohmann::json(nullptr);
       e["r_acc"] = p.r_acc ? nlohmann::json(*p.r_acc) : nlohmann::json(nullptr);
       e["r_acc_err"] = p.r_acc_err ? nlohmann::json(*p.r_acc_err) : nlohmann::json(nullptr);
       j.push_back(e);
@@ -47,9 +51,13 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
     s = fmt::format("{:<12} {:>6}  {:>24}  {:>18}  {}\n", "group", "angle", "<<w_p>> (mm/s)", "r_acc",
                     "setting");
     for (const auto& p : pts) {
-      const std::string r = p.r_acc ? fmt::format("{:.3f} +- {:.3f}", *p.r_acc, *p.r_acc_err) : "-";
-      s += fmt::format("{:<12} {:>6g}  {:>11.4f} +- {:<9.4f}  {:>18}  {}\n", p.group, p.angle_deg,
-                       p.w_m_s * 1e3, p.w_err_m_s * 1e3, r, p.setting);
+      // A missing error is "n/a", never a zero that reads as an exact value.
+      const std::string r = p.r_acc ? fmt::format("{:.3f} +- {}", *p.r_acc,
+                                                  p.r_acc_err ? fmt::format("{:.3f}", *p.r_acc_err) : "n/a")
+                                    : "-";
+      const std::string w_err = p.w_err_m_s ? fmt::format("{:.4f}", *p.w_err_m_s * 1e3) : "n/a";
+      s += fmt::format("{:<12} {:>6g}  {:>11.4f} +- {:<9}  {:>18}  {}\n", p.group, p.angle_deg, p.w_m_s * 1e3,
+                       w_err, r, p.setting);
     }
   }
   return s;
@@ -83,9 +91,10 @@ std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& tit
   for (int panel = 0; panel < 2; ++panel) {
     // Left: <<w_p>> in mm/s; right: r_acc (dimensionless).
     auto value = [&](const CurvePoint& p) -> std::optional<std::pair<double, double>> {
-      if (panel == 0) return std::pair{p.w_m_s * 1e3, p.w_err_m_s * 1e3};
+      // An unknown error draws no bar.
+      if (panel == 0) return std::pair{p.w_m_s * 1e3, p.w_err_m_s.value_or(0.0) * 1e3};
       if (!p.r_acc) return std::nullopt;
-      return std::pair{*p.r_acc, *p.r_acc_err};
+      return std::pair{*p.r_acc, p.r_acc_err.value_or(0.0)};
     };
     double lo = INFINITY, hi = -INFINITY;
     for (const auto& p : pts)

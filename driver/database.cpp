@@ -3,15 +3,49 @@
 #include <sqlite3.h>
 #include <sys/stat.h>
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <ctime>
+#include <filesystem>
 #include <thread>
 
 #include <fmt/format.h>
 
+#include "core/error.hpp"
 #include "driver/schema_files.hpp"
 
 namespace boycott::driver {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// The error of a failed SQLite call: StorageError when the storage failed (disk full, I/O
+/// error), DatabaseError otherwise.
+[[noreturn]] void sqlite_failure(int rc, const std::string& what) {
+  const int primary = rc & 0xff;
+  if (primary == SQLITE_FULL || primary == SQLITE_IOERR) throw StorageError(what);
+  throw DatabaseError(what);
+}
+
+/// A file path as the path of a file: URI (RFC 3986 percent-encoding of what is not unreserved).
+std::string uri_path(const std::string& path) {
+  std::string out;
+  for (const unsigned char c : path) {
+    if (std::isalnum(c) || c == '/' || c == '-' || c == '_' || c == '.' || c == '~')
+      out += static_cast<char>(c);
+    else
+      out += fmt::format("%{:02X}", c);
+  }
+  return out;
+}
+
+/// The tables every version of this program's schema has.
+constexpr const char* kOwnTables[] = {"studies",     "cases",    "study_cases",
+                                      "case_values", "attempts", "results"};
+
+}  // namespace
 
 Statement::Statement(sqlite3* db, const std::string& sql) : db_(db) {
   if (sqlite3_prepare_v2(db, sql.c_str(), -1, &st_, nullptr) != SQLITE_OK)
@@ -47,7 +81,7 @@ bool Statement::step() {
   }
   if (rc == SQLITE_ROW) return true;
   if (rc == SQLITE_DONE) return false;
-  throw DatabaseError(fmt::format("database: {}", sqlite3_errmsg(db_)));
+  sqlite_failure(rc, fmt::format("database: {}", sqlite3_errmsg(db_)));
 }
 bool Statement::is_null(int col) const {
   return sqlite3_column_type(st_, col) == SQLITE_NULL;
@@ -64,35 +98,89 @@ std::int64_t Statement::integer(int col) const {
 }
 
 Database::Database(const std::string& path, OpenMode mode, int target_version) : path_(path) {
+  if (path.empty()) throw DatabaseError("the database path is empty");
   struct stat sb {};
   const bool exists = ::stat(path.c_str(), &sb) == 0;
-  if (!exists && mode == OpenMode::kExisting) throw DatabaseError(fmt::format("no database at '{}'", path));
-  const int flags = SQLITE_OPEN_READWRITE | (mode == OpenMode::kCreate ? SQLITE_OPEN_CREATE : 0);
-  if (sqlite3_open_v2(path.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
-    std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
+  if (!exists && mode != OpenMode::kCreate) throw DatabaseError(fmt::format("no database at '{}'", path));
+  const int flags = mode == OpenMode::kReadOnly
+                        ? SQLITE_OPEN_READONLY
+                        : SQLITE_OPEN_READWRITE | (mode == OpenMode::kCreate ? SQLITE_OPEN_CREATE : 0);
+  open(path, flags);
+  if (mode == OpenMode::kReadOnly &&
+      (sqlite3_exec(db_, "SELECT 1 FROM sqlite_master LIMIT 1", nullptr, nullptr, nullptr) & 0xff) ==
+          SQLITE_CANTOPEN) {
+    // A WAL database on a read-only mount: SQLite cannot create its shared-memory file. With no
+    // write-ahead log to read, the file alone is the whole database and cannot change: open it
+    // as immutable.
+    std::error_code ec;
+    const auto wal = fs::file_size(path + "-wal", ec);
+    if (!ec && wal > 0)
+      throw DatabaseError(
+          fmt::format("database '{}' is read-only and has a write-ahead log that cannot be read without "
+                      "writing beside it; "
+                      "copy the database (with its -wal file) to a writable place to query it",
+                      path));
     sqlite3_close(db_);
     db_ = nullptr;
-    throw DatabaseError(fmt::format("cannot open database '{}': {}", path, msg));
+    open(fmt::format("file:{}?immutable=1", uri_path(path)), SQLITE_OPEN_READONLY | SQLITE_OPEN_URI);
   }
   try {
     // Several drivers (or a driver and a query) may share the file: wait for locks, never fail.
     sqlite3_busy_timeout(db_, 30000);
+    // Reads only until the file is known to be ours: another program's file is left untouched.
+    require_own_schema();
     const int v = version();
     if (v > latest_version())
       throw DatabaseError(fmt::format(
           "database '{}' has schema version {}, newer than this program's {}: use a newer boycott", path, v,
           latest_version()));
-    exec("PRAGMA journal_mode = WAL");
-    exec("PRAGMA synchronous = NORMAL");
-    exec("PRAGMA foreign_keys = ON");
-    migrate(target_version < 0 ? latest_version() : target_version);
-  } catch (const DatabaseError& e) {
+    if (mode == OpenMode::kReadOnly) {
+      if (v < latest_version())
+        throw DatabaseError(
+            fmt::format("database '{}' has schema version {}, older than this program's {}: a query does not "
+                        "upgrade it; run `boycott study run` on it once",
+                        path, v, latest_version()));
+    } else {
+      exec("PRAGMA journal_mode = WAL");
+      exec("PRAGMA synchronous = NORMAL");
+      exec("PRAGMA foreign_keys = ON");
+      migrate(target_version < 0 ? latest_version() : target_version);
+    }
+  } catch (const std::runtime_error& e) {
     sqlite3_close(db_);
     db_ = nullptr;
     // SQLite's own words for a path it cannot create are vague; name the file.
     std::string what = e.what();
     if (what.find(path) == std::string::npos) what = fmt::format("database '{}': {}", path, what);
+    if (dynamic_cast<const StorageError*>(&e)) throw StorageError(what);
     throw DatabaseError(what);
+  }
+}
+
+void Database::require_own_schema() {
+  // Ours: no table at all (a new file), or every table of the schema. Read with plain
+  // statements: a file that is not SQLite fails here too ("file is not a database").
+  std::vector<std::string> tables;
+  Statement st(db_, "SELECT name FROM sqlite_master WHERE type = 'table'");
+  while (st.step()) tables.push_back(st.text(0));
+  if (tables.empty() && version() == 0) return;
+  std::string missing;
+  for (const char* t : kOwnTables)
+    if (std::find(tables.begin(), tables.end(), t) == tables.end())
+      missing += (missing.empty() ? "" : ", ") + std::string(t);
+  if (!missing.empty())
+    throw DatabaseError(fmt::format(
+        "'{}' is an SQLite file of another program, not a boycott study database (no table {}); it is left "
+        "untouched",
+        path_, missing));
+}
+
+void Database::open(const std::string& name, int flags) {
+  if (sqlite3_open_v2(name.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
+    std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw DatabaseError(fmt::format("cannot open database '{}': {}", path_, msg));
   }
 }
 
@@ -126,7 +214,7 @@ void Database::exec(const std::string& sql) {
   if (rc != SQLITE_OK) {
     std::string msg = err ? err : sqlite3_errmsg(db_);
     sqlite3_free(err);
-    throw DatabaseError(msg);
+    sqlite_failure(rc, msg);
   }
 }
 

@@ -1,7 +1,10 @@
 #pragma once
 // The study database: one SQLite file in WAL mode, schema from results_schema/ (embedded), every
 // write one BEGIN IMMEDIATE ... COMMIT transaction, so a reader never sees half a case and a
-// process killed mid-write leaves the previous state.
+// process killed mid-write leaves the previous state. Queries open it read-only (no WAL switch,
+// no migration: a read-only file or mount can be queried); a SQLite file of another program is
+// refused before anything is written to it. A write that fails for the storage (disk full, I/O
+// error) is a StorageError, not a DatabaseError.
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
@@ -49,12 +52,17 @@ class Statement {
   sqlite3_stmt* st_ = nullptr;
 };
 
-enum class OpenMode { kCreate, kExisting };
+enum class OpenMode {
+  kCreate,    ///< read-write, created when missing
+  kExisting,  ///< read-write, must exist
+  kReadOnly,  ///< must exist; opened read-only, never switched to WAL nor migrated
+};
 
 class Database {
  public:
-  /// Opens `path` (creating it with kCreate), refuses a database whose user_version is newer than
-  /// this program knows, then migrates up to `target_version` (-1: the newest).
+  /// Opens `path` (creating it with kCreate), refuses a file that is not this program's database
+  /// and one whose user_version is newer than this program knows, then (except kReadOnly)
+  /// switches to WAL and migrates up to `target_version` (-1: the newest).
   Database(const std::string& path, OpenMode mode, int target_version = -1);
   ~Database();
   Database(const Database&) = delete;
@@ -82,7 +90,11 @@ class Database {
   }
 
  private:
+  /// sqlite3_open_v2 of `name` (the path, or a file: URI) into db_; DatabaseError naming path_.
+  void open(const std::string& name, int flags);
   void exec_noexcept(const char* sql);
+  /// DatabaseError unless the file is empty or holds this program's tables; reads only.
+  void require_own_schema();
   void migrate(int target);
   std::string path_;
   sqlite3* db_ = nullptr;

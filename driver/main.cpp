@@ -33,6 +33,10 @@ int run_guarded(const std::function<int()>& fn) {
   } catch (const boycott::CheckpointError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return boycott::kExitCheckpointError;
+  } catch (const boycott::StorageError& e) {
+    // A write failed (disk full, I/O error); the last good checkpoint is kept.
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return boycott::kExitStorageError;
   } catch (const boycott::driver::DatabaseError& e) {
     // An unusable database (unwritable path, newer schema) is bad input to the driver.
     std::fprintf(stderr, "error: %s\n", e.what());
@@ -41,6 +45,17 @@ int run_guarded(const std::function<int()>& fn) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return boycott::kExitFailure;
   }
+}
+
+/// --db names a file: an empty one would be SQLite's private temporary database.
+void require_db_path(const std::string& path) {
+  if (path.empty()) throw boycott::InputError("--db is empty: name the study database file");
+}
+
+/// A query's database: read-only (a read-only file or mount can be queried; nothing migrated).
+boycott::driver::Database open_for_query(const std::string& path) {
+  require_db_path(path);
+  return boycott::driver::Database(path, boycott::driver::OpenMode::kReadOnly);
 }
 
 }  // namespace
@@ -123,14 +138,20 @@ int main(int argc, char** argv) {
 
   if (srun->parsed()) {
     sopt.progress = isatty(STDOUT_FILENO);
-    return run_guarded([&] { return boycott::driver::study_run(sopt); });
+    return run_guarded([&] {
+      require_db_path(sopt.db_path);
+      return boycott::driver::study_run(sopt);
+    });
   }
   if (sstatus->parsed())
-    return run_guarded([&] { return boycott::driver::study_status(status_file, status_db, status_retries); });
+    return run_guarded([&] {
+      require_db_path(status_db);
+      return boycott::driver::study_status(status_file, status_db, status_retries);
+    });
   if (qcurve->parsed())
     return run_guarded([&] {
       const auto fmt_kind = boycott::driver::parse_curve_format(q_format);
-      boycott::driver::Database db(q_db, boycott::driver::OpenMode::kExisting);
+      auto db = open_for_query(q_db);
       const auto pts = boycott::driver::query_curve(db, q_study, q_group);
       if (pts.empty())
         throw boycott::InputError(fmt::format("no finished cases of study '{}'{} in '{}'", q_study,
@@ -146,7 +167,7 @@ int main(int argc, char** argv) {
   if (qvalid->parsed())
     return run_guarded([&] {
       const auto fmt_kind = boycott::driver::parse_curve_format(q_format);
-      boycott::driver::Database db(q_db, boycott::driver::OpenMode::kExisting);
+      auto db = open_for_query(q_db);
       const auto rows = boycott::driver::query_validation(db, q_study);
       std::fputs(boycott::driver::format_validation(rows, fmt_kind).c_str(), stdout);
       return 0;
@@ -154,7 +175,7 @@ int main(int argc, char** argv) {
   if (qwork->parsed())
     return run_guarded([&] {
       const auto fmt_kind = boycott::driver::parse_curve_format(q_format);
-      boycott::driver::Database db(q_db, boycott::driver::OpenMode::kExisting);
+      auto db = open_for_query(q_db);
       const auto wp = boycott::driver::query_work_precision(db, q_study, q_reference);
       if (wp.rows.empty())
         throw boycott::InputError(
@@ -171,7 +192,7 @@ int main(int argc, char** argv) {
     });
   if (qcases->parsed())
     return run_guarded([&] {
-      boycott::driver::Database db(q_db, boycott::driver::OpenMode::kExisting);
+      auto db = open_for_query(q_db);
       std::fputs(boycott::driver::format_cases(boycott::driver::case_states(db, q_study, 2)).c_str(), stdout);
       return 0;
     });

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "core/run_status.hpp"
 #include "driver/store.hpp"
 
 namespace fs = std::filesystem;
@@ -24,14 +25,18 @@ std::string read_text(const fs::path& p) {
 }
 
 /// The last non-empty line the solver wrote to its log since `offset_bytes`: its one-line reason.
-std::string last_line(const fs::path& log, std::uintmax_t offset_bytes) {
+/// With prefer_error, the last line that starts "error: " when there is one (mpirun adds its own
+/// lines after the solver's reason when a rank aborts).
+std::string last_line(const fs::path& log, std::uintmax_t offset_bytes, bool prefer_error = false) {
   std::ifstream in(log);
   if (!in) return "";
   in.seekg(static_cast<std::streamoff>(offset_bytes));
-  std::string line, last;
-  while (std::getline(in, line))
+  std::string line, last, last_error;
+  while (std::getline(in, line)) {
     if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
-  return last;
+    if (line.rfind("error: ", 0) == 0) last_error = line;
+  }
+  return prefer_error && !last_error.empty() ? last_error : last;
 }
 
 /// Whether this attempt wrote a summary.json of its case with status "interrupted".
@@ -41,7 +46,7 @@ bool wrote_interrupted_summary(const RunningCase& run) {
   if (ec || (run.summary_before && *run.summary_before == mtime)) return false;
   try {
     const auto summary = nlohmann::json::parse(read_text(run.dir / "summary.json"));
-    return summary.value("status", "") == "interrupted" && summary.value("case_id", "") == run.c->id;
+    return summary.value("status", "") == kStatusInterrupted && summary.value("case_id", "") == run.c->id;
   } catch (const nlohmann::json::exception&) {
     return false;
   }
@@ -57,6 +62,8 @@ AttemptEnd record_attempt_end(Database& db, const RunningCase& run, int exit_cod
       const auto summary = nlohmann::json::parse(read_text(run.dir / "summary.json"));
       if (summary.value("case_id", "") != c->id)
         why = fmt::format("summary.json is for case '{}'", summary.value("case_id", ""));
+      else if (!is_finished_status(summary.value("status", "")))
+        why = fmt::format("exit 0 but summary.json has status '{}'", summary.value("status", ""));
       else
         record_result(db, run.attempt, c->id, summary);
     } catch (const nlohmann::json::exception&) {
@@ -65,6 +72,13 @@ AttemptEnd record_attempt_end(Database& db, const RunningCase& run, int exit_cod
     if (why.empty()) return {AttemptEnd::Kind::kDone, 0, ""};
     finish_attempt(db, run.attempt, 1, why);
     return {AttemptEnd::Kind::kFailed, 1, why};
+  }
+  if (exit_code == kExitStorageError) {
+    // The storage failed, not the case: the solver kept its last good checkpoint.
+    std::string why = last_line(run.dir / "solver.log", run.log_offset_bytes, true);
+    if (why.empty()) why = "storage error (exit 74)";
+    finish_attempt(db, run.attempt, exit_code, why);
+    return {AttemptEnd::Kind::kStorageFailed, exit_code, why};
   }
   // A case run under mpirun that stopped on the driver's signal: mpirun, signalled too, exits
   // with 1 whatever its ranks returned; the summary this attempt wrote says what happened.
@@ -86,7 +100,7 @@ bool record_left_summary(Database& db, std::int64_t attempt, const std::string& 
   if (!fs::exists(run_dir / "summary.json")) return false;
   try {
     const auto summary = nlohmann::json::parse(read_text(run_dir / "summary.json"));
-    if (summary.value("status", "") == "done" && summary.value("case_id", "") == case_id) {
+    if (is_finished_status(summary.value("status", "")) && summary.value("case_id", "") == case_id) {
       record_result(db, attempt, case_id, summary);
       return true;
     }

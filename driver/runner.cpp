@@ -53,6 +53,11 @@ int study_run(const StudyRunOptions& opt) {
 
   Scheduler scheduler(db, study, case_states(db, study.name, opt.retries), opt, root, std::move(solver));
   const bool stopped = scheduler.run();
+  if (!scheduler.storage_stop().empty()) {
+    std::fprintf(stderr, "error: study %s stopped: %s; once the storage works again, run the same command\n",
+                 study.name.c_str(), scheduler.storage_stop().c_str());
+    return kExitStorageError;
+  }
 
   const int n_total = static_cast<int>(study.cases.size());
   int done = 0, failed = 0;
@@ -72,7 +77,7 @@ int study_run(const StudyRunOptions& opt) {
 
 int study_status(const std::string& study_file, const std::string& db_path, int retries) {
   const Study study = expand_study_file(study_file);
-  Database db(db_path, OpenMode::kExisting);
+  Database db(db_path, OpenMode::kReadOnly);
   std::map<std::string, CaseState> known;
   for (auto& s : case_states(db, study.name, retries)) known[s.id] = s;
   std::map<std::string, int> counts;
@@ -85,9 +90,11 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
         run_folder_unheld(fs::path(runs_root(db_path)) / c.id))
       st = "interrupted";
     ++counts[st];
-    const std::string ranks = it != known.end() && it->second.ranks > 0 ? std::to_string(it->second.ranks) : "-";
-    lines += fmt::format("{:<16} {:<12} {:6.1f} {:<12} {:>5} {}\n", c.id, c.group, c.params.gravity.angle_deg, st,
-                         ranks, it != known.end() && it->second.status != CaseStatus::kDone ? it->second.last_error : "");
+    const std::string ranks =
+        it != known.end() && it->second.ranks > 0 ? std::to_string(it->second.ranks) : "-";
+    lines += fmt::format(
+        "{:<16} {:<12} {:6.1f} {:<12} {:>5} {}\n", c.id, c.group, c.params.gravity.angle_deg, st, ranks,
+        it != known.end() && it->second.status != CaseStatus::kDone ? it->second.last_error : "");
   }
   std::printf("study %s: %zu cases: %d done, %d running, %d failed, %d interrupted, %d pending\n",
               study.name.c_str(), study.cases.size(), counts["done"], counts["running"], counts["failed"],

@@ -21,7 +21,8 @@ struct StudyRunOptions {
   bool progress = false;  ///< live display (on when stdout is a terminal)
 };
 
-/// Exit code: 0 all cases done, 75 stopped by a signal, 1 some case failed for good.
+/// Exit code: 0 all cases done, 75 stopped by a signal, 1 some case failed for good, 74 stopped
+/// after storage errors in a row (Scheduler::kStorageFailuresToStop).
 int study_run(const StudyRunOptions& opt);
 int study_status(const std::string& study_file, const std::string& db_path, int retries);
 

@@ -1,7 +1,12 @@
 #include "driver/scheduler.hpp"
 
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <set>
 #include <stdexcept>
@@ -26,9 +31,18 @@ void write_atomic(const fs::path& p, const std::string& text) {
   {
     std::ofstream out(tmp, std::ios::trunc);
     out << text;
-    if (!out) throw std::runtime_error(fmt::format("cannot write '{}'", tmp.string()));
+    out.flush();
+    if (!out) throw StorageError(fmt::format("cannot write '{}': {}", tmp.string(), std::strerror(errno)));
   }
   fs::rename(tmp, p);
+}
+
+/// The wait before a case that hit the n-th storage error in a row runs again: 2, 4, 8 ... s, at
+/// most 64 s. BOYCOTT_TEST_STORAGE_BACKOFF_S replaces the first 2 s (tests).
+std::chrono::duration<double> storage_backoff(int n) {
+  double first = 2.0;
+  if (const char* t = std::getenv("BOYCOTT_TEST_STORAGE_BACKOFF_S")) first = std::atof(t);
+  return std::chrono::duration<double>(std::min(first * std::pow(2.0, n - 1), 64.0));
 }
 
 }  // namespace
@@ -55,9 +69,20 @@ Scheduler::Scheduler(Database& db, const Study& study, const std::vector<CaseSta
 
 bool Scheduler::run() {
   std::set<const StudyCase*> told_locked;
-  while (!queue_.empty() || !running_.empty()) {
+  while (!queue_.empty() || !running_.empty() || !backing_off_.empty()) {
     bool lock_wait = false;
     if (stop_signal() && !stopping_) stop_all();
+    if (stopping_) backing_off_.clear();  // they stay pending in the database
+    // Back in the queue once their back-off has passed.
+    const auto now = Clock::now();
+    for (auto it = backing_off_.begin(); it != backing_off_.end();) {
+      if (it->first > now) {
+        ++it;
+        continue;
+      }
+      queue_.push_back(it->second);
+      it = backing_off_.erase(it);
+    }
     while (!stopping_ && static_cast<int>(running_.size()) < opt_.jobs && !queue_.empty()) {
       const StudyCase* c = queue_.front();
       queue_.pop_front();
@@ -139,6 +164,7 @@ void Scheduler::reap(const SolverExit& exited) {
 void Scheduler::finish(const RunningCase& run, int exit_code) {
   const StudyCase* c = run.c;
   const AttemptEnd end = record_attempt_end(db_, run, exit_code);
+  if (end.kind != AttemptEnd::Kind::kStorageFailed) storage_failures_in_a_row_ = 0;
   if (end.kind == AttemptEnd::Kind::kDone) {
     ++done_;
     progress_.add_finished_case(std::chrono::duration<double>(Clock::now() - run.started).count());
@@ -150,6 +176,21 @@ void Scheduler::finish(const RunningCase& run, int exit_code) {
   }
   const std::string where =
       fmt::format("case {} ({} angle={:g} deg)", c->id, c->group, c->params.gravity.angle_deg);
+  if (end.kind == AttemptEnd::Kind::kStorageFailed) {
+    // Not the case's fault: its last checkpoint is kept; it runs again once there is room.
+    const int n = ++storage_failures_in_a_row_;
+    std::fprintf(stderr, "%s: storage error (exit %d), not counted as a failure: %s\n", where.c_str(),
+                 exit_code, end.reason.c_str());
+    if (n >= kStorageFailuresToStop) {
+      storage_stop_ = fmt::format("{} storage errors in a row (exit 74), the last: {}", n, end.reason);
+      if (!stopping_) stop_all();
+    } else if (!stopping_ && !stop_signal()) {
+      const auto wait = storage_backoff(n);
+      std::fprintf(stderr, "%s: runs again in %g s\n", where.c_str(), wait.count());
+      backing_off_.emplace_back(Clock::now() + std::chrono::duration_cast<Clock::duration>(wait), c);
+    }
+    return;
+  }
   if (exit_code == 0)
     std::fprintf(stderr, "%s failed: %s\n", where.c_str(), end.reason.c_str());
   else
@@ -167,7 +208,7 @@ void Scheduler::finish(const RunningCase& run, int exit_code) {
 }
 
 ProgressCounts Scheduler::counts() const {
-  return {done_, failed_, queue_.size(), stopping_};
+  return {done_, failed_, queue_.size() + backing_off_.size(), stopping_};
 }
 
 }  // namespace boycott::driver

@@ -2,11 +2,16 @@
 // Scheduling of `study run`: which case runs next (the queue of the cases that the database shows
 // neither done nor failed, in study order), how many run at once (--jobs slots, each case on
 // --ranks processes), which failed cases run again (--retries, counted over all runs of the
-// study), and how a stop signal drains the running cases.
+// study), and how a stop signal drains the running cases. A case whose solver hit a storage error
+// (exit 74: disk full, I/O error) runs again after a back-off (2, 4, 8 ... s, at most 64 s),
+// neither counted against --retries nor set aside; after kStorageFailuresToStop of them in a row
+// (any cases) the study stops.
+#include <chrono>
 #include <deque>
 #include <filesystem>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "driver/database.hpp"
@@ -25,9 +30,13 @@ class Scheduler {
   Scheduler(Database& db, const Study& study, const std::vector<CaseState>& states,
             const StudyRunOptions& opt, std::filesystem::path runs_root, std::vector<std::string> solver);
 
-  /// Runs cases until the queue is empty, or after a stop signal until the running cases have
-  /// checkpointed and exited; true when a stop signal ended it.
+  /// Runs cases until the queue is empty, or after a stop signal (or too many storage errors in
+  /// a row) until the running cases have checkpointed and exited; true when a stop ended it.
   bool run();
+  /// Why the study stopped for storage errors; empty when it did not.
+  const std::string& storage_stop() const { return storage_stop_; }
+
+  static constexpr int kStorageFailuresToStop = 5;
 
  private:
   /// Starts the case, or records it without running it when its result is already there; false
@@ -48,6 +57,10 @@ class Scheduler {
   int done_ = 0;
   int failed_ = 0;
   std::vector<RunningCase> running_;
+  /// Cases whose solver hit a storage error, each with the time it may run again.
+  std::vector<std::pair<std::chrono::steady_clock::time_point, const StudyCase*>> backing_off_;
+  int storage_failures_in_a_row_ = 0;
+  std::string storage_stop_;
   bool stopping_ = false;
   ProgressDisplay progress_;
 };

@@ -194,7 +194,7 @@ std::vector<CaseState> case_states(Database& db, const std::string& study, int r
       "SELECT sc.study, sc.group_name, c.id, c.angle_deg, "
       " EXISTS(SELECT 1 FROM results r WHERE r.case_id = c.id), "
       " (SELECT COUNT(*) FROM attempts a WHERE a.case_id = c.id AND a.exit_status IS NOT NULL "
-      "    AND a.exit_status NOT IN (0, 75, 130, 143)), "
+      "    AND a.exit_status NOT IN (0, 74, 75, 130, 143)), "
       " (SELECT COUNT(*) FROM attempts a WHERE a.case_id = c.id AND a.exit_status = 2 "
       "    AND a.program_version = ?2), "
       " EXISTS(SELECT 1 FROM attempts a WHERE a.case_id = c.id AND a.ended_at IS NULL), "
@@ -271,7 +271,7 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
     p.case_id = st.text(1);
     p.angle_deg = st.real(2);
     p.w_m_s = st.real(3);
-    p.w_err_m_s = st.is_null(4) ? 0.0 : st.real(4);
+    if (!st.is_null(4)) p.w_err_m_s = st.real(4);
     auto& gp = group_pos.try_emplace(p.group, st.integer(5)).first->second;
     gp = std::min(gp, st.integer(5));
     setting_pos.emplace_back(st.integer(5));
@@ -309,10 +309,14 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
     if (!ref || ref->w_m_s == 0.0) continue;
     const double r = p.w_m_s / ref->w_m_s;
     p.r_acc = r;
-    const double rel_p = p.w_m_s != 0.0 ? p.w_err_m_s / p.w_m_s : 0.0;
-    const double rel_ref = ref->w_err_m_s / ref->w_m_s;
     // At 90 deg itself the ratio is exactly 1 (the same number over itself).
-    p.r_acc_err = (&p == ref || p.case_id == ref->case_id) ? 0.0 : std::abs(r) * std::hypot(rel_p, rel_ref);
+    if (&p == ref || p.case_id == ref->case_id) {
+      p.r_acc_err = 0.0;
+    } else if (p.w_err_m_s && ref->w_err_m_s) {
+      const double rel_p = p.w_m_s != 0.0 ? *p.w_err_m_s / p.w_m_s : 0.0;
+      const double rel_ref = *ref->w_err_m_s / ref->w_m_s;
+      p.r_acc_err = std::abs(r) * std::hypot(rel_p, rel_ref);
+    }
   }
   return pts;
 }

@@ -51,8 +51,11 @@ struct CurvePoint {
   std::string setting;
   std::string case_id;
   double angle_deg = 0;
-  double w_m_s = 0, w_err_m_s = 0;         ///< <<w_p>> and its standard error
-  std::optional<double> r_acc, r_acc_err;  ///< <<w_p>>/<<w_p>>(90 deg); unset without a 90 deg case
+  double w_m_s = 0;
+  std::optional<double> w_err_m_s;  ///< standard error of <<w_p>>; unset when the run recorded none
+  /// <<w_p>>/<<w_p>>(90 deg), unset without a 90 deg case; its error unset when an error it
+  /// depends on is.
+  std::optional<double> r_acc, r_acc_err;
 };
 
 /// A key a study sets on a case (group `set`, matrix, zip), as stored in case_values.

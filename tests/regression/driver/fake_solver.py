@@ -4,10 +4,14 @@ section 7, so the study driver's resume, retry and signal logic is tested agains
 
 It advances a simulated clock in steps of 0.1 s up to time.end (sleeping FAKE_STEP_WALL_S per
 step), checkpoints its state to DIR/checkpoint.json every step, appends DIR/timeseries.csv, and
-writes DIR/summary.json at the end. The result depends on the parameters only (never on how often
-it was interrupted): <<w_p>> = -0.01 (1 + 0.5 sin(theta)) * (viscosity/1e-3)^-0.1 m/s.
+writes DIR/summary.json at the end with the real solver's keys and statuses (core/run_status.hpp:
+"completed" at the end, "interrupted" when stopped; test_driver_faults checks them against the
+real solver). The result depends on the parameters only (never on how often it was interrupted):
+<<w_p>> = -0.01 (1 + 0.5 sin(theta)) * (viscosity/1e-3)^-0.1 m/s.
 Exit 75 on SIGTERM/SIGINT after a checkpoint; exit 3 once per run folder when seed == 13 and
 FAKE_FAIL_SEED13 is set (a retried failure); exit 3 always when seed == 14 (a failure for good).
+Exit 74 (a storage error: "No space left on device") on the first FAKE_STORAGE_FAILS runs in a
+run folder before any step, or on every run when FAKE_STORAGE_FAILS = "always".
 """
 import json, math, os, signal, sys, time
 import tomllib
@@ -48,6 +52,16 @@ def main():
         print("error: the run became unphysical: NaN in the pressure", file=sys.stderr)
         return 3
 
+    fails = os.environ.get("FAKE_STORAGE_FAILS")
+    if fails:
+        counter = os.path.join(out, "storage_failures")
+        n = int(open(counter).read()) if os.path.exists(counter) else 0
+        if fails == "always" or n < int(fails):
+            with open(counter, "w") as f:
+                f.write(str(n + 1))
+            print(f"error: cannot write {out}/checkpoint.json.tmp: No space left on device", file=sys.stderr)
+            return 74
+
     end = p["time"]["end"]
     angle = p["gravity"]["angle_deg"]
     visc = p["fluid"]["viscosity"]
@@ -71,9 +85,30 @@ def main():
         with open(ts) as f:
             lines = f.readlines()[: state["step"] + 1]
     t0 = time.time()
+
+    def summary(status):
+        n = max(state["n"], 1)
+        mean = state["sum"] / n
+        var = max(state["sum2"] / n - mean * mean, 0.0)
+        return {
+            "scene": p.get("scene", "inclined_settling"),
+            "case_id": os.path.basename(os.path.normpath(out)),
+            "status": status,
+            "mean_settling_velocity_m_s": mean,
+            "settling_velocity_stderr_m_s": math.sqrt(var / n),
+            "simulated_time_s": state["step"] * 0.1,
+            "wall_time_s": time.time() - t0,
+            "particle_steps": count * state["step"] * 50,
+            "models": {"drag": p["forces"]["drag"]},
+            "mean_fluid_velocity_m_s": -0.1 * mean,
+            "mean_slurry_velocity_m_s": 0.0,
+        }
+
     while state["step"] < nsteps:
         if stop["sig"]:
-            return 75  # the checkpoint below was written after the last completed step
+            # As the real solver: the checkpoint below was written after the last completed step.
+            write_atomic(os.path.join(out, "summary.json"), json.dumps(summary("interrupted"), indent=1))
+            return 75
         k = state["step"] + 1
         w = w_mean * (1 + 0.1 * math.sin(1.7 * k))
         state["sum"] += w
@@ -84,23 +119,7 @@ def main():
         write_atomic(ts, "".join(lines))
         write_atomic(ckpt, json.dumps(state))
         time.sleep(step_wall)
-    n = state["n"]
-    mean = state["sum"] / n
-    var = max(state["sum2"] / n - mean * mean, 0.0)
-    summary = {
-        "scene": p.get("scene", "inclined_settling"),
-        "case_id": os.path.basename(os.path.normpath(out)),
-        "status": "done",
-        "mean_settling_velocity_m_s": mean,
-        "settling_velocity_stderr_m_s": math.sqrt(var / n),
-        "simulated_time_s": nsteps * 0.1,
-        "wall_time_s": time.time() - t0,
-        "particle_steps": count * nsteps * 50,
-        "models": {"drag": p["forces"]["drag"]},
-        "mean_fluid_velocity_m_s": -0.1 * mean,
-        "mean_slurry_velocity_m_s": 0.0,
-    }
-    write_atomic(os.path.join(out, "summary.json"), json.dumps(summary, indent=1))
+    write_atomic(os.path.join(out, "summary.json"), json.dumps(summary("completed"), indent=1))
     return 0
 
 if __name__ == "__main__":

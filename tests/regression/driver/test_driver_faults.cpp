@@ -1,0 +1,424 @@
+// The driver against faults and against the real solver (issue 26): storage errors (exit 74) are
+// retried after a back-off, never counted nor set aside, and stop the study after five in a row;
+// the test double writes the real solver's summary keys and statuses; a summary the real solver
+// finished but no driver recorded is recorded without rerunning; queries open the database
+// read-only, refuse another program's SQLite file untouched and an empty --db, and print "n/a"
+// for an error that was never recorded.
+#include <signal.h>
+#include <sqlite3.h>
+#include <sys/mount.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "core/run_status.hpp"
+#include "driver/database.hpp"
+
+namespace bd = boycott::driver;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kFake = std::string("python3 ") + FAKE_SOLVER;
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    char tmpl[] = "/tmp/boycott_faults_XXXXXX";
+    path = mkdtemp(tmpl);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+void write(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+struct Run {
+  int rc = -1;
+  std::string out, err;
+};
+
+/// Starts argv[0] (BOYCOTT_BIN unless given) with extra environment; output to files in dir.
+pid_t spawn(std::vector<std::string> args, const fs::path& dir, const std::map<std::string, std::string>& env,
+            const std::string& program = BOYCOTT_BIN) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+    setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+    for (const auto& [k, v] : env) setenv(k.c_str(), v.c_str(), 1);
+    freopen((dir / "stdout.txt").c_str(), "w", stdout);
+    freopen((dir / "stderr.txt").c_str(), "w", stderr);
+    args.insert(args.begin(), program);
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execvp(argv[0], argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+Run wait_run(pid_t pid, const fs::path& dir) {
+  int st = 0;
+  waitpid(pid, &st, 0);
+  Run r;
+  r.rc = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+  r.out = read(dir / "stdout.txt");
+  r.err = read(dir / "stderr.txt");
+  return r;
+}
+
+Run run(const std::vector<std::string>& args, const fs::path& dir,
+        std::map<std::string, std::string> env = {}) {
+  env.try_emplace("FAKE_STEP_WALL_S", "0.01");
+  return wait_run(spawn(args, dir, env), dir);
+}
+
+std::vector<std::string> study_run(const fs::path& study, const fs::path& db,
+                                   const std::string& solver = kFake) {
+  std::vector<std::string> a = {"study", "run", study.string(), "--db", db.string(), "--jobs", "1"};
+  if (!solver.empty()) a.insert(a.end(), {"--solver-command", solver});
+  return a;
+}
+
+std::int64_t count(const fs::path& db, const std::string& sql) {
+  bd::Database d(db.string(), bd::OpenMode::kExisting);
+  auto st = d.prepare(sql);
+  st.step();
+  return st.integer(0);
+}
+
+bool any_set_aside(const fs::path& db) {
+  for (const auto& e : fs::directory_iterator(db.string() + ".runs"))
+    if (e.path().filename().string().find(".bad-") != std::string::npos) return true;
+  return false;
+}
+
+// One case for the fake solver (8 steps).
+const char* kOneCase = R"(
+name = "one"
+[base]
+scene = "inclined_settling"
+[base.particles]
+count = 1000
+[base.time]
+end = 0.8
+average_from = 0.4
+[matrix]
+"gravity.angle_deg" = [60]
+)";
+
+// Two angles for the fake solver (a curve with r_acc).
+const char* kTwo = R"(
+name = "small"
+[base]
+scene = "inclined_settling"
+[base.particles]
+count = 1000
+[base.time]
+end = 0.3
+average_from = 0.1
+[matrix]
+"gravity.angle_deg" = [60, 90]
+)";
+
+// A real coupled case as small as the smoke test, a few steps.
+const char* kRealCoupled = R"(
+name = "real"
+[base]
+scene = "inclined_settling"
+[base.particles]
+volume_fraction = 0.113
+[base.domain]
+length_x = 0.02
+width_y = 0.006
+height_z = 0.02
+cells = [20, 6, 20]
+[base.time]
+end = 0.01
+average_from = 0.005
+[matrix]
+"gravity.angle_deg" = [60]
+)";
+
+}  // namespace
+
+TEST(StudyRunStorage, ExitSeventyFourIsRetriedAfterABackOffNeitherCountedNorSetAside) {
+  TempDir d;
+  write(d.path / "s.toml", kOneCase);
+  const auto db = d.path / "s.db";
+  auto args = study_run(d.path / "s.toml", db);
+  args.insert(args.end(), {"--retries", "0"});
+  // Four storage errors in a row (one fewer than stops a study), then room again.
+  const auto r = run(args, d.path, {{"FAKE_STORAGE_FAILS", "4"}, {"BOYCOTT_TEST_STORAGE_BACKOFF_S", "0.05"}});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 1);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 74"), 4);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE error_text LIKE '%No space left on device%'"), 4);
+  EXPECT_FALSE(any_set_aside(db));
+  EXPECT_NE(r.err.find("not counted as a failure"), std::string::npos) << r.err;
+  // 0.05, 0.1, 0.2, 0.4 s: the back-off doubles.
+  for (const char* wait :
+       {"runs again in 0.05 s", "runs again in 0.1 s", "runs again in 0.2 s", "runs again in 0.4 s"})
+    EXPECT_NE(r.err.find(wait), std::string::npos) << r.err;
+  const auto status =
+      run({"study", "status", (d.path / "s.toml").string(), "--db", db.string(), "--retries", "0"}, d.path);
+  EXPECT_NE(status.out.find("1 cases: 1 done, 0 running, 0 failed"), std::string::npos) << status.out;
+}
+
+TEST(StudyRunStorage, FiveStorageErrorsInARowStopTheStudyNamingTheCause) {
+  TempDir d;
+  write(d.path / "s.toml", kOneCase);
+  const auto db = d.path / "s.db";
+  const auto r = run(study_run(d.path / "s.toml", db), d.path,
+                     {{"FAKE_STORAGE_FAILS", "always"}, {"BOYCOTT_TEST_STORAGE_BACKOFF_S", "0.02"}});
+  EXPECT_EQ(r.rc, boycott::kExitStorageError) << r.err;
+  EXPECT_NE(r.err.find("5 storage errors in a row"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 74"), 5);
+  EXPECT_FALSE(any_set_aside(db));
+  // The case is not failed: the next run (with room) finishes it.
+  const auto status = run({"study", "status", (d.path / "s.toml").string(), "--db", db.string()}, d.path);
+  EXPECT_NE(status.out.find("0 failed"), std::string::npos) << status.out;
+  const auto again = run(study_run(d.path / "s.toml", db), d.path);
+  EXPECT_EQ(again.rc, 0) << again.err;
+}
+
+TEST(FakeSolverContract, SummaryKeysAndStatusesMatchTheRealSolver) {
+  TempDir d;
+  write(d.path / "s.toml", kRealCoupled);
+  const auto db = d.path / "s.db";
+  // The real solver (this program) through the driver: a full case.toml and a real summary.
+  const auto r = run(study_run(d.path / "s.toml", db, ""), d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  fs::path real_dir;
+  for (const auto& e : fs::directory_iterator(db.string() + ".runs")) real_dir = e.path();
+  const auto real = nlohmann::json::parse(read(real_dir / "summary.json"));
+  const fs::path case_file = real_dir / "case.toml";
+
+  // The fake on the same case, made to take a few of its 0.1 s steps.
+  std::string text = read(case_file);
+  const auto at = text.find("\nend = ");
+  ASSERT_NE(at, std::string::npos) << text;
+  text.replace(at, text.find('\n', at + 1) - at, "\nend = 0.5");
+  const fs::path fake_case = d.path / "fake_case.toml";
+  write(fake_case, text);
+  const fs::path fake_dir = d.path / "fake" / real_dir.filename();
+  fs::create_directories(fake_dir.parent_path());
+  const auto f = wait_run(spawn({FAKE_SOLVER, "case", "run", fake_case.string(), "--out", fake_dir.string()},
+                                d.path, {{"FAKE_STEP_WALL_S", "0"}}, "python3"),
+                          d.path);
+  ASSERT_EQ(f.rc, 0) << f.err;
+  const auto fake = nlohmann::json::parse(read(fake_dir / "summary.json"));
+
+  std::set<std::string> missing;
+  for (const auto& [k, v] : fake.items()) {
+    if (!real.contains(k))
+      missing.insert(k);
+    else
+      EXPECT_EQ(real[k].type_name(), std::string(v.type_name())) << k;
+  }
+  EXPECT_TRUE(missing.empty()) << "keys the test double writes and the real solver does not: "
+                               << nlohmann::json(missing).dump();
+  for (const char* k :
+       {"scene", "case_id", "status", "mean_settling_velocity_m_s", "settling_velocity_stderr_m_s",
+        "simulated_time_s", "wall_time_s", "particle_steps"}) {
+    EXPECT_TRUE(real.contains(k)) << k;
+    EXPECT_TRUE(fake.contains(k)) << k;
+  }
+  EXPECT_EQ(real["status"], std::string(boycott::kStatusCompleted));
+  EXPECT_EQ(fake["status"], real["status"]);
+  EXPECT_TRUE(boycott::is_finished_status(real["status"].get<std::string>()));
+
+  // Stopped by SIGTERM: both exit 75 with the summary marked interrupted.
+  const auto stopped = [&](const std::vector<std::string>& args, const std::string& program,
+                           const fs::path& out, const fs::path& sign) {
+    const pid_t pid = spawn(args, d.path, {{"FAKE_STEP_WALL_S", "0.2"}}, program);
+    for (int i = 0; i < 1000 && !fs::exists(sign); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    ::kill(pid, SIGTERM);
+    const auto res = wait_run(pid, d.path);
+    EXPECT_EQ(res.rc, boycott::kExitInterrupted) << res.err;
+    return nlohmann::json::parse(read(out / "summary.json"));
+  };
+  const fs::path real_stop = d.path / "real_stop", fake_stop = d.path / "fake_stop" / real_dir.filename();
+  const auto rs = stopped({"case", "run", case_file.string(), "--out", real_stop.string(), "--quiet", "--set",
+                           "time.end=5", "--set", "time.checkpoint_every=0.005"},
+                          BOYCOTT_BIN, real_stop, real_stop / "checkpoints");
+  const auto fs_ = stopped({FAKE_SOLVER, "case", "run", fake_case.string(), "--out", fake_stop.string()},
+                           "python3", fake_stop, fake_stop / "checkpoint.json");
+  EXPECT_EQ(rs["status"], std::string(boycott::kStatusInterrupted));
+  EXPECT_EQ(fs_["status"], rs["status"]);
+}
+
+TEST(StudyRunLeftSummary, RealSolverSummaryIsRecordedWithoutRerunning) {
+  TempDir d;
+  write(d.path / "s.toml", kRealCoupled);
+  const auto first = d.path / "first.db";
+  ASSERT_EQ(run(study_run(d.path / "s.toml", first, ""), d.path).rc, 0);
+  fs::path left;
+  for (const auto& e : fs::directory_iterator(first.string() + ".runs")) left = e.path();
+  // The state a driver killed between the solver's end and the recording leaves: a run folder
+  // with the real solver's summary.json and no result in the database.
+  const auto db = d.path / "s.db";
+  const fs::path dir = fs::path(db.string() + ".runs") / left.filename();
+  fs::create_directories(dir.parent_path());
+  fs::copy(left, dir, fs::copy_options::recursive);
+  const auto log_before = fs::file_size(dir / "solver.log");
+  // A solver that would fail if it ran.
+  const auto r = run(study_run(d.path / "s.toml", db, "/bin/false"), d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 1);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 1);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 0"), 1);
+  EXPECT_EQ(fs::file_size(dir / "solver.log"), log_before) << "the solver ran again";
+  const auto summary = nlohmann::json::parse(read(dir / "summary.json"));
+  bd::Database c(db.string(), bd::OpenMode::kReadOnly);
+  auto st = c.prepare("SELECT mean_settling_velocity_m_s FROM results");
+  ASSERT_TRUE(st.step());
+  EXPECT_EQ(st.real(0), summary["mean_settling_velocity_m_s"].get<double>());
+}
+
+namespace {
+
+/// A study database of two finished fake cases at d/s.db.
+fs::path fake_study_db(const TempDir& d) {
+  write(d.path / "s.toml", kTwo);
+  const auto db = d.path / "s.db";
+  EXPECT_EQ(run(study_run(d.path / "s.toml", db), d.path).rc, 0);
+  return db;
+}
+
+}  // namespace
+
+TEST(Queries, ReadOnlyDatabaseIsQueriedWithoutWritingToIt) {
+  TempDir d;
+  const auto db = fake_study_db(d);
+  const fs::path mnt = d.path / "ro";
+  fs::create_directories(mnt);
+  bool mounted = ::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=4m") == 0;
+  if (!mounted && geteuid() == 0) GTEST_SKIP() << "cannot mount a tmpfs (" << std::strerror(errno) << ")";
+  fs::copy_file(db, mnt / "s.db");
+  const auto bytes = read(mnt / "s.db");
+  if (mounted) {
+    ASSERT_EQ(::mount("tmpfs", mnt.c_str(), "tmpfs", MS_REMOUNT | MS_RDONLY, nullptr), 0)
+        << std::strerror(errno);
+  } else {
+    fs::permissions(mnt / "s.db", fs::perms::owner_read);
+    fs::permissions(mnt, fs::perms::owner_read | fs::perms::owner_exec);
+  }
+  const std::string ro = (mnt / "s.db").string();
+  const auto curve = run({"query", "curve", "--db", ro, "--study", "small"}, d.path);
+  EXPECT_EQ(curve.rc, 0) << curve.err;
+  EXPECT_NE(curve.out.find("r_acc"), std::string::npos) << curve.out;
+  for (const std::vector<std::string>& q :
+       std::vector<std::vector<std::string>>{{"query", "cases", "--db", ro},
+                                             {"query", "validation", "--db", ro},
+                                             {"study", "status", (d.path / "s.toml").string(), "--db", ro}}) {
+    const auto r = run(q, d.path);
+    EXPECT_EQ(r.rc, 0) << q[1] << ": " << r.err;
+  }
+  EXPECT_EQ(read(mnt / "s.db"), bytes);
+  if (mounted) {
+    ::umount(mnt.c_str());
+  } else {
+    fs::permissions(mnt, fs::perms::owner_all);
+  }
+}
+
+TEST(Queries, QueryLeavesARollbackJournalDatabaseAsItWas) {
+  TempDir d;
+  const auto db = fake_study_db(d);
+  {
+    bd::Database c(db.string(), bd::OpenMode::kExisting);
+    c.exec("PRAGMA journal_mode = DELETE");
+  }
+  const auto bytes = read(db);
+  const auto r = run({"query", "curve", "--db", db.string(), "--study", "small"}, d.path);
+  EXPECT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(read(db), bytes) << "no WAL switch, no write";
+  EXPECT_FALSE(fs::exists(db.string() + "-wal"));
+}
+
+TEST(Queries, ForeignSqliteFileIsRefusedUntouched) {
+  TempDir d;
+  write(d.path / "s.toml", kTwo);
+  const fs::path f = d.path / "other.sqlite";
+  sqlite3* h = nullptr;
+  ASSERT_EQ(sqlite3_open(f.c_str(), &h), SQLITE_OK);
+  sqlite3_exec(
+      h, "CREATE TABLE photos(id INTEGER PRIMARY KEY, name TEXT); INSERT INTO photos(name) VALUES ('a');",
+      nullptr, nullptr, nullptr);
+  sqlite3_close(h);
+  const auto bytes = read(f);
+  for (const std::vector<std::string>& q : std::vector<std::vector<std::string>>{
+           {"query", "curve", "--db", f.string(), "--study", "small"},
+           {"query", "cases", "--db", f.string()},
+           {"query", "validation", "--db", f.string()},
+           {"query", "work-precision", "--db", f.string(), "--study", "small"},
+           {"study", "status", (d.path / "s.toml").string(), "--db", f.string()},
+           study_run(d.path / "s.toml", f)}) {
+    const auto r = run(q, d.path);
+    EXPECT_EQ(r.rc, boycott::kExitInputError) << q[1] << ": " << r.err;
+    EXPECT_NE(r.err.find("another program"), std::string::npos) << q[1] << ": " << r.err;
+    EXPECT_EQ(read(f), bytes) << q[1];
+    EXPECT_FALSE(fs::exists(f.string() + "-wal")) << q[1];
+    EXPECT_FALSE(fs::exists(f.string() + "-shm")) << q[1];
+  }
+}
+
+TEST(Queries, EmptyDbOptionIsRefusedAsUsage) {
+  TempDir d;
+  write(d.path / "s.toml", kTwo);
+  for (const std::vector<std::string>& q :
+       std::vector<std::vector<std::string>>{{"query", "curve", "--db", "", "--study", "small"},
+                                             {"query", "cases", "--db", ""},
+                                             {"study", "status", (d.path / "s.toml").string(), "--db", ""},
+                                             {"study", "run", (d.path / "s.toml").string(), "--db", ""}}) {
+    const auto r = run(q, d.path);
+    EXPECT_EQ(r.rc, boycott::kExitInputError) << q[1] << ": " << r.err;
+    EXPECT_NE(r.err.find("--db"), std::string::npos) << r.err;
+  }
+}
+
+TEST(Queries, MissingErrorPrintsNotAvailable) {
+  TempDir d;
+  const auto db = fake_study_db(d);
+  {
+    bd::Database c(db.string(), bd::OpenMode::kExisting);
+    c.exec("UPDATE results SET settling_velocity_stderr_m_s = NULL");
+  }
+  const auto table = run({"query", "curve", "--db", db.string(), "--study", "small"}, d.path);
+  ASSERT_EQ(table.rc, 0) << table.err;
+  EXPECT_NE(table.out.find("+- n/a"), std::string::npos) << table.out;
+  EXPECT_EQ(table.out.find("+- 0.0000"), std::string::npos) << table.out;
+  const auto json =
+      run({"query", "curve", "--db", db.string(), "--study", "small", "--format", "json"}, d.path);
+  for (const auto& p : nlohmann::json::parse(json.out)) {
+    EXPECT_TRUE(p["stderr_m_s"].is_null()) << p.dump();
+    if (p["angle_deg"] != 90.0) {
+      EXPECT_TRUE(p["r_acc_err"].is_null()) << p.dump();
+    }
+  }
+}
