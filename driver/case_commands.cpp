@@ -1,5 +1,7 @@
 #include "driver/case_commands.hpp"
 
+#include <mpi.h>
+
 #include <csignal>
 #include <cstdio>
 
@@ -47,7 +49,20 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv) {
   ctx.out_dir = opt.out_dir;
   ctx.stop_requested = &g_stop;
   ctx.quiet = opt.quiet;
-  return scenes::run_case(p, ctx);
+  try {
+    return scenes::run_case(p, ctx);
+  } catch (const StorageError& e) {
+    // Only the rank that writes (0) meets a failed write; on several ranks the others wait in
+    // the run's next collective, and finalizing would wait for them forever: say why and end
+    // them all with the storage error's code.
+    int size = 1;
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    if (size == 1) throw;
+    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fflush(stderr);
+    MPI_Abort(MPI_COMM_WORLD, kExitStorageError);
+    throw;
+  }
 }
 
 int case_check(const std::string& file, const std::vector<std::string>& sets) {

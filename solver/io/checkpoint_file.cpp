@@ -401,7 +401,9 @@ fs::path set_aside(const fs::path& checkpoint) {
   for (int k = 1;; ++k) {
     const fs::path to = checkpoint.string() + (k == 1 ? ".bad" : fmt::format(".bad{}", k));
     if (fs::exists(to)) continue;
-    fs::rename(checkpoint, to);
+    std::error_code ec;
+    fs::rename(checkpoint, to, ec);
+    if (ec) storage_failure(fmt::format("cannot set {} aside", checkpoint.string()), ec.message());
     return to;
   }
 }

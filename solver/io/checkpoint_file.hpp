@@ -92,7 +92,8 @@ std::optional<std::filesystem::path> latest_checkpoint(const std::filesystem::pa
 /// The checkpoint files of a run folder, newest first. Does not open them.
 std::vector<std::filesystem::path> checkpoints_newest_first(const std::filesystem::path& run_dir);
 /// Renames a refused checkpoint to <name>.bad (or .bad2, ...), out of the way of later
-/// checkpoints of the same step and of pruning; returns the new path. Never deletes it.
+/// checkpoints of the same step and of pruning; returns the new path. Never deletes it;
+/// StorageError when the rename fails.
 std::filesystem::path set_aside(const std::filesystem::path& checkpoint);
 /// Deletes all but the newest `keep` checkpoints (only complete, older ones).
 void prune_checkpoints(const std::filesystem::path& run_dir, int keep);

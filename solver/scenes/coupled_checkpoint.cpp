@@ -3,6 +3,7 @@
 #include <mpi.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -12,6 +13,7 @@
 
 #include "core/error.hpp"
 #include "core/version.hpp"
+#include "io/state_checks.hpp"
 #include "io/state_io.hpp"
 #include "scenes/run_common.hpp"
 
@@ -88,42 +90,132 @@ void save_coupled(io::CheckpointWriter* w, const coupling::CoupledSystem& run) {
   io::save(*w, "coupler.", coupler);
 }
 
-void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run) {
-  coupling::CoupledCounters c;
-  c.time_s = r.scalar("run.time_s");
-  c.dt_prev_s = r.scalar("run.dt_prev_s");
-  c.steps = r.integer("run.steps");
+namespace {
+
+/// What a coupled run resumes from, read from a checkpoint and checked before any of it reaches
+/// the run (so that a refused file leaves the run as it was, for the next older one).
+struct CoupledCheckpoint {
+  coupling::CoupledCounters counters;
+  particles::DemState dem;
+  fluid::FluidState fluid;
+  std::vector<std::vector<double>> coupler;
+  double wall_time_s = 0.0;
+};
+
+CoupledCheckpoint read_coupled(const io::CheckpointReader& r, const CaseParams& p) {
+  CoupledCheckpoint c;
+  c.counters.time_s = r.scalar("run.time_s");
+  c.counters.dt_prev_s = r.scalar("run.dt_prev_s");
+  c.counters.steps = r.integer("run.steps");
   // absent from checkpoints written before these counters existed
-  c.unconverged_fluid_steps =
+  c.counters.unconverged_fluid_steps =
       r.has("run.unconverged_fluid_steps") ? r.integer("run.unconverged_fluid_steps") : 0;
-  c.pressure_fallbacks = r.has("run.pressure_fallbacks") ? r.integer("run.pressure_fallbacks") : 0;
-  run.restore_counters(c);
+  c.counters.pressure_fallbacks = r.has("run.pressure_fallbacks") ? r.integer("run.pressure_fallbacks") : 0;
+  io::load(r, "dem.", c.dem);
+  io::load(r, "fluid.", c.fluid);
+  c.coupler = io::load_arrays(r, "coupler.");
+  c.wall_time_s = r.scalar("run.wall_time_s");
+  const std::string file = r.path().string();
+  const io::StateBounds box{{p.domain.length_x_m, p.domain.width_y_m, p.domain.height_z_m},
+                            {true, p.domain.periodic_y, true}};
+  io::check_state(c.dem, box, file, "dem.");
+  io::check_state(c.fluid, file, "fluid.");
+  io::check_finite(c.coupler, file, "coupler.");
+  for (const auto& [name, v] : {std::pair{"run.time_s", c.counters.time_s},
+                                {"run.dt_prev_s", c.counters.dt_prev_s},
+                                {"run.wall_time_s", c.wall_time_s}})
+    if (!std::isfinite(v))
+      throw CheckpointError(
+          fmt::format("checkpoint {}: dataset '{}' fails the check: {} is not finite", file, name, v));
+  return c;
+}
+
+void import_coupled(const CoupledCheckpoint& c, coupling::CoupledSystem& run, const std::string& file) {
+  run.restore_counters(c.counters);
   run.decompose();
-  particles::DemState ds;
-  io::load(r, "dem.", ds);
-  run.dem().import_state(ds);
-  fluid::FluidState fs;
-  io::load(r, "fluid.", fs);
-  run.fluid().import_state(own_part(fs, run.fluid(), r.path().string()));
-  run.coupler().import_state(io::load_arrays(r, "coupler."), run.dem());
+  run.dem().import_state(c.dem);
+  run.fluid().import_state(own_part(c.fluid, run.fluid(), file));
+  run.coupler().import_state(c.coupler, run.dem());
+}
+
+/// How one candidate checkpoint fared on this rank.
+enum Verdict : int { kUsable = 0, kRefused = 1, kOtherCase = 2 };
+
+}  // namespace
+
+void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run) {
+  import_coupled(read_coupled(r, run.params()), run, r.path().string());
 }
 
 std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::filesystem::path& run_dir,
                                      bool quiet,
                                      const std::function<void(const io::CheckpointReader&)>& load_scene) {
-  const auto ck = io::latest_checkpoint(run_dir);
-  if (!ck) return std::nullopt;
-  io::CheckpointReader r(*ck);
+  // Listed once, before any is set aside, so that every rank walks the same list.
+  const auto candidates = io::checkpoints_newest_first(run_dir);
+  if (candidates.empty()) return std::nullopt;
   const std::string id = case_id(run.params());
-  if (r.string("case_id") != id)
-    throw CheckpointError(fmt::format("{} belongs to case {}, not {}; it is left in place", ck->string(),
-                                      r.string("case_id"), id));
-  load_coupled(r, run);
-  load_scene(r);
-  truncate_csv_after(run_dir / "timeseries.csv", run.time_s());
-  if (!quiet && output_rank())
-    std::fprintf(stderr, "resuming from %s at t = %g s\n", ck->c_str(), run.time_s());
-  return r.scalar("run.wall_time_s");
+  std::vector<std::string> refused;
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    const auto& ck = candidates[k];
+    // Every rank reads and checks the same bytes; the verdicts are combined all the same, so
+    // that no rank resumes from a file another one refused.
+    std::optional<io::CheckpointReader> r;
+    std::optional<CoupledCheckpoint> state;
+    std::string why;
+    int verdict = kUsable;
+    try {
+      r.emplace(ck);
+      const std::string stored = r->string("case_id");
+      if (stored != id) {
+        verdict = kOtherCase;
+        why = fmt::format("{} belongs to case {}, not {}; it is left in place", ck.string(), stored, id);
+      } else {
+        state = read_coupled(*r, run.params());
+      }
+    } catch (const CheckpointError& e) {
+      verdict = kRefused;
+      why = e.what();
+    } catch (const std::exception& e) {
+      // What a damaged file without a hash can make a reader throw (a size beyond memory, say):
+      // refused all the same, and every rank still reaches the reduction below.
+      verdict = kRefused;
+      why = fmt::format("checkpoint {} is unreadable: {}", ck.string(), e.what());
+    }
+    int worst = verdict;
+    MPI_Allreduce(&verdict, &worst, 1, MPI_INT, MPI_MAX, run.fluid().comm());
+    if (worst == kOtherCase)
+      throw CheckpointError(why.empty() ? fmt::format("{} belongs to another case", ck.string()) : why);
+    if (worst == kRefused) {
+      if (why.empty()) why = fmt::format("checkpoint {} was refused on another rank", ck.string());
+      if (output_rank()) std::fprintf(stderr, "checkpoint refused: %s\n", why.c_str());
+      refused.push_back(why);
+      continue;
+    }
+    import_coupled(*state, run, ck.string());
+    load_scene(*r);
+    if (output_rank()) {
+      // Out of the way of this run's later checkpoints of the same steps, and of pruning.
+      for (std::size_t j = 0; j < k; ++j) {
+        const auto kept = io::set_aside(candidates[j]);
+        std::fprintf(stderr, "refused checkpoint kept as %s\n", kept.c_str());
+      }
+      if (r->integrity() == io::Integrity::kUnverified)
+        std::fprintf(stderr,
+                     "note: %s carries no hash (written before checkpoints did): resumed from it "
+                     "unverified\n",
+                     ck.c_str());
+    }
+    truncate_csv_after(run_dir / "timeseries.csv", run.time_s());
+    if (!quiet && output_rank())
+      std::fprintf(stderr, "resuming from %s at t = %g s%s\n", ck.c_str(), run.time_s(),
+                   k > 0 ? " (an older checkpoint: the newer ones were refused)" : "");
+    return state->wall_time_s;
+  }
+  std::string all;
+  for (const auto& w : refused) all += (all.empty() ? "" : "; ") + w;
+  throw CheckpointError(fmt::format(
+      "no usable checkpoint in {}: {} refused ({}); they are left in place: move them away to start over",
+      (run_dir / "checkpoints").string(), refused.size(), all));
 }
 
 void checkpoint_coupled(const coupling::CoupledSystem& run, const std::filesystem::path& run_dir,

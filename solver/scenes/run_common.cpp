@@ -6,12 +6,16 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 
 #include <fmt/format.h>
 
+#include "core/error.hpp"
 #include "core/version.hpp"
+#include "io/atomic_file.hpp"
 #include "scenes/scene.hpp"
 
 namespace boycott::scenes {
@@ -36,21 +40,7 @@ bool output_rank() {
 
 void write_file_atomic(const std::filesystem::path& path, const std::string& text) {
   if (!output_rank()) return;
-  const auto tmp = path.string() + ".tmp";
-  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (fd < 0) throw std::runtime_error(fmt::format("cannot write {}", tmp));
-  std::size_t off = 0;
-  while (off < text.size()) {
-    auto n = ::write(fd, text.data() + off, text.size() - off);
-    if (n <= 0) {
-      ::close(fd);
-      throw std::runtime_error(fmt::format("write to {} failed", tmp));
-    }
-    off += static_cast<std::size_t>(n);
-  }
-  ::fsync(fd);
-  ::close(fd);
-  std::filesystem::rename(tmp, path);
+  io::write_file_atomic(path, text);
 }
 
 namespace {
@@ -79,11 +69,11 @@ nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const Mod
 }
 
 CsvWriter::CsvWriter(const std::filesystem::path& path, std::vector<std::string> columns, bool append)
-    : ncol_(columns.size()) {
+    : path_(path), ncol_(columns.size()) {
   if (!output_rank()) return;
   const bool exists = std::filesystem::exists(path) && std::filesystem::file_size(path) > 0;
   f_ = std::fopen(path.c_str(), append && exists ? "a" : "w");
-  if (!f_) throw std::runtime_error(fmt::format("cannot write {}", path.string()));
+  if (!f_) throw StorageError(fmt::format("cannot write {}: {}", path.string(), std::strerror(errno)));
   if (!(append && exists)) {
     for (std::size_t i = 0; i < columns.size(); ++i) std::fprintf(f_, i ? ",%s" : "%s", columns[i].c_str());
     std::fputc('\n', f_);
@@ -97,12 +87,18 @@ CsvWriter::~CsvWriter() {
 void CsvWriter::row(const std::vector<double>& values) {
   if (!f_) return;
   for (std::size_t i = 0; i < values.size() && i < ncol_; ++i)
-    std::fprintf(f_, i ? ",%.10g" : "%.10g", values[i]);
-  std::fputc('\n', f_);
+    if (std::fprintf(f_, i ? ",%.10g" : "%.10g", values[i]) < 0 && !error_) error_ = errno;
+  if (std::fputc('\n', f_) == EOF && !error_) error_ = errno;
 }
 
 void CsvWriter::flush() {
-  if (f_) std::fflush(f_);
+  if (!f_) return;
+  if (std::fflush(f_) != 0 && !error_) error_ = errno;
+  // A row that did not reach the file is a lost row: stop here (the checkpoint written next
+  // would claim rows the file does not have).
+  if (error_ || std::ferror(f_))
+    throw StorageError(
+        fmt::format("cannot write {}: {}", path_.string(), std::strerror(error_ ? error_ : EIO)));
 }
 
 void truncate_csv_after(const std::filesystem::path& path, double t_max) {

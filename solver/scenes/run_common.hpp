@@ -22,7 +22,8 @@ namespace boycott::scenes {
 bool output_rank();
 
 /// Writes `text` to `path` through a temporary file, fsync and rename, so a reader (or a kill)
-/// never sees half a file. Only on the output rank (a no-op on the others).
+/// never sees half a file. Only on the output rank (a no-op on the others). A failed write is a
+/// StorageError naming the file and the cause; `path` is left as it was.
 void write_file_atomic(const std::filesystem::path& path, const std::string& text);
 
 /// Common summary keys. Scene-specific keys are added to the returned object by the scene.
@@ -37,7 +38,8 @@ struct SummaryBase {
 nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const ModelTimers& timers);
 
 /// Appends rows to a CSV file with a fixed header; creates it (with the header) when absent.
-/// Only the output rank writes.
+/// Only the output rank writes. A row that could not be written (disk full, I/O error) is a
+/// StorageError at the next flush(), naming the file and the cause.
 class CsvWriter {
  public:
   CsvWriter(const std::filesystem::path& path, std::vector<std::string> columns, bool append);
@@ -48,8 +50,10 @@ class CsvWriter {
   CsvWriter& operator=(const CsvWriter&) = delete;
 
  private:
+  std::filesystem::path path_;
   std::FILE* f_ = nullptr;
   std::size_t ncol_;
+  int error_ = 0;  ///< errno of the first failed write since opening
 };
 
 /// Drops the rows of a CSV file whose first column exceeds t_max (a resumed run repeats nothing

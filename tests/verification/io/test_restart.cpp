@@ -133,18 +133,39 @@ TEST(BadCheckpoint, TruncatedFileIsRefusedAndLeftInPlace) {
   const fs::path d = fs::temp_directory_path() / "boycott_restart_trunc";
   fs::remove_all(d);
   ASSERT_EQ(run_in(p, d, 0.03), kExitInterrupted);
-  const auto ck = io::latest_checkpoint(d);
-  ASSERT_TRUE(ck);
-  const auto size = fs::file_size(*ck);
-  fs::resize_file(*ck, size / 2);
+  const auto all = io::checkpoints_newest_first(d);
+  ASSERT_EQ(all.size(), 2u);  // t = 0.025 (the schedule) and 0.03 (the stop)
+  const auto ck = all.front();
+  const auto size = fs::file_size(ck);
+  fs::resize_file(ck, size / 2);
+  // The only checkpoint: refused, naming it, and left as it is.
+  fs::remove(all.back());
   try {
     run_in(p, d);
     FAIL() << "a truncated checkpoint was accepted";
   } catch (const CheckpointError& e) {
-    EXPECT_NE(std::string(e.what()).find(ck->filename().string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(ck.filename().string()), std::string::npos) << e.what();
   }
-  EXPECT_EQ(fs::file_size(*ck), size / 2);  // not overwritten, not deleted
+  EXPECT_EQ(fs::file_size(ck), size / 2);  // not overwritten, not deleted
   EXPECT_FALSE(fs::exists(d / "summary.json") && summary(d)["status"] == "completed");
+}
+
+TEST(BadCheckpoint, TruncatedNewestIsSetAsideAndTheRunResumesFromTheOlderOne) {
+  const CaseParams p = small_case();
+  const fs::path ref = fs::temp_directory_path() / "boycott_restart_trunc_ref",
+                 d = fs::temp_directory_path() / "boycott_restart_trunc_older";
+  fs::remove_all(ref);
+  fs::remove_all(d);
+  ASSERT_EQ(run_in(p, ref), kExitOk);
+  ASSERT_EQ(run_in(p, d, 0.03), kExitInterrupted);
+  const auto ck = *io::latest_checkpoint(d);
+  const auto size = fs::file_size(ck);
+  fs::resize_file(ck, size / 2);
+  ASSERT_EQ(run_in(p, d), kExitOk);
+  EXPECT_EQ(fs::file_size(ck.string() + ".bad"), size / 2);  // kept aside, never deleted
+  EXPECT_EQ(summary(d)["mean_settling_velocity_m_s"], summary(ref)["mean_settling_velocity_m_s"]);
+  EXPECT_EQ(summary(d)["dem_steps"], summary(ref)["dem_steps"]);
+  EXPECT_EQ(slurp(d / "timeseries.csv"), slurp(ref / "timeseries.csv"));
 }
 
 TEST(BadCheckpoint, CheckpointOfOtherParametersIsRefused) {
