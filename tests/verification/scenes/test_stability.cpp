@@ -22,6 +22,7 @@
 #include "core/constants.hpp"
 #include "core/error.hpp"
 #include "coupling/drag_laws.hpp"
+#include "io/checkpoint_file.hpp"
 #include "scenes/preflight.hpp"
 #include "scenes/scene.hpp"
 
@@ -228,7 +229,11 @@ TEST(Preflight, ReportsTheDimensionlessGroupsOfTheBaseCase) {
 
 // ---- NaN: stopped before it is checkpointed, the last good checkpoint kept ----
 
+/// Angular velocities that no state check refuses (finite) but whose sum overflows in the first
+/// step, written into the checkpoint, which is then sealed again (a NaN itself, or an edited
+/// file whose hash no longer matches, is refused on resume: io/state_checks, io/checkpoint_file).
 void poison_first_angular_velocity(const fs::path& checkpoint) {
+  fs::resize_file(checkpoint, fs::file_size(checkpoint) - 81);  // the hash footer
   const hid_t f = H5Fopen(checkpoint.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
   ASSERT_GE(f, 0);
   // dem.array06 is wx (ParticleStore::for_each_array order: x y z vx vy vz wx ...).
@@ -237,11 +242,12 @@ void poison_first_angular_velocity(const fs::path& checkpoint) {
   const hid_t space = H5Dget_space(ds);
   std::vector<double> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
   H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
-  v.at(0) = std::nan("");
+  v.at(0) = v.at(1) = 1.7e308;
   H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
   H5Sclose(space);
   H5Dclose(ds);
   H5Fclose(f);
+  io::seal_file(checkpoint);
 }
 
 std::set<std::string> files_in(const fs::path& dir) {
