@@ -81,9 +81,16 @@ int case_check(const std::string& file, const std::vector<std::string>& sets) {
   return 0;
 }
 
-int case_keys() {
-  const auto j = to_json(CaseParams{});
-  for (const auto& k : case_key_names()) {
+int case_keys(const std::string& scene) {
+  // A scene's keys at its own defaults (resolved for Table III's box), or every key.
+  CaseParams p;
+  if (!scene.empty()) {
+    apply_override(p, "scene=\"" + scene + "\"");
+    validate(p);
+  }
+  const auto j = to_json_all_keys(p);
+  if (!scene.empty()) std::printf("scene %s: %s\n", scene.c_str(), scene_spec(scene).measures.c_str());
+  for (const auto& k : scene.empty() ? case_key_names() : case_key_names(scene)) {
     std::string ptr = "/" + k;
     for (auto& c : ptr)
       if (c == '.') c = '/';

@@ -17,6 +17,7 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv);
 /// `boycott case check`: validates and prints the pre-flight report.
 int case_check(const std::string& file, const std::vector<std::string>& sets);
 /// `boycott case keys`: every key with its default.
-int case_keys();
+/// The case keys with their defaults: every key, or those `scene` reads at its defaults.
+int case_keys(const std::string& scene);
 
 }  // namespace boycott::driver

@@ -135,7 +135,9 @@ Database::Database(const std::string& path, OpenMode mode, int target_version) :
           "database '{}' has schema version {}, newer than this program's {}: use a newer boycott", path, v,
           latest_version()));
     if (mode == OpenMode::kReadOnly) {
-      if (v < latest_version())
+      // Version 2 holds every table and column a query reads (3 adds only the identity scheme's
+      // record); older ones need the upgrade a `study run` makes.
+      if (v < 2)
         throw DatabaseError(
             fmt::format("database '{}' has schema version {}, older than this program's {}: a query does not "
                         "upgrade it; run `boycott study run` on it once",

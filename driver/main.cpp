@@ -83,7 +83,9 @@ int main(int argc, char** argv) {
   check->add_option("case", check_file, "case file (TOML)")->required()->check(CLI::ExistingFile);
   check->add_option("--set", check_sets, "override a key: section.key=value")->take_all();
 
-  auto* keys = case_cmd->add_subcommand("keys", "list every case key and its default");
+  std::string keys_scene;
+  auto* keys = case_cmd->add_subcommand("keys", "list every case key and its default (or a scene's)");
+  keys->add_option("--scene", keys_scene, "only the keys this scene reads, at its defaults");
 
   // ---- study ----
   auto* study_cmd = app.add_subcommand("study", "run a study (a matrix of cases) into a database");
@@ -203,6 +205,6 @@ int main(int argc, char** argv) {
   }
   if (check->parsed())
     return run_guarded([&] { return boycott::driver::case_check(check_file, check_sets); });
-  if (keys->parsed()) return run_guarded([&] { return boycott::driver::case_keys(); });
+  if (keys->parsed()) return run_guarded([&] { return boycott::driver::case_keys(keys_scene); });
   return 0;
 }

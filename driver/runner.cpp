@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "driver/case_id_migration.hpp"
 #include "driver/curve.hpp"
 #include "driver/database.hpp"
 #include "driver/scheduler.hpp"
@@ -45,8 +46,14 @@ int study_run(const StudyRunOptions& opt) {
   // The whole study is expanded and validated before the database is touched.
   const Study study = expand_study_file(opt.study_file);
   Database db(opt.db_path, OpenMode::kCreate);
-  register_study(db, study);
   const fs::path root = runs_root(opt.db_path);
+  // Ids of an older identity scheme become this one's before the study's cases are matched.
+  const IdMigration moved = migrate_case_ids(db, root);
+  if (moved.cases > 0)
+    std::fprintf(stderr,
+                 "case identity version %d: %d case ids recomputed (%d merged), %d run folders renamed\n",
+                 kCaseIdVersion, moved.cases, moved.merged, moved.folders);
+  register_study(db, study);
   fs::create_directories(root);
   auto solver = solver_argv(opt.solver_command);
   install_stop_handlers();

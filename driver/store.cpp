@@ -136,9 +136,10 @@ void record_result(Database& db, std::int64_t attempt, const std::string& case_i
     pst.bind(1, case_id);
     std::optional<double> from, to;
     if (pst.step()) {
+      // Scenes that do not average have no time.average_from (and channel_flow no window at all).
       const auto p = nlohmann::json::parse(pst.text(0));
-      from = p["time"]["average_from"].get<double>();
-      to = p["time"]["end"].get<double>();
+      if (auto f = json_number(p.value("time", nlohmann::json::object()), "average_from")) from = f;
+      if (auto e = json_number(p.value("time", nlohmann::json::object()), "end")) to = e;
     }
     if (auto t = json_number(summary, "simulated_time_s")) to = t;
     std::optional<std::int64_t> steps;

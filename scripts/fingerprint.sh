@@ -32,6 +32,6 @@ run demo90_piso 1 "$c/inclined_settling_smoke.toml" --set gravity.angle_deg=90 -
 run sediment 1 "$c/sediment_transport.toml" --set time.end=0.05 --set time.average_from=0.02
 run ergun 1 "$c/ergun.toml"
 run single 1 "$c/single_particle.toml" --set time.end=0.1 --set time.average_from=0.05
-run channel 1 "$c/channel_flow.toml" --set time.end=0.2 --set time.average_from=0.1
-run channel_2ranks 2 "$c/channel_flow.toml" --set time.end=0.2 --set time.average_from=0.1
+run channel 1 "$c/channel_flow.toml" --set time.end=0.2
+run channel_2ranks 2 "$c/channel_flow.toml" --set time.end=0.2
 run dem_only 1 "$c/dem_only.toml" --set time.end=0.05 --set time.average_from=0.02

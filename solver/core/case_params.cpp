@@ -1,6 +1,7 @@
 #include "core/case_params.hpp"
 
 #include <algorithm>
+#include <array>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -12,6 +13,7 @@
 #include "core/constants.hpp"
 #include "core/error.hpp"
 #include "core/hash.hpp"
+#include "core/model_names.hpp"
 
 namespace boycott {
 namespace {
@@ -62,7 +64,7 @@ void visit_keys(P& p, V&& v) {
 
   v("fluid.density", p.fluid.density_kg_m3, positive("kg/m^3"));
   v("fluid.viscosity", p.fluid.viscosity_pa_s, positive("Pa s"));
-  v("fluid.subgrid_model", p.fluid.subgrid_model, choice({"vreman", "none"}));
+  v("fluid.subgrid_model", p.fluid.subgrid_model, choice(subgrid_model_names()));
 
   v("particles.diameter", p.particles.diameter_m, positive("m"));
   v("particles.density", p.particles.density_kg_m3, positive("kg/m^3"));
@@ -75,8 +77,8 @@ void visit_keys(P& p, V&& v) {
   v("contact.friction", p.contact.friction, nonneg(""));
   v("contact.rolling_friction", p.contact.rolling_friction, nonneg(""));
   v("contact.tangential_damping_ratio", p.contact.tangential_damping_ratio, range(0.0, 1.0));
-  v("contact.model", p.contact.model, choice({"linear_spring_dashpot"}));
-  v("contact.rolling_model", p.contact.rolling_model, choice({"constant_directional", "none"}));
+  v("contact.model", p.contact.model, choice(contact_model_names()));
+  v("contact.rolling_model", p.contact.rolling_model, choice(rolling_model_names()));
   v("contact.clip_attractive_normal", p.contact.clip_attractive_normal, any());
 
   v("domain.length_x", p.domain.length_x_m, positive("m"));
@@ -95,7 +97,7 @@ void visit_keys(P& p, V&& v) {
   v("time.average_from", p.time.average_from_s, nonneg("s"));
   v("time.checkpoint_every", p.time.checkpoint_every_s, positive("s"));
 
-  v("forces.drag", p.forces.drag, choice({"difelice_paper", "schiller_naumann", "stokes", "none"}));
+  v("forces.drag", p.forces.drag, choice(drag_law_names()));
   v("forces.saffman_lift", p.forces.saffman_lift, any());
   v("forces.added_mass", p.forces.added_mass, any());
   v("forces.pressure_gradient", p.forces.pressure_gradient, any());
@@ -112,8 +114,7 @@ void visit_keys(P& p, V&& v) {
   v("numerics.piso_correctors", p.numerics.piso_correctors, range(1, 100));
   v("numerics.cfl_max", p.numerics.cfl_max, open_range(0.0, 1.0, true, false));
   v("numerics.neighbor_skin", p.numerics.neighbor_skin_m, positive("m"));
-  v("numerics.void_fraction_kernel", p.numerics.void_fraction_kernel,
-    choice({"trilinear_smoothed", "trilinear", "cell"}));
+  v("numerics.void_fraction_kernel", p.numerics.void_fraction_kernel, choice(kernel_names()));
 
   v("output.timeseries_every", p.output.timeseries_every_s, optional(positive("s")));
   v("output.keep_checkpoints", p.output.keep_checkpoints, range(1, 1000));
@@ -304,8 +305,12 @@ CaseParams from_toml_table(const toml::table& tbl) {
   std::set<std::string> known;
   visit_keys(p, [&](const char* key, auto& ref, const Rule&) {
     known.insert(key);
-    if (auto node = tbl.at_path(key)) from_toml(key, *node.node(), ref);
+    if (auto node = tbl.at_path(key)) {
+      from_toml(key, *node.node(), ref);
+      p.set_keys.emplace_back(key);
+    }
   });
+  std::sort(p.set_keys.begin(), p.set_keys.end());
   std::vector<std::string> present;
   collect_toml_keys(tbl, "", present);
   for (const auto& k : present) {
@@ -315,13 +320,6 @@ CaseParams from_toml_table(const toml::table& tbl) {
 }
 
 }  // namespace
-
-const std::vector<std::string>& scene_names() {
-  static const std::vector<std::string> names = {"inclined_settling", "ergun",        "sediment_transport",
-                                                 "single_particle",   "channel_flow", "dem_only",
-                                                 "hindered_settling"};
-  return names;
-}
 
 double CaseParams::particle_volume_m3() const {
   return kPi / 6.0 * particles.diameter_m * particles.diameter_m * particles.diameter_m;
@@ -375,16 +373,14 @@ CaseParams case_from_json(const nlohmann::json& j) {
     auto ptr = pointer_of(key);
     if (j.contains(ptr)) from_json(key, j.at(ptr), ref);
   });
+  // The canonical form holds resolved values (written after validate()).
+  p.resolved = true;
   return p;
 }
 
-void apply_override(CaseParams& p, const std::string& assignment) {
-  const auto eq = assignment.find('=');
-  if (eq == std::string::npos || eq == 0)
-    throw InputError(fmt::format("--set '{}': expected key=value", assignment));
-  std::string key = assignment.substr(0, eq);
-  std::string value = assignment.substr(eq + 1);
-  key.erase(key.find_last_not_of(" \t") + 1);
+namespace {
+/// Sets one key from a TOML value; returns false for an unknown key.
+bool set_key(CaseParams& p, const std::string& key, const std::string& value) {
   toml::table t;
   try {
     t = toml::parse("v = " + value);
@@ -399,37 +395,91 @@ void apply_override(CaseParams& p, const std::string& assignment) {
       found = true;
     }
   });
-  if (!found) throw InputError(fmt::format("--set: unknown key '{}'", key));
-  // The particle load is given one way or the other; the later assignment wins (otherwise a
-  // count set over a case file's volume_fraction would be silently ignored).
-  if (key == "particles.count") p.particles.volume_fraction = kUnset;
+  return found;
 }
 
-void validate(CaseParams& p) {
-  visit_keys(p, [&](const char* key, auto& ref, const Rule& r) { check_value(key, ref, r); });
+bool is_set_key(const CaseParams& p, const std::string& key) {
+  return std::binary_search(p.set_keys.begin(), p.set_keys.end(), key);
+}
+}  // namespace
 
-  const double d = p.particles.diameter_m;
-  // single_particle is one sphere by definition, whatever the Table III default count says.
-  if (p.scene == "single_particle") {
-    p.particles.count = 1;
+void apply_override(CaseParams& p, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError(fmt::format("--set '{}': expected key=value", assignment));
+  std::string key = assignment.substr(0, eq);
+  std::string value = assignment.substr(eq + 1);
+  key.erase(key.find_last_not_of(" \t") + 1);
+  if (!set_key(p, key, value)) throw InputError(fmt::format("--set: unknown key '{}'", key));
+  p.set_keys.insert(std::lower_bound(p.set_keys.begin(), p.set_keys.end(), key), key);
+  p.set_keys.erase(std::unique(p.set_keys.begin(), p.set_keys.end()), p.set_keys.end());
+  // The particle load is given one way or the other; the later assignment wins (otherwise a
+  // count set over a case file's volume_fraction would be silently ignored).
+  if (key == "particles.count") {
     p.particles.volume_fraction = kUnset;
+    p.set_keys.erase(std::remove(p.set_keys.begin(), p.set_keys.end(), "particles.volume_fraction"),
+                     p.set_keys.end());
+  }
+  if (key == "particles.volume_fraction")
+    p.set_keys.erase(std::remove(p.set_keys.begin(), p.set_keys.end(), "particles.count"), p.set_keys.end());
+}
+
+namespace {
+
+/// The scene's defaults, the particle count and the skin, for the keys the user did not set.
+void resolve_defaults(CaseParams& p, const SceneSpec& sc) {
+  for (const auto& [key, value] : sc.defaults)
+    if (!is_set_key(p, key)) set_key(p, key, value);
+  const bool reads_count = scene_reads(sc, "particles.count");
+  if (!reads_count) {
+    // single_particle is one sphere by definition; scenes without particles have none.
+    p.particles.count = sc.name == "single_particle" ? 1 : 0;
+    p.particles.volume_fraction = kUnset;
+  } else if (!is_set_key(p, "particles.count") && !is_set(p.particles.volume_fraction)) {
+    // Neither given: the scene's solid fraction (Table III's unless the scene has its own) in the
+    // case's own box.
+    p.particles.volume_fraction = sc.default_solid_fraction;
   }
   if (is_set(p.particles.volume_fraction)) {
     p.particles.count =
         std::llround(p.particles.volume_fraction * p.box_volume_m3() / p.particle_volume_m3());
     p.particles.volume_fraction = kUnset;  // resolved: equal cases hash equal whichever way given
   }
-  if (!p.domain.periodic_y && d >= p.domain.width_y_m)
+  // The skin must not exceed the diameter (pairs further than d + skin apart never meet within
+  // a rebuild); Table III's 0.3 mm where d allows.
+  if (!is_set_key(p, "numerics.neighbor_skin"))
+    p.numerics.neighbor_skin_m = std::min(NumericsParams{}.neighbor_skin_m, p.particles.diameter_m);
+  p.resolved = true;
+}
+
+}  // namespace
+
+void validate(CaseParams& p) {
+  visit_keys(p, [&](const char* key, auto& ref, const Rule& r) { check_value(key, ref, r); });
+  const SceneSpec& sc = scene_spec(p.scene);
+  for (const auto& key : p.set_keys)
+    if (key != "scene" && !scene_reads(sc, key))
+      throw InputError(
+          fmt::format("{} is not used by scene {}: the scene would ignore or overwrite it (`boycott "
+                      "case keys --scene {}` lists the keys it reads)",
+                      key, sc.name, sc.name));
+  if (!p.resolved) resolve_defaults(p, sc);
+  const auto reads = [&](const char* key) { return scene_reads(sc, key); };
+
+  const double d = p.particles.diameter_m;
+  const bool particles = reads("particles.diameter");
+  if (particles && !p.domain.periodic_y && d >= p.domain.width_y_m)
     throw InputError(
         fmt::format("particles.diameter = {} m does not fit the channel: must be < domain.width_y = {} m",
                     fmt_num(d), fmt_num(p.domain.width_y_m)));
   // The minimum-image convention needs a periodic length of at least two diameters.
-  for (auto [name, len] :
-       {std::pair{"domain.length_x", p.domain.length_x_m}, {"domain.height_z", p.domain.height_z_m}})
-    if (len < 2.0 * d)
-      throw InputError(
-          fmt::format("{} = {} m is too short for particles.diameter = {} m: must be >= 2 d = {} m", name,
-                      fmt_num(len), fmt_num(d), fmt_num(2.0 * d)));
+  if (particles)
+    for (auto [name, len] :
+         {std::pair{"domain.length_x", p.domain.length_x_m}, {"domain.height_z", p.domain.height_z_m}})
+      if (len < 2.0 * d)
+        throw InputError(
+            fmt::format("{} = {} m is too short for particles.diameter = {} m: must be >= 2 d = {} m", name,
+                        fmt_num(len), fmt_num(d), fmt_num(2.0 * d)));
   // Random close packing of monodisperse spheres: no more can be placed without overlap.
   constexpr double kRandomClosePacking = 0.64;
   const double ap = p.solid_fraction();
@@ -437,83 +487,112 @@ void validate(CaseParams& p) {
   // (Table I, 19561 spheres of 1 mm in 0.02 x 0.02 x 0.04 m) is at 0.6401.
   const double max_fraction =
       p.particles.insertion == "packed" ? kRandomClosePacking + 0.005 : kRandomClosePacking;
-  if (ap > max_fraction)
+  if (reads("particles.count") && ap > max_fraction)
     throw InputError(
         fmt::format("particles.count = {} overfills the box: solid fraction {:.4f} exceeds {} "
                     "(random close packing{})",
                     p.particles.count, ap, max_fraction,
                     p.particles.insertion == "packed" ? " with soft-sphere overlap" : ""));
-  if (p.particles.count > 0 && p.particles.insertion == "random" && ap > 0.45)
+  if (reads("particles.count") && p.particles.count > 0 && p.particles.insertion == "random" && ap > 0.45)
     throw InputError(
         fmt::format("particles.count = {} (solid fraction {:.4f}) is too dense for random insertion: must be "
-                    "<= 0.45; use "
-                    "particles.insertion = \"bed\" or \"packed\"",
+                    "<= 0.45; use particles.insertion = \"bed\" or \"packed\"",
                     p.particles.count, ap));
 
   const double limit = p.dem_spring_limit_s();
-  if (p.particles.count > 0 && p.time.dt_dem_s > limit)
+  if (particles && p.particles.count > 0 && reads("time.dt_dem") && p.time.dt_dem_s > limit)
     throw InputError(fmt::format(
         "time.dt_dem = {:.4g} us exceeds the spring limit (pi/5) sqrt(m/k_n) = {:.4g} us for "
         "contact.stiffness = {} N/m "
         "and particle mass {:.4g} kg",
         p.time.dt_dem_s * 1e6, limit * 1e6, fmt_num(p.contact.stiffness_n_m), p.particle_mass_kg()));
-  if (p.time.dt_dem_s > p.time.dt_cfd_s * (1.0 + 1e-12))
-    throw InputError(fmt::format("time.dt_dem = {} s must be <= time.dt_cfd = {} s", fmt_num(p.time.dt_dem_s),
-                                 fmt_num(p.time.dt_cfd_s)));
-  const double ratio = p.time.dt_cfd_s / p.time.dt_dem_s;
-  if (std::abs(ratio - std::round(ratio)) > 1e-6 * ratio)
-    throw InputError(
-        fmt::format("time.dt_cfd / time.dt_dem = {} must be a whole number of DEM sub-steps", ratio));
-  if (p.time.average_from_s >= p.time.end_s)
-    throw InputError(fmt::format("time.average_from = {} s must be < time.end = {} s",
-                                 fmt_num(p.time.average_from_s), fmt_num(p.time.end_s)));
-  if (p.numerics.neighbor_skin_m > d)
+  if (reads("time.dt_dem") && reads("time.dt_cfd")) {
+    if (p.time.dt_dem_s > p.time.dt_cfd_s * (1.0 + 1e-12))
+      throw InputError(fmt::format("time.dt_dem = {} s must be <= time.dt_cfd = {} s",
+                                   fmt_num(p.time.dt_dem_s), fmt_num(p.time.dt_cfd_s)));
+    const double ratio = p.time.dt_cfd_s / p.time.dt_dem_s;
+    if (std::abs(ratio - std::round(ratio)) > 1e-6 * ratio)
+      throw InputError(
+          fmt::format("time.dt_cfd / time.dt_dem = {} must be a whole number of DEM sub-steps", ratio));
+  }
+  if (reads("time.average_from") && p.time.average_from_s >= p.time.end_s)
+    throw InputError(fmt::format(
+        "time.average_from = {} s{} must be < time.end = {} s", fmt_num(p.time.average_from_s),
+        is_set_key(p, "time.average_from") ? "" : " (Table III's default)", fmt_num(p.time.end_s)));
+  if (reads("numerics.neighbor_skin") && p.numerics.neighbor_skin_m > d)
     throw InputError(fmt::format("numerics.neighbor_skin = {} m must be <= particles.diameter = {} m",
                                  fmt_num(p.numerics.neighbor_skin_m), fmt_num(d)));
 }
 
 nlohmann::json to_json(const CaseParams& p) {
+  const SceneSpec* sc = nullptr;
+  for (const auto& s : scene_specs())
+    if (s.name == p.scene) sc = &s;
+  nlohmann::json j = nlohmann::json::object();
+  visit_keys(p, [&](const char* key, const auto& ref, const Rule&) {
+    if (std::string_view(key) == "scene" || !sc || scene_reads(*sc, key))
+      j[pointer_of(key)] = json_value(ref);
+  });
+  return j;
+}
+
+nlohmann::json to_json_all_keys(const CaseParams& p) {
   nlohmann::json j = nlohmann::json::object();
   visit_keys(p, [&](const char* key, const auto& ref, const Rule&) { j[pointer_of(key)] = json_value(ref); });
   return j;
 }
 
+bool is_output_only_key(const std::string& key) {
+  return key == "time.end" || key == "time.checkpoint_every" || key == "time.target_rel_error" ||
+         key.rfind("output.", 0) == 0;
+}
+
 namespace {
-/// Keys added after the id scheme was fixed. They enter a case's id only when they differ from
-/// their defaults, so adding a key never changes the id of an existing case: a study database
-/// written by an older binary resumes without repeating its finished cases. Append every new
-/// key here.
-constexpr const char* kKeysHashedOnlyWhenSet[] = {"numerics.pressure_velocity_coupling",
-                                                  "numerics.piso_correctors"};
-// Keys added later that only one scene reads: hashed for that scene only, so that the ids of
-// every other scene's cases stay as they were. (Its own cases get new ids: their results
-// changed with the key's default.)
-struct SceneOnlyKey {
+/// Keys added after identity version 2, each with the value that reproduces the behaviour
+/// before it existed: the key enters a case's id only when its value differs from that, so
+/// adding a key never changes the id of a case that does not use it. Append every new key here.
+struct LateKey {
   const char* key;
-  const char* scene;
+  const char* old_behaviour;  ///< the value as JSON text
 };
-constexpr SceneOnlyKey kSceneOnlyKeys[] = {{"sediment.initial_flow", "sediment_transport"}};
+constexpr std::array<LateKey, 0> kLateKeys{};
 }  // namespace
 
 std::string case_id(const CaseParams& p) {
   nlohmann::json j = to_json(p);
-  const nlohmann::json defaults = to_json(CaseParams{});
-  for (const char* key : kKeysHashedOnlyWhenSet) {
-    const auto ptr = pointer_of(key);
-    if (j.at(ptr) == defaults.at(ptr)) j.at(ptr.parent_pointer()).erase(ptr.back());
+  for (const auto& key : case_key_names(p.scene))
+    if (is_output_only_key(key)) {
+      const auto ptr = pointer_of(key);
+      if (j.contains(ptr)) j.at(ptr.parent_pointer()).erase(ptr.back());
+    }
+  for (const auto& late : kLateKeys) {
+    const auto ptr = pointer_of(late.key);
+    if (j.contains(ptr) && j.at(ptr) == nlohmann::json::parse(late.old_behaviour))
+      j.at(ptr.parent_pointer()).erase(ptr.back());
   }
-  for (const auto& k : kSceneOnlyKeys) {
-    const auto ptr = pointer_of(k.key);
-    if (p.scene != k.scene) j.at(ptr.parent_pointer()).erase(ptr.back());
-  }
+  // Sections left empty (all their keys output-only) are dropped, as if never there.
+  for (auto it = j.begin(); it != j.end();) it = it->is_object() && it->empty() ? j.erase(it) : std::next(it);
+  j["identity_version"] = kCaseIdVersion;
   // nlohmann's object keys are sorted (std::map), so dump() is canonical.
   return hex64(fnv1a64(j.dump()));
+}
+
+std::string case_id_of_json(const std::string& canonical_json) {
+  return case_id(case_from_json(nlohmann::json::parse(canonical_json)));
 }
 
 std::vector<std::string> case_key_names() {
   std::vector<std::string> names;
   CaseParams p;
   visit_keys(p, [&](const char* key, auto&, const Rule&) { names.emplace_back(key); });
+  return names;
+}
+
+std::vector<std::string> case_key_names(const std::string& scene) {
+  const SceneSpec& sc = scene_spec(scene);
+  std::vector<std::string> names;
+  for (const auto& key : case_key_names())
+    if (key == "scene" || scene_reads(sc, key)) names.push_back(key);
   return names;
 }
 

@@ -11,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/scene_specs.hpp"
+
 namespace boycott {
 
 inline constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
@@ -141,6 +143,14 @@ struct CaseParams {
   ErgunParams ergun;
   SedimentParams sediment;
 
+  // ---- provenance (not part of the case's values) ----
+  /// Keys the user set (case file, --set, a study's base, group and matrix), sorted: the only
+  /// ones a scene may refuse, and the ones its defaults do not replace.
+  std::vector<std::string> set_keys;
+  /// validate() has applied the scene's defaults and derived the particle count and skin; a
+  /// case read back from its canonical JSON is resolved already.
+  bool resolved = false;
+
   // ---- derived quantities (from the resolved parameters) ----
   double particle_volume_m3() const;
   double particle_mass_kg() const;
@@ -155,9 +165,6 @@ struct CaseParams {
   std::int64_t dem_substeps() const;
 };
 
-/// The scenes that exist; validate() refuses any other name.
-const std::vector<std::string>& scene_names();
-
 /// Parses a case file. Unknown keys, wrong types and out-of-range values are InputErrors naming
 /// the key, the value and the limit.
 CaseParams parse_case_file(const std::string& path);
@@ -168,16 +175,35 @@ CaseParams case_from_json(const nlohmann::json& j);
 /// Applies "section.key=value" (value in TOML syntax: 1e-3, true, "vreman", [1,2,3]).
 void apply_override(CaseParams& p, const std::string& assignment);
 
-/// Resolves derived inputs (volume_fraction -> count) and checks every limit, per key and
-/// across keys (d < W, Delta t_DEM <= spring limit, count fits the box, ...). Throws InputError.
+/// Refuses a user-set key the scene does not read (naming the key and the scene), applies the
+/// scene's defaults to the keys the user did not set, derives the particle count (from
+/// particles.volume_fraction, or the scene's default solid fraction in the case's own box) and
+/// the neighbour skin (min(0.3 mm, d)), and checks every limit, per key and across keys (d < W,
+/// Delta t_DEM <= spring limit, count fits the box, ...). Throws InputError.
 void validate(CaseParams& p);
 
-/// Canonical JSON: every key, sorted, defaults included. Equal parameters give equal text.
+/// Canonical JSON of a resolved case: the scene and the keys it reads, sorted, defaults
+/// included. Equal cases give equal text. (params.json in every run folder.)
 nlohmann::json to_json(const CaseParams& p);
-/// Hash of the canonical JSON, 16 hex digits: the case's identity.
+/// Every key of the key table, whichever scene (for `case keys`).
+nlohmann::json to_json_all_keys(const CaseParams& p);
+/// The identity scheme case_id() follows (stored with results, so a database knows its ids).
+inline constexpr int kCaseIdVersion = 2;
+/// The case's identity, 16 hex digits: the hash of the physics keys its scene reads at their
+/// resolved values, with the scheme's version. Keys that only steer output or the run's length
+/// (time.end, time.checkpoint_every, time.target_rel_error, output.*) are not part of it, so
+/// raising time.end continues a finished run; a key added after version 2 enters it only where
+/// its value differs from the behaviour before the key existed.
 std::string case_id(const CaseParams& p);
+/// The identity of a case stored as canonical JSON (params.json, a checkpoint's case_json), in
+/// this program's scheme whatever scheme it was written under.
+std::string case_id_of_json(const std::string& canonical_json);
+/// The keys case_id() leaves out because they steer output or the run's length only.
+bool is_output_only_key(const std::string& key);
 
 /// All dotted key names in table order (for documentation and `case keys`).
 std::vector<std::string> case_key_names();
+/// The dotted key names a scene reads, in table order.
+std::vector<std::string> case_key_names(const std::string& scene);
 
 }  // namespace boycott

@@ -29,10 +29,7 @@ inline KernelKind kernel_from_name(const std::string& s) {
   if (s == "cell") return KernelKind::cell;
   if (s == "trilinear") return KernelKind::trilinear;
   if (s == "trilinear_smoothed") return KernelKind::trilinear_smoothed;
-  throw InputError(
-      fmt::format("numerics.void_fraction_kernel = \"{}\": expected cell, trilinear or "
-                  "trilinear_smoothed",
-                  s));
+  throw InputError(fmt::format("numerics.void_fraction_kernel = \"{}\": not a kernel of the coupling", s));
 }
 
 /// 1-D weights over the contiguous index range [first, first + n). Indices may lie outside

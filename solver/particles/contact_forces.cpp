@@ -264,7 +264,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
 
 void DemSystem::compute_forces() {
   auto t0 = std::chrono::steady_clock::now();
-  if (cfg_.rolling_model == "none" || cfg_.rolling_friction == 0.0)
+  if (!rolling_model_enabled(cfg_.rolling_model) || cfg_.rolling_friction == 0.0)
     compute_forces_impl(RollingNone{});
   else
     compute_forces_impl(RollingConstantDirectional{cfg_.rolling_friction});

@@ -4,6 +4,7 @@
 // call per contact.
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "core/constants.hpp"
 
@@ -59,5 +60,12 @@ struct RollingConstantDirectional {
 struct RollingNone {
   static constexpr bool enabled = false;
 };
+
+/// The rolling model named in contact.rolling_model (core/model_names.hpp's list): whether
+/// Eq. 11's torque is on. Throws InputError for a name not in the list.
+bool rolling_model_enabled(const std::string& name);
+/// Checks contact.model against the contact models this engine has (one: the linear
+/// spring-dashpot above). Throws InputError for another name.
+void check_contact_model(const std::string& name);
 
 }  // namespace boycott::particles

@@ -9,10 +9,24 @@
 #include <stdexcept>
 #include <vector>
 
+#include <fmt/format.h>
+
+#include "core/error.hpp"
 #include "core/timers.hpp"
 #include "particles/min_image.hpp"
 
 namespace boycott::particles {
+
+bool rolling_model_enabled(const std::string& name) {
+  if (name == "constant_directional") return true;
+  if (name == "none") return false;
+  throw InputError(fmt::format("contact.rolling_model = \"{}\" is not a rolling model of this engine", name));
+}
+
+void check_contact_model(const std::string& name) {
+  if (name != "linear_spring_dashpot")
+    throw InputError(fmt::format("contact.model = \"{}\" is not a contact model of this engine", name));
+}
 
 DemConfig DemConfig::from_case(const CaseParams& p) {
   DemConfig c;
@@ -29,6 +43,7 @@ DemConfig DemConfig::from_case(const CaseParams& p) {
   c.contact =
       LinearSpringDashpot(p.contact.stiffness_n_m, p.contact.restitution, p.contact.tangential_damping_ratio,
                           p.contact.friction, p.contact.clip_attractive_normal);
+  check_contact_model(p.contact.model);
   c.rolling_model = p.contact.rolling_model;
   c.rolling_friction = p.contact.rolling_friction;
   return c;

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "core/run_status.hpp"
 #include "core/timers.hpp"
 #include "fluid/fluid_solver.hpp"
 #include "scenes/run_common.hpp"
@@ -119,7 +120,7 @@ int run_channel_flow(const CaseParams& p, RunContext& ctx) {
   if (csv) csv->flush();
 
   SummaryBase base;
-  base.status = interrupted ? "interrupted" : "completed";
+  base.status = interrupted ? kStatusInterrupted : kStatusCompleted;
   base.simulated_time_s = solver.time_s();
   base.wall_time_s = clock.seconds();
   nlohmann::json j = make_summary(p, base, timers);

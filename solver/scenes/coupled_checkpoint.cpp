@@ -165,7 +165,10 @@ std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::fi
     int verdict = kUsable;
     try {
       r.emplace(ck);
-      const std::string stored = r->string("case_id");
+      // The identity of the parameters it holds, in this program's scheme (a checkpoint written
+      // before case identity version 2 names its case by the older id).
+      const std::string stored =
+          r->has("case_json") ? case_id_of_json(r->string("case_json")) : r->string("case_id");
       if (stored != id) {
         verdict = kOtherCase;
         why = fmt::format("{} belongs to case {}, not {}; it is left in place", ck.string(), stored, id);

@@ -8,6 +8,7 @@
 
 #include "core/constants.hpp"
 #include "core/error.hpp"
+#include "core/run_status.hpp"
 #include "core/statistics.hpp"
 #include "particles/dem_system.hpp"
 #include "scenes/particle_setup.hpp"
@@ -81,7 +82,7 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
     }
     if (ctx.should_stop()) {
       // No checkpoint is written by this scene yet: say so instead of claiming a resumable stop.
-      sb.status = "interrupted";
+      sb.status = kStatusInterrupted;
       exit_code = kExitFailure;
       std::fprintf(stderr,
                    "interrupted at t = %g s; dem_only writes no checkpoint yet, a rerun starts over\n",

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "core/run_status.hpp"
 #include "coupling/coupled_system.hpp"
 #include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
@@ -73,7 +74,7 @@ int run_ergun(const CaseParams& p, RunContext& ctx) {
     run.fluid().set_mean_pressure_gradient_pa_m(-dpdl);
     const int steps = run_to_steady(run, 1e-7, 20, 20000, ctx);
     if (steps < 0) {
-      sb.status = "interrupted";
+      sb.status = kStatusInterrupted;
       exit_code = kExitFailure;
       std::fprintf(stderr, "interrupted; ergun writes no checkpoint, a rerun starts over\n");
       break;

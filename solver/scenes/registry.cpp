@@ -14,7 +14,8 @@
 
 namespace boycott::scenes {
 
-SceneFn find_scene(const std::string& name) {
+namespace {
+const std::map<std::string, SceneFn>& scene_table() {
   static const std::map<std::string, SceneFn> table = {
       {"dem_only", &run_dem_only},
       {"channel_flow", &run_channel_flow},
@@ -23,9 +24,22 @@ SceneFn find_scene(const std::string& name) {
       {"ergun", &run_ergun},
       {"sediment_transport", &run_sediment_transport},
   };
-  auto it = table.find(name);
-  if (it == table.end()) throw InputError(fmt::format("scene '{}' is not implemented yet", name));
+  return table;
+}
+}  // namespace
+
+SceneFn find_scene(const std::string& name) {
+  scene_spec(name);  // names the known scenes when it is not one
+  auto it = scene_table().find(name);
+  if (it == scene_table().end())
+    throw InputError(fmt::format("scene '{}' has no code in the scene table", name));
   return it->second;
+}
+
+std::vector<std::string> registered_scenes() {
+  std::vector<std::string> names;
+  for (const auto& [name, fn] : scene_table()) names.push_back(name);
+  return names;
 }
 
 int run_case(CaseParams params, RunContext& ctx) {

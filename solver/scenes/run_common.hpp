@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/case_params.hpp"
+#include "core/run_status.hpp"
 #include "core/timers.hpp"
 
 namespace boycott::scenes {
@@ -28,7 +29,7 @@ void write_file_atomic(const std::filesystem::path& path, const std::string& tex
 
 /// Common summary keys. Scene-specific keys are added to the returned object by the scene.
 struct SummaryBase {
-  std::string status = "completed";  ///< "completed" | "interrupted" | "failed"
+  std::string status{kStatusCompleted};  ///< core/run_status.hpp
   double simulated_time_s = 0.0;
   double wall_time_s = 0.0;
   double particle_steps = 0.0;  ///< particles x DEM steps
@@ -99,7 +100,7 @@ bool checkpoint_or_stop(bool stop_requested, bool quiet, CheckpointClock& clock,
     write_checkpoint();
   }
   if (!stop_requested) return false;
-  summary.status = "interrupted";
+  summary.status = kStatusInterrupted;
   if (!quiet && output_rank())
     std::fprintf(stderr, "stopped at t = %g s after writing a checkpoint; run again to resume\n", t_s);
   return true;

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -28,8 +29,10 @@ struct RunContext {
 /// Runs (or resumes) a case. Returns the process exit code (error.hpp); writes summary.json.
 using SceneFn = int (*)(const CaseParams&, RunContext&);
 
-/// The scene table: name -> function. Throws InputError for a scene not built yet.
+/// The scene table: name -> function. Throws InputError for a name not in core's scene list.
 SceneFn find_scene(const std::string& name);
+/// The names the scene table holds (a test checks them against core/scene_specs.hpp's list).
+std::vector<std::string> registered_scenes();
 
 /// Validates, writes params.json beside the outputs (refusing a folder that holds another case)
 /// and runs the scene.

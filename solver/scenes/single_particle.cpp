@@ -16,6 +16,7 @@
 
 #include "core/constants.hpp"
 #include "core/error.hpp"
+#include "core/run_status.hpp"
 #include "core/statistics.hpp"
 #include "coupling/coupled_system.hpp"
 #include "coupling/drag_laws.hpp"
@@ -74,7 +75,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
              run.fluid().mean_pressure_gradient_pa_m(), slip * d / nu});
     if (ctx.progress) ctx.progress(t);
     if (ctx.should_stop()) {
-      sb.status = "interrupted";
+      sb.status = kStatusInterrupted;
       exit_code = kExitFailure;
       if (output_rank())
         std::fprintf(stderr,

@@ -64,7 +64,7 @@ TEST(CaseParams, ValidationNamesFieldValueAndLimit) {
   p.contact.stiffness_n_m = 500.0;
   expect_message(p, "exceeds the spring limit");
   p = CaseParams{};
-  p.particles.count = 10000000;
+  apply_override(p, "particles.count=10000000");
   expect_message(p, "overfills the box");
 }
 
@@ -84,38 +84,117 @@ TEST(CaseParams, IdIsStableAndDistinguishesParameters) {
   EXPECT_EQ(case_id(case_from_json(to_json(a))), case_id(a));
 }
 
-TEST(CaseParams, KeysAddedLaterKeepEveryExistingIdAtTheirDefaults) {
-  // 34c0cdaa3b877dc1 is the id 30c36a8 (before numerics.pressure_velocity_coupling and
-  // numerics.piso_correctors existed) gave the default case: study databases written then must
-  // find their cases again.
+TEST(CaseParams, IdentityVersion2LeavesOutTheRunLengthAndOutputOnly) {
+  // Raising time.end continues a run: it, the checkpoint interval and output.* are not the case.
   CaseParams a;
   validate(a);
-  EXPECT_EQ(case_id(a), "34c0cdaa3b877dc1");
-  CaseParams b = a;
-  apply_override(b, "numerics.piso_correctors=2");  // the default, written out
-  EXPECT_EQ(case_id(b), case_id(a));
-  apply_override(b, "numerics.pressure_velocity_coupling=\"piso\"");
-  EXPECT_NE(case_id(b), case_id(a));
-  CaseParams c = b;
-  apply_override(c, "numerics.piso_correctors=3");
-  EXPECT_NE(case_id(c), case_id(b));
+  for (const char* change :
+       {"time.end=40.0", "time.checkpoint_every=0.5", "output.timeseries_every=0.01",
+        "output.keep_checkpoints=5", "output.snapshot_times=[1.0]", "output.pdf_bins=80"}) {
+    CaseParams b;
+    apply_override(b, change);
+    validate(b);
+    EXPECT_EQ(case_id(b), case_id(a)) << change;
+  }
+  // The averaging window is part of the measurement.
+  CaseParams c;
+  apply_override(c, "time.average_from=6.0");
+  validate(c);
+  EXPECT_NE(case_id(c), case_id(a));
+  // The default case's id under version 2 (a change of the scheme must bump kCaseIdVersion and
+  // migrate stored ids, see driver/case_id_migration.cpp).
+  EXPECT_EQ(case_id(a), "feaf57c856c9fbc2");
 }
 
-TEST(CaseParams, ASceneOnlyKeyIsHashedForItsSceneOnly) {
-  // sediment.initial_flow came later and only sediment_transport reads it: the other scenes'
-  // ids stay as they were, and a sediment case started from rest is another case.
+TEST(CaseParams, IdHashesOnlyTheKeysTheSceneReads) {
+  // channel_flow has no particles: their keys are neither part of its id nor accepted.
+  CaseParams a;
+  apply_override(a, "scene=\"channel_flow\"");
+  validate(a);
+  CaseParams b = a;
+  b.particles.diameter_m = 1e-3;
+  b.contact.stiffness_n_m = 10.0;
+  EXPECT_EQ(case_id(b), case_id(a));
+  EXPECT_EQ(to_json(a).count("particles"), 0u);
+  CaseParams c;
+  apply_override(c, "scene=\"channel_flow\"");
+  apply_override(c, "particles.count=10");
+  try {
+    validate(c);
+    FAIL() << "particles.count accepted for channel_flow";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("particles.count is not used by scene channel_flow"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(CaseParams, ASceneRefusesKeysItWouldOverwrite) {
+  // Coupled scenes set the fluid's body force from gravity: a user's [flow] would be lost.
+  CaseParams p;
+  apply_override(p, "flow.body_acceleration=[0.0, 0.0, 1.0]");
+  EXPECT_THROW(validate(p), InputError);
+  // sediment.initial_flow belongs to sediment_transport only.
+  CaseParams q;
+  apply_override(q, "sediment.initial_flow=\"rest\"");
+  EXPECT_THROW(validate(q), InputError);
+  CaseParams s, r;
+  apply_override(s, "scene=\"sediment_transport\"");
+  apply_override(r, "scene=\"sediment_transport\"");
+  apply_override(r, "sediment.initial_flow=\"rest\"");
+  validate(s);
+  validate(r);
+  EXPECT_NE(case_id(r), case_id(s));
+}
+
+TEST(CaseParams, ParticleCountFollowsTheBoxAtTableIIISolidFraction) {
+  // Neither count nor volume fraction: Table III's 0.1130973 in the case's own box.
+  EXPECT_NEAR(table3_solid_fraction(), 0.1130973, 1e-7);
   CaseParams a;
   validate(a);
-  const std::string before = case_id(a);
-  apply_override(a, "sediment.initial_flow=\"rest\"");
-  EXPECT_EQ(case_id(a), before);
-  CaseParams s;
-  apply_override(s, "scene=\"sediment_transport\"");
-  CaseParams r = s;
-  apply_override(r, "sediment.initial_flow=\"rest\"");
-  EXPECT_NE(case_id(r), case_id(s));
-  apply_override(r, "sediment.initial_flow=\"laminar\"");
-  EXPECT_THROW(validate(r), InputError);
+  EXPECT_EQ(a.particles.count, 120000);
+  CaseParams b;
+  apply_override(b, "particles.diameter=0.4e-3");
+  validate(b);
+  EXPECT_EQ(b.particles.count, 405000);
+  EXPECT_DOUBLE_EQ(b.numerics.neighbor_skin_m, 0.3e-3);
+  CaseParams c;
+  apply_override(c, "domain.length_x=0.02");
+  apply_override(c, "domain.height_z=0.02");
+  validate(c);
+  EXPECT_EQ(c.particles.count, 2400);
+  // The skin follows small particles: min(0.3 mm, d).
+  CaseParams d;
+  apply_override(d, "particles.diameter=0.1e-3");
+  apply_override(d, "time.dt_dem=1e-5");
+  apply_override(d, "domain.length_x=0.01");
+  apply_override(d, "domain.height_z=0.01");
+  validate(d);
+  EXPECT_DOUBLE_EQ(d.numerics.neighbor_skin_m, 0.1e-3);
+  // A scene's own default load: ergun's packed bed (porosity 0.36).
+  CaseParams e;
+  apply_override(e, "scene=\"ergun\"");
+  apply_override(e, "domain.length_x=0.02");
+  apply_override(e, "domain.width_y=0.02");
+  apply_override(e, "domain.height_z=0.04");
+  apply_override(e, "particles.diameter=1e-3");
+  validate(e);
+  EXPECT_NEAR(e.solid_fraction(), 0.64, 1e-4);
+  EXPECT_EQ(e.particles.insertion, "packed");
+  EXPECT_TRUE(e.domain.periodic_y);
+}
+
+TEST(CaseParams, CanonicalJsonRoundTripsWithoutReResolving) {
+  // params.json holds resolved values; reading it back neither re-derives nor refuses anything.
+  CaseParams a;
+  apply_override(a, "particles.count=300");
+  apply_override(a, "domain.length_x=0.01");
+  apply_override(a, "domain.height_z=0.01");
+  validate(a);
+  CaseParams b = case_from_json(to_json(a));
+  validate(b);
+  EXPECT_EQ(b.particles.count, 300);
+  EXPECT_EQ(case_id(b), case_id(a));
 }
 
 TEST(CaseParams, OverridesUseTomlSyntax) {

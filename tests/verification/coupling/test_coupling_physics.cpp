@@ -195,12 +195,11 @@ periodic_y = true
 [particles]
 diameter = 1.0e-3
 count = 1
-[gravity]
-magnitude = 0.0
 [forces]
 saffman_lift = false
 added_mass = false
 )");
+  p.gravity.magnitude_m_s2 = 0.0;  // as the ergun scene runs its bed (it reads no [gravity])
   coupling::CoupledSystem run(p, coupling::CoupledOptions{false, false});
   std::int64_t id = 0;
   auto lattice = [&](int n, double z0) {

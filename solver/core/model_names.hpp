@@ -1,0 +1,37 @@
+#pragma once
+// One list of names per model kind. Parsing, `case check`, `case keys` and the registries that
+// turn a name into code (coupling/drag_laws.hpp, coupling/kernels.hpp, the contact model of
+// particles/, scenes/registry.cpp) all read these lists, and a test checks that each registry
+// knows exactly its list: a name is added here and in its registry, nowhere else.
+#include <string>
+#include <vector>
+
+namespace boycott {
+
+/// forces.drag
+inline const std::vector<std::string>& drag_law_names() {
+  static const std::vector<std::string> n = {"difelice_paper", "schiller_naumann", "stokes", "none"};
+  return n;
+}
+/// numerics.void_fraction_kernel
+inline const std::vector<std::string>& kernel_names() {
+  static const std::vector<std::string> n = {"trilinear_smoothed", "trilinear", "cell"};
+  return n;
+}
+/// contact.model
+inline const std::vector<std::string>& contact_model_names() {
+  static const std::vector<std::string> n = {"linear_spring_dashpot"};
+  return n;
+}
+/// contact.rolling_model
+inline const std::vector<std::string>& rolling_model_names() {
+  static const std::vector<std::string> n = {"constant_directional", "none"};
+  return n;
+}
+/// fluid.subgrid_model
+inline const std::vector<std::string>& subgrid_model_names() {
+  static const std::vector<std::string> n = {"vreman", "none"};
+  return n;
+}
+
+}  // namespace boycott

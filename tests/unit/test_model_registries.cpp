@@ -1,0 +1,67 @@
+// Each registry that turns a model's name into code knows exactly the names of its list in
+// core/model_names.hpp and core/scene_specs.hpp (the lists parsing and `case keys` read).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "core/case_params.hpp"
+#include "core/error.hpp"
+#include "core/model_names.hpp"
+#include "core/scene_specs.hpp"
+#include "coupling/drag_laws.hpp"
+#include "coupling/kernels.hpp"
+#include "particles/contact_models.hpp"
+#include "scenes/scene.hpp"
+
+namespace boycott {
+namespace {
+
+TEST(ModelRegistries, SceneTableHoldsExactlyTheListedScenes) {
+  auto listed = scene_names(), registered = scenes::registered_scenes();
+  std::sort(listed.begin(), listed.end());
+  EXPECT_EQ(registered, listed);
+  for (const auto& name : scene_names()) EXPECT_NE(scenes::find_scene(name), nullptr) << name;
+  EXPECT_THROW(scenes::find_scene("hindered_settling"), InputError);
+}
+
+TEST(ModelRegistries, DragLawsResolveExactlyTheListedNames) {
+  std::vector<std::string> resolved;
+  for (const auto& name : drag_law_names())
+    resolved.push_back(coupling::visit_drag_law(name, [](const auto& law) { return std::string(law.name); }));
+  EXPECT_EQ(resolved, drag_law_names());
+  EXPECT_THROW(coupling::visit_drag_law("ergun_only", [](const auto&) { return 0; }), InputError);
+}
+
+TEST(ModelRegistries, KernelsResolveExactlyTheListedNames) {
+  for (const auto& name : kernel_names()) EXPECT_NO_THROW(coupling::kernel_from_name(name)) << name;
+  EXPECT_THROW(coupling::kernel_from_name("gaussian"), InputError);
+}
+
+TEST(ModelRegistries, ContactAndRollingModelsResolveExactlyTheListedNames) {
+  for (const auto& name : contact_model_names())
+    EXPECT_NO_THROW(particles::check_contact_model(name)) << name;
+  EXPECT_THROW(particles::check_contact_model("hertz_mindlin"), InputError);
+  for (const auto& name : rolling_model_names())
+    EXPECT_NO_THROW(particles::rolling_model_enabled(name)) << name;
+  EXPECT_THROW(particles::rolling_model_enabled("viscous"), InputError);
+}
+
+TEST(ModelRegistries, EverySceneReadsOnlyKeysThatExist) {
+  // A scene's list of keys names sections and keys of the key table, nothing else.
+  const auto keys = case_key_names();
+  for (const auto& sc : scene_specs()) {
+    for (const auto& r : sc.reads) {
+      const bool found = std::any_of(keys.begin(), keys.end(), [&](const std::string& k) {
+        return k == r || (r.back() == '.' && k.rfind(r, 0) == 0);
+      });
+      EXPECT_TRUE(found) << sc.name << " reads unknown '" << r << "'";
+    }
+    for (const auto& [k, v] : sc.defaults)
+      EXPECT_TRUE(scene_reads(sc, k)) << sc.name << " defaults unread " << k;
+  }
+}
+
+}  // namespace
+}  // namespace boycott
