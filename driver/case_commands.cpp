@@ -69,7 +69,9 @@ int case_check(const std::string& file, const std::vector<std::string>& sets) {
   CaseParams p = load(file, sets);
   const scenes::Preflight pre = scenes::preflight(p);
   std::printf("case %s (scene %s): %s\n", case_id(p).c_str(), p.scene.c_str(),
-              pre.errors.empty() ? (pre.warnings.empty() ? "valid" : "valid, with warnings") : "REFUSED");
+              pre.errors.empty()
+                  ? (pre.warnings.empty() && pre.machine_errors.empty() ? "valid" : "valid, with warnings")
+                  : "REFUSED");
   std::printf("  particles %lld, solid fraction %.4f, dt_dem %.4g us, dt_cfd %.4g ms\n",
               static_cast<long long>(p.particles.count), p.solid_fraction(), p.time.dt_dem_s * 1e6,
               p.time.dt_cfd_s * 1e3);

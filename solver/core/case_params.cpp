@@ -5,6 +5,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <type_traits>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -151,8 +152,11 @@ void check_number(const char* key, double v, const Rule& r) {
     if (r.optional) return;
     throw InputError(fmt::format("{} is not a number", key));
   }
-  bool ok = std::isfinite(v) || (v == kInf && r.max == kInf && !r.max_open);
-  ok = ok && (r.min_open ? v > r.min : v >= r.min) && (r.max_open ? v < r.max : v <= r.max);
+  // No key takes an infinite value: a run to time.end = inf would never end.
+  if (!std::isfinite(v))
+    throw InputError(
+        fmt::format("{} = {} is not a finite number: must be {}", key, fmt_num(v), describe_rule(r)));
+  const bool ok = (r.min_open ? v > r.min : v >= r.min) && (r.max_open ? v < r.max : v <= r.max);
   if (!ok)
     throw InputError(fmt::format("{} = {} is out of range: must be {}", key, fmt_num(v), describe_rule(r)));
 }
@@ -455,7 +459,13 @@ void resolve_defaults(CaseParams& p, const SceneSpec& sc) {
 }  // namespace
 
 void validate(CaseParams& p) {
-  visit_keys(p, [&](const char* key, auto& ref, const Rule& r) { check_value(key, ref, r); });
+  visit_keys(p, [&](const char* key, auto& ref, const Rule& r) {
+    check_value(key, ref, r);
+    // An optional key's NaN means "not set"; set by the user, it is a value, and not a finite one.
+    if constexpr (std::is_same_v<std::decay_t<decltype(ref)>, double>)
+      if (std::isnan(ref) && is_set_key(p, key) && !p.resolved)
+        throw InputError(fmt::format("{} = nan is not a finite number", key));
+  });
   const SceneSpec& sc = scene_spec(p.scene);
   for (const auto& key : p.set_keys)
     if (key != "scene" && !scene_reads(sc, key))
@@ -499,6 +509,11 @@ void validate(CaseParams& p) {
                     "<= 0.45; use particles.insertion = \"bed\" or \"packed\"",
                     p.particles.count, ap));
 
+  // A scene that places particles measures them: none is nothing to measure (a settling
+  // velocity of 0 would be stored as a result).
+  if (sc.has_particles && reads("particles.count") && p.particles.count < 1)
+    throw InputError(fmt::format("particles.count = {}: scene {} needs at least one particle",
+                                 p.particles.count, sc.name));
   const double limit = p.dem_spring_limit_s();
   if (particles && p.particles.count > 0 && reads("time.dt_dem") && p.time.dt_dem_s > limit)
     throw InputError(fmt::format(
@@ -515,6 +530,13 @@ void validate(CaseParams& p) {
       throw InputError(
           fmt::format("time.dt_cfd / time.dt_dem = {} must be a whole number of DEM sub-steps", ratio));
   }
+  // A step so small that the run would not end in any time a machine has.
+  constexpr double kMaxSteps = 1e12;
+  for (auto [key, dt] : {std::pair{"time.dt_dem", p.time.dt_dem_s}, {"time.dt_cfd", p.time.dt_cfd_s}})
+    if (reads(key) && reads("time.end") && p.time.end_s / dt > kMaxSteps)
+      throw InputError(
+          fmt::format("{} = {} s would take {:.3g} steps to time.end = {} s: must be at most {:g}", key,
+                      fmt_num(dt), p.time.end_s / dt, fmt_num(p.time.end_s), kMaxSteps));
   if (reads("time.average_from") && p.time.average_from_s >= p.time.end_s)
     throw InputError(fmt::format(
         "time.average_from = {} s{} must be < time.end = {} s", fmt_num(p.time.average_from_s),

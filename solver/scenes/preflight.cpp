@@ -1,5 +1,10 @@
 #include "scenes/preflight.hpp"
 
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+
 #include <algorithm>
 #include <cmath>
 
@@ -36,7 +41,36 @@ double collision_time_s(double mass_kg, double stiffness_n_m, double restitution
   return kPi / (w0 * std::sqrt(std::max(1.0 - zeta * zeta, 1e-300)));
 }
 
-Preflight preflight(const CaseParams& p) {
+double machine_memory_bytes() {
+  double bytes = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  // A container's limit (cgroup v2), where there is one.
+  std::ifstream in("/sys/fs/cgroup/memory.max");
+  std::string limit;
+  if (in >> limit && limit != "max") {
+    char* end = nullptr;
+    const double v = std::strtod(limit.c_str(), &end);
+    if (end != limit.c_str() && v > 0.0) bytes = std::min(bytes, v);
+  }
+  return bytes;
+}
+
+double memory_estimate_bytes(const CaseParams& p, int ranks) {
+  // Per particle: ~40 arrays of the store, predicted velocities and reference positions (~0.4
+  // kB), and ~20 list pairs of ~110 B (indices, shear history, the per-contact force arrays).
+  // Per cell: ~110 fluid and coupling arrays and ~60 Krylov work vectors of 8 B. Rank 0 also
+  // holds the gathered checkpoint twice while writing it (~0.45 kB per particle, ~0.2 per cell).
+  constexpr double kPerParticle = 2600.0, kPerCell = 1400.0, kCheckpointParticle = 900.0,
+                   kCheckpointCell = 200.0;
+  const double cells = static_cast<double>(p.domain.cells[0] * p.domain.cells[1] * p.domain.cells[2]);
+  const double particles = static_cast<double>(p.particles.count);
+  const bool fluid = has_fluid(p);
+  const double n = std::max(ranks, 1);
+  return kPerParticle * particles / n + (fluid ? kPerCell * cells / n : 0.0) +
+         kCheckpointParticle * particles + (fluid ? kCheckpointCell * cells : 0.0) +
+         64.0e6;  // + the program itself
+}
+
+Preflight preflight(const CaseParams& p, int ranks) {
   Preflight r;
   auto add = [&](std::string name, double v, std::string unit, std::string meaning) {
     r.items.push_back({std::move(name), v, std::move(unit), std::move(meaning)});
@@ -49,9 +83,24 @@ Preflight preflight(const CaseParams& p) {
   const double dx_min = std::min({dx[0], dx[1], dx[2]});
   const bool fluid = has_fluid(p), parts = has_particles(p);
 
+  const double mem = memory_estimate_bytes(p, ranks), have = machine_memory_bytes();
+  add("memory_estimate_per_rank", mem, "B",
+      fmt::format("peak memory of one of {} rank(s), estimated", ranks));
+  if (mem > have)
+    r.machine_errors.push_back(
+        fmt::format("the case needs about {:.3g} GB per rank on {} rank(s), more than this "
+                    "machine's {:.3g} GB: use more ranks (on more machines) or a smaller "
+                    "domain.cells or particles.count",
+                    mem / 1e9, ranks, have / 1e9));
+
   if (fluid) {
     add("Ga", std::sqrt(g * W * W * W) / nu, "", "Galileo number sqrt(g W^3)/nu (Eq. 26)");
   }
+  if (p.scene == "dem_only" && p.forces.drag != "none" && p.forces.drag != "stokes")
+    r.errors.push_back(
+        fmt::format("forces.drag = \"{}\": the dem_only scene has no fluid; use \"stokes\" (drag "
+                    "against still fluid) or \"none\"",
+                    p.forces.drag));
   if (p.scene == "sediment_transport") {
     if (std::abs(std::cos(p.gravity.angle_deg * kPi / 180.0) - 1.0) > 1e-9)
       r.errors.push_back(
@@ -198,6 +247,7 @@ nlohmann::json Preflight::to_json() const {
     j["items"][it.name] = {{"value", it.value}, {"unit", it.unit}, {"meaning", it.meaning}};
   j["warnings"] = warnings;
   j["errors"] = errors;
+  j["machine_errors"] = machine_errors;
   return j;
 }
 
@@ -207,6 +257,7 @@ std::string Preflight::text() const {
     s += fmt::format("  {:<36} {:>12.4g} {:<4} {}\n", it.name, it.value, it.unit, it.meaning);
   for (const auto& w : warnings) s += "  warning: " + w + "\n";
   for (const auto& e : errors) s += "  error: " + e + "\n";
+  for (const auto& e : machine_errors) s += "  on this machine: " + e + "\n";
   return s;
 }
 

@@ -24,14 +24,24 @@ struct Preflight {
   std::vector<PreflightItem> items;
   std::vector<std::string> warnings;  ///< doubtful: the run goes ahead
   std::vector<std::string> errors;    ///< cannot work: the run is refused
+  /// Cannot work on this machine (memory): `case run` refuses, `case check` warns (the case may
+  /// be meant for a larger machine).
+  std::vector<std::string> machine_errors;
 
   nlohmann::json to_json() const;
   /// Human-readable table, one item per line, then warnings and errors.
   std::string text() const;
 };
 
-/// Computes the report for a validated case. Never throws for physics reasons: it collects.
-Preflight preflight(const CaseParams& p);
+/// Computes the report for a validated case, run on `ranks` MPI ranks of this machine (the
+/// memory estimate is per rank). Never throws for physics reasons: it collects.
+Preflight preflight(const CaseParams& p, int ranks = 1);
+
+/// Memory of this machine available to the program, bytes (the cgroup limit where lower).
+double machine_memory_bytes();
+/// Estimated peak memory of one rank of a case on `ranks` ranks, bytes: particle and fluid
+/// arrays, neighbour list, linear solver work vectors, and the checkpoint gathered on rank 0.
+double memory_estimate_bytes(const CaseParams& p, int ranks);
 
 /// Binary collision time of the linear spring-dashpot for two equal spheres with restitution e
 /// (s): pi / (omega_0 sqrt(1 - zeta^2)), omega_0 = sqrt(k / m_eff), m_eff = m / 2.

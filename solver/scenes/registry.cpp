@@ -42,31 +42,66 @@ std::vector<std::string> registered_scenes() {
   return names;
 }
 
+namespace {
+
+/// What may be in a run folder before its first run: the driver's lock, case file and log, and
+/// checkpoints to start from (a folder prepared by hand).
+bool is_preparation_file(const std::string& name) {
+  return name == ".lock" || name == "case.toml" || name == "solver.log" || name == "checkpoints";
+}
+
+/// Refuses an --out folder that is not this case's run folder (CheckpointError: exit 4): one that
+/// holds another case, a damaged params.json, or files of the user's (a folder that is not a run
+/// folder of this program). Reads only.
+void check_run_folder(const std::filesystem::path& dir, const CaseParams& params) {
+  namespace fs = std::filesystem;
+  if (!fs::exists(dir)) return;
+  if (!fs::is_directory(dir))
+    throw CheckpointError(fmt::format("--out {} exists and is not a folder", dir.string()));
+  const auto params_path = dir / "params.json";
+  if (!fs::exists(params_path)) {
+    for (const auto& e : fs::directory_iterator(dir))
+      if (!is_preparation_file(e.path().filename().string()))
+        throw CheckpointError(
+            fmt::format("--out {} is not empty and is not a run folder of boycott (it has no "
+                        "params.json, and holds {}): refusing to write into it; use another "
+                        "--out folder",
+                        dir.string(), e.path().filename().string()));
+    return;
+  }
+  // A run folder belongs to one case: resuming another case's folder would mix results.
+  std::string stored_id;
+  try {
+    std::ifstream in(params_path);
+    stored_id = case_id(case_from_json(nlohmann::json::parse(in)));
+  } catch (const std::exception& e) {
+    // A damaged folder is unusable, never bad input: the case itself may be fine.
+    throw CheckpointError(
+        fmt::format("{} is damaged ({}); refusing to overwrite it", params_path.string(), e.what()));
+  }
+  // By identity, not by the JSON text: a folder written by another version holds another form.
+  if (stored_id != case_id(params))
+    throw CheckpointError(fmt::format("{} holds case {} but this is case {}; use another --out folder",
+                                      dir.string(), stored_id, case_id(params)));
+}
+
+}  // namespace
+
 int run_case(CaseParams params, RunContext& ctx) {
   validate(params);
   const SceneFn fn = find_scene(params.scene);
+  int ranks = 1, initialized = 0;
+  MPI_Initialized(&initialized);
+  if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   // Refused before anything is written: a case that cannot work leaves the folder as it was.
-  const Preflight pre = preflight(params);
+  const Preflight pre = preflight(params, ranks);
   if (!pre.errors.empty()) throw InputError(pre.errors.front());
+  if (!pre.machine_errors.empty()) throw InputError(pre.machine_errors.front());
+  check_run_folder(ctx.out_dir, params);
   std::filesystem::create_directories(ctx.out_dir);
   const auto params_path = ctx.out_dir / "params.json";
   const auto canonical = to_json(params);
-  if (std::filesystem::exists(params_path)) {
-    // A run folder belongs to one case: resuming another case's folder would mix results.
-    std::ifstream in(params_path);
-    nlohmann::json stored;
-    try {
-      stored = nlohmann::json::parse(in);
-    } catch (const std::exception&) {
-      throw CheckpointError(fmt::format("{} is unreadable; refusing to overwrite it", params_path.string()));
-    }
-    // By identity, not by the JSON text: a folder written before a key was added lacks that key
-    // (case_id() hashes late keys only when they differ from their defaults).
-    if (case_id(case_from_json(stored)) != case_id(params))
-      throw CheckpointError(fmt::format("{} holds case {} but this is case {}; use another --out folder",
-                                        ctx.out_dir.string(), case_id(case_from_json(stored)),
-                                        case_id(params)));
-  } else {
+  if (!std::filesystem::exists(params_path)) {
     // One writer: under mpirun every rank runs this, and they would race on the temporary file.
     int rank = 0, initialized = 0;
     MPI_Initialized(&initialized);

@@ -174,18 +174,30 @@ TEST(BadCheckpoint, CheckpointOfOtherParametersIsRefused) {
   fs::remove_all(d);
   ASSERT_EQ(run_in(p, d, 0.03), kExitInterrupted);
   const auto ck = io::latest_checkpoint(d);
-  // Another case in the same folder: refused by params.json already; without it, by the
-  // checkpoint's own case hash.
+  // Another case in the same folder: refused by params.json already; without params.json the
+  // folder is no run folder any more (refused, untouched); a lone checkpoint of another case in
+  // an otherwise empty folder is refused by the checkpoint's own parameters.
   apply_override(p, "gravity.angle_deg=70");
   EXPECT_THROW(run_in(p, d), CheckpointError);
   fs::remove(d / "params.json");
   try {
     run_in(p, d);
+    FAIL() << "a folder without params.json was written into";
+  } catch (const CheckpointError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no params.json"), std::string::npos) << e.what();
+  }
+  const fs::path lone = fs::temp_directory_path() / "boycott_restart_other_lone";
+  fs::remove_all(lone);
+  fs::create_directories(lone / "checkpoints");
+  fs::copy_file(*ck, lone / "checkpoints" / ck->filename());
+  try {
+    run_in(p, lone);
     FAIL() << "a checkpoint of another case was accepted";
   } catch (const CheckpointError& e) {
     EXPECT_NE(std::string(e.what()).find("belongs to case"), std::string::npos) << e.what();
   }
   EXPECT_TRUE(fs::exists(*ck));
+  EXPECT_TRUE(fs::exists(lone / "checkpoints" / ck->filename()));
 }
 
 }  // namespace

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# What `case run` and `case check` refuse, and that a refused run writes nothing:
+# non-finite values in any key, steps so small a run would never end, sizes beyond this
+# machine's memory (refused by case run, a warning of case check), a settling case without
+# particles, an --out folder holding the user's own files, and a run folder whose params.json is
+# damaged (unusable, exit 4, not bad input).
+#   refusals.sh BOYCOTT_BIN CASE.toml
+set -uo pipefail
+bin=$1; case_file=$2
+work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
+fails=0
+expect() {  # expected-exit description command...
+  local want=$1 what=$2; shift 2
+  "$@" > "$work/out.txt" 2>&1; local rc=$?
+  if [ "$rc" -ne "$want" ]; then echo "FAIL $what: exit $rc, expected $want"; cat "$work/out.txt"; fails=$((fails + 1));
+  else echo "ok   $what: exit $rc: $(grep -m1 -i 'error\|warning\|machine' "$work/out.txt" | cut -c1-110)"; fi
+}
+run() { "$bin" case run "$case_file" --out "$work/r" "$@"; }
+for kv in time.end=inf time.dt_cfd=inf fluid.viscosity=inf domain.length_x=inf particles.density=-inf \
+          particles.volume_fraction=nan; do
+  expect 2 "--set $kv" run --set "$kv"
+done
+expect 2 "case check --set fluid.viscosity=inf" "$bin" case check "$case_file" --set fluid.viscosity=inf
+expect 2 "time.dt_dem=1e-300 (never ends)" run --set time.dt_dem=1e-300 --set time.dt_cfd=1e-298
+big=(--set 'domain.cells=[4096, 6, 4096]' --set domain.length_x=4.096 --set domain.height_z=4.096 --set particles.count=1000)
+expect 2 "a 4096 x 6 x 4096 grid, case run" run "${big[@]}"
+expect 0 "a 4096 x 6 x 4096 grid, case check warns" "$bin" case check "$case_file" "${big[@]}"
+grep -q "on this machine" "$work/out.txt" || { echo "FAIL: no machine warning"; fails=$((fails + 1)); }
+expect 2 "2e8 particles, case run" run --set particles.count=200000000 --set domain.length_x=2.0 --set domain.height_z=10.0
+expect 2 "a settling case without particles" run --set particles.count=0
+[ ! -e "$work/r" ] || { echo "FAIL: a refused run wrote $work/r"; ls -la "$work/r"; fails=$((fails + 1)); }
+# An --out folder with the user's own files: refused, untouched, nothing written.
+mkdir -p "$work/mine"
+for f in summary.json timeseries.csv pdf_y.csv; do echo "user's own $f" > "$work/mine/$f"; done
+( cd "$work/mine" && sha256sum * > ../mine.sha )
+expect 4 "--out a folder of the user's" "$bin" case run "$case_file" --out "$work/mine" --set time.end=0.02 --set time.average_from=0.01
+( cd "$work/mine" && sha256sum -c --quiet ../mine.sha ) || { echo "FAIL: the user's files changed"; fails=$((fails + 1)); }
+[ "$(ls "$work/mine" | wc -l)" -eq 3 ] || { echo "FAIL: files written into the user's folder"; ls "$work/mine"; fails=$((fails + 1)); }
+# A run folder whose params.json was damaged (a wrong type): unusable (4), not bad input (2).
+"$bin" case run "$case_file" --out "$work/ok" --set time.end=0.02 --set time.average_from=0.01 > /dev/null 2>&1
+python3 - "$work/ok/params.json" <<'PY'
+import json, sys
+p = json.load(open(sys.argv[1])); p["fluid"]["viscosity"] = "thick"; json.dump(p, open(sys.argv[1], "w"))
+PY
+expect 4 "a run folder with a mistyped params.json" "$bin" case run "$case_file" --out "$work/ok" --set time.end=0.02 --set time.average_from=0.01
+[ "$fails" -eq 0 ] && echo "[ report ] every refusal as expected" || exit 1
