@@ -27,6 +27,7 @@ void install_stop_handlers() {
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+  sigaction(SIGUSR1, &sa, nullptr);  // a Slurm task's wall-time warning (study submit)
 }
 
 CaseParams load(const std::string& file, const std::vector<std::string>& sets) {
@@ -49,6 +50,8 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv) {
   ctx.out_dir = opt.out_dir;
   ctx.stop_requested = &g_stop;
   ctx.quiet = opt.quiet;
+  ctx.branch_from = opt.from_dir;
+  if (opt.at_s >= 0.0) ctx.branch_at_s = opt.at_s;
   try {
     return scenes::run_case(p, ctx);
   } catch (const StorageError& e) {

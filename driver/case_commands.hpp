@@ -10,6 +10,8 @@ struct CaseRunOptions {
   std::vector<std::string> overrides;
   std::vector<std::string> petsc_options;
   bool quiet = false;
+  std::string from_dir;  ///< branch from this run folder's checkpoint (empty: none)
+  double at_s = -1.0;    ///< ... the newest at or before this time, s (< 0: the newest)
 };
 
 /// `boycott case run`: exit code as in design brief section 7.

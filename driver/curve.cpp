@@ -25,12 +25,18 @@ CurveFormat parse_curve_format(const std::string& s) {
 std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
   std::string s;
   auto opt = [](const std::optional<double>& v) { return v ? fmt::format("{:.6g}", *v) : std::string(); };
+  auto opt9 = [](const std::optional<double>& v) { return v ? fmt::format("{:.9g}", *v) : std::string(); };
+  auto opt_json = [](const std::optional<double>& v) {
+    return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+  };
   if (f == CurveFormat::kCsv) {
-    s = "group,angle_deg,mean_settling_velocity_m_s,stderr_m_s,r_acc,r_acc_err,case_id,setting\n";
+    s = "group,angle_deg,mean_settling_velocity_m_s,stderr_m_s,n_replicas,between_replica_stderr_m_s,"
+        "mean_within_run_stderr_m_s,r_acc,r_acc_err,error_method,case_id,setting\n";
     for (const auto& p : pts)
-      s += fmt::format("{},{:g},{:.9g},{},{},{},{},{}\n", p.group, p.angle_deg, p.w_m_s,
-                       p.w_err_m_s ? fmt::format("{:.9g}", *p.w_err_m_s) : std::string(), opt(p.r_acc),
-                       opt(p.r_acc_err), p.case_id, report::csv_field(p.setting));
+      s += fmt::format("{},{:g},{:.9g},{},{},{},{},{},{},{},{},{}\n", p.group, p.angle_deg, p.w_m_s,
+                       opt9(p.w_err_m_s), p.n_replicas, opt9(p.between_replica_stderr_m_s),
+                       opt9(p.mean_within_run_stderr_m_s), opt(p.r_acc), opt(p.r_acc_err), p.error_method,
+                       p.case_id, report::csv_field(p.setting));
   } else if (f == CurveFormat::kJson) {
     nlohmann::json j = nlohmann::json::array();
     for (const auto& p : pts) {
@@ -39,26 +45,37 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
                           {"mean_settling_velocity_m_s", p.w_m_s},
                           {"case_id", p.case_id},
                           {"setting", p.setting}};
-      e["stderr_m_s"] = p.w_err_m_s ? nlohmann::json(*p.w_err_m_s) : nlohmann::json(nullptr);
-      e["r_acc"] = p.r_acc ? nlohmann::json(*p.r_acc) : nlohmann::json(nullptr);
-      e["r_acc_err"] = p.r_acc_err ? nlohmann::json(*p.r_acc_err) : nlohmann::json(nullptr);
+      e["stderr_m_s"] = opt_json(p.w_err_m_s);
+      e["n_replicas"] = p.n_replicas;
+      e["between_replica_stderr_m_s"] = opt_json(p.between_replica_stderr_m_s);
+      e["mean_within_run_stderr_m_s"] = opt_json(p.mean_within_run_stderr_m_s);
+      e["error_method"] = p.error_method;
+      e["r_acc"] = opt_json(p.r_acc);
+      e["r_acc_err"] = opt_json(p.r_acc_err);
+      e["replica_case_ids"] = p.replica_case_ids;
+      e["replica_mean_settling_velocities_m_s"] = p.replica_w_m_s;
       j.push_back(e);
     }
     s = j.dump(2) + "\n";
   } else if (pts.empty()) {
     s = "(no finished cases)\n";
   } else {
-    s = fmt::format("{:<12} {:>6}  {:>24}  {:>18}  {}\n", "group", "angle", "<<w_p>> (mm/s)", "r_acc",
-                    "setting");
+    // A missing error is "n/a", never a zero that reads as an exact value. With replicas the
+    // error of <<w_p>> is their scatter (between); "within" is the mean of the runs' own errors.
+    auto mm = [](const std::optional<double>& v) { return v ? fmt::format("{:.4f}", *v * 1e3) : "n/a"; };
+    report::TextTable t({"group", "angle", "<<w_p>> (mm/s)", "n", "between (mm/s)", "within (mm/s)", "r_acc",
+                         "error method", "setting"},
+                        {false, true, true, true, true, true, true, false, false});
     for (const auto& p : pts) {
-      // A missing error is "n/a", never a zero that reads as an exact value.
       const std::string r = p.r_acc ? fmt::format("{:.3f} +- {}", *p.r_acc,
                                                   p.r_acc_err ? fmt::format("{:.3f}", *p.r_acc_err) : "n/a")
                                     : "-";
-      const std::string w_err = p.w_err_m_s ? fmt::format("{:.4f}", *p.w_err_m_s * 1e3) : "n/a";
-      s += fmt::format("{:<12} {:>6g}  {:>11.4f} +- {:<9}  {:>18}  {}\n", p.group, p.angle_deg, p.w_m_s * 1e3,
-                       w_err, r, p.setting);
+      t.add({p.group, fmt::format("{:g}", p.angle_deg),
+             fmt::format("{:.4f} +- {}", p.w_m_s * 1e3, mm(p.w_err_m_s)), std::to_string(p.n_replicas),
+             p.n_replicas >= 2 ? mm(p.between_replica_stderr_m_s) : "-", mm(p.mean_within_run_stderr_m_s), r,
+             p.error_method, p.setting});
     }
+    s = t.str();
   }
   return s;
 }
@@ -77,12 +94,24 @@ struct Panel {
   double py(double v) const { return y0 + h - (v - vmin) / (vmax - vmin) * h; }
 };
 
+/// The angles where the paper places its critical angles: a peak value stated without its
+/// angle is drawn over this range.
+constexpr double kPeakFrom = 60.0, kPeakTo = 75.0;
+
 }  // namespace
 
-std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& title) {
+std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& title,
+                      const std::vector<PaperValue>* paper) {
   std::vector<std::string> groups;
   for (const auto& p : pts)
     if (std::find(groups.begin(), groups.end(), series_of(p)) == groups.end()) groups.push_back(series_of(p));
+  // A paper value takes the colour of the first series of its group, grey when the study has none.
+  auto paper_color = [&](const PaperValue& v) -> const char* {
+    for (std::size_t g = 0; g < groups.size(); ++g)
+      for (const auto& p : pts)
+        if (series_of(p) == groups[g] && p.group == v.group) return report::color(g);
+    return "#777";
+  };
 
   std::string s =
       "<svg xmlns='http://www.w3.org/2000/svg' width='1000' height='440' font-family='sans-serif' "
@@ -96,12 +125,31 @@ std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& tit
       if (!p.r_acc) return std::nullopt;
       return std::pair{*p.r_acc, p.r_acc_err.value_or(0.0)};
     };
+    // Each replica's value: its <<w_p>>, or its ratio to the point's 90 deg mean.
+    auto replica_values = [&](const CurvePoint& p) {
+      std::vector<double> v;
+      if (p.n_replicas < 2) return v;
+      for (double w : p.replica_w_m_s) {
+        if (panel == 0)
+          v.push_back(w * 1e3);
+        else if (p.r_acc && p.w_m_s != 0.0)
+          v.push_back(w * *p.r_acc / p.w_m_s);
+      }
+      return v;
+    };
+    const char* quantity = panel == 0 ? "mean_settling_velocity_m_s" : "r_acc";
+    const double scale = panel == 0 ? 1e3 : 1.0;
     double lo = INFINITY, hi = -INFINITY;
-    for (const auto& p : pts)
+    for (const auto& p : pts) {
       if (auto v = value(p)) {
         lo = std::min(lo, v->first - v->second);
         hi = std::max(hi, v->first + v->second);
       }
+      for (double r : replica_values(p)) lo = std::min(lo, r), hi = std::max(hi, r);
+    }
+    if (paper)
+      for (const auto& v : *paper)
+        if (v.quantity == quantity) lo = std::min(lo, v.value * scale), hi = std::max(hi, v.value * scale);
     if (!std::isfinite(lo)) lo = 0, hi = 1;
     if (panel == 1) lo = std::min(lo, 1.0), hi = std::max(hi, 1.0);
     if (hi - lo < 1e-12) lo -= 0.5, hi += 0.5;
@@ -134,12 +182,17 @@ std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& tit
         if (!v) continue;
         const double x = pn.px(p.angle_deg), y = pn.py(v->first);
         line += fmt::format("{:.1f},{:.1f} ", x, y);
+        for (double r : replica_values(p))
+          marks += fmt::format(
+              "<circle class='replica' cx='{:.1f}' cy='{:.1f}' r='2.5' fill='{}' fill-opacity='0.3'/>\n",
+              x + 7, pn.py(r), color);
         if (v->second > 0)
           marks += fmt::format(
-              "<line x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' stroke='{3}'/>"
-              "<line x1='{4:.1f}' y1='{1:.1f}' x2='{5:.1f}' y2='{1:.1f}' stroke='{3}'/>"
-              "<line x1='{4:.1f}' y1='{2:.1f}' x2='{5:.1f}' y2='{2:.1f}' stroke='{3}'/>\n",
-              x, pn.py(v->first - v->second), pn.py(v->first + v->second), color, x - 3, x + 3);
+              "<g class='errorbar' stroke='{3}' stroke-width='1.5'><line x1='{0:.1f}' y1='{1:.1f}' "
+              "x2='{0:.1f}' "
+              "y2='{2:.1f}'/><line x1='{4:.1f}' y1='{1:.1f}' x2='{5:.1f}' y2='{1:.1f}'/>"
+              "<line x1='{4:.1f}' y1='{2:.1f}' x2='{5:.1f}' y2='{2:.1f}'/></g>\n",
+              x, pn.py(v->first - v->second), pn.py(v->first + v->second), color, x - 5, x + 5);
         marks += marker(report::marker_kind(g), x, y, color) + "\n";
       }
       if (!line.empty())
@@ -153,7 +206,34 @@ std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& tit
                          marker(report::marker_kind(g), pn.x0 + 18, pn.y0 + 18 + 18.0 * g, color), pn.x0 + 28,
                          pn.y0 + 22 + 18.0 * g, xml_escape(groups[g]));
     }
+    if (paper) {
+      for (const auto& v : *paper) {
+        if (v.quantity != quantity) continue;
+        const double y = pn.py(v.value * scale);
+        const char* color = paper_color(v);
+        if (v.angle_deg)
+          s += fmt::format("<g class='paper' data-group='{}'>{}</g>\n", xml_escape(v.group),
+                           marker("diamond", pn.px(*v.angle_deg), y, color, true));
+        else
+          s += fmt::format(
+              "<line class='paper' data-group='{}' x1='{:.1f}' y1='{:.1f}' x2='{:.1f}' y2='{:.1f}' "
+              "stroke='{}' "
+              "stroke-width='1.5' stroke-dasharray='5,3'/>\n",
+              xml_escape(v.group), pn.px(kPeakFrom), y, pn.px(kPeakTo), y, color);
+      }
+      if (panel == 1) {
+        const double ly = pn.y0 + 22 + 18.0 * static_cast<double>(groups.size());
+        s += fmt::format(
+            "{}<text x='{:.1f}' y='{:.1f}'>Zeng et al. 2021 (stated values; dashed: peak, angle not "
+            "stated)</text>\n",
+            marker("diamond", pn.x0 + 18, ly - 4, "#333", true), pn.x0 + 28, ly);
+      }
+    }
   }
+  if (std::any_of(pts.begin(), pts.end(), [](const CurvePoint& p) { return p.n_replicas > 1; }))
+    s +=
+        "<text x='500' y='436' text-anchor='middle' font-size='11' fill='#555'>faint dots: replicas (seeds); "
+        "error bars: their standard error of the mean</text>\n";
   s += "</svg>\n";
   return s;
 }

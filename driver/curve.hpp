@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "driver/paper_reference.hpp"
 #include "driver/store.hpp"
 
 namespace boycott::driver {
@@ -12,8 +13,10 @@ enum class CurveFormat { kTable, kCsv, kJson };
 CurveFormat parse_curve_format(const std::string& s);
 
 std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f);
-/// Both panels, one line per group with error bars.
-std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& title);
+/// Both panels, one line per group with error bars (capped), each replica as a faint dot; with
+/// `paper`, the values Zeng et al. (2021) state (driver/paper_reference.hpp) as hollow diamonds.
+std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& title,
+                      const std::vector<PaperValue>* paper = nullptr);
 
 std::string format_cases(const std::vector<CaseState>& cases);
 

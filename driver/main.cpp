@@ -12,9 +12,11 @@
 #include "core/error.hpp"
 #include "core/version.hpp"
 #include "driver/case_commands.hpp"
+#include "driver/collect.hpp"
 #include "driver/curve.hpp"
 #include "driver/database.hpp"
 #include "driver/runner.hpp"
+#include "driver/slurm.hpp"
 #include "driver/store.hpp"
 #include "driver/validation_query.hpp"
 #include "driver/work_precision.hpp"
@@ -75,6 +77,11 @@ int main(int argc, char** argv) {
   run->add_option("--out", run_opt.out_dir, "run folder (params, checkpoints, outputs)")->required();
   run->add_option("--set", run_opt.overrides, "override a key: section.key=value")->take_all();
   run->add_flag("--quiet", run_opt.quiet, "no progress output");
+  run->add_option("--from", run_opt.from_dir,
+                  "branch: start from this run folder's newest kept checkpoint (with this case's parameters)")
+      ->check(CLI::ExistingDirectory);
+  run->add_option("--at", run_opt.at_s, "with --from: the newest checkpoint at or before this time, s")
+      ->check(CLI::NonNegativeNumber);
   run->allow_extras();
 
   std::string check_file;
@@ -106,6 +113,35 @@ int main(int argc, char** argv) {
   sstatus->add_option("study", status_file, "study file (TOML)")->required();
   sstatus->add_option("--db", status_db, "results database (SQLite)")->required();
   sstatus->add_option("--retries", status_retries, "as given to study run")->capture_default_str();
+  boycott::driver::SlurmSubmitOptions subopt;
+  auto* ssubmit = study_cmd->add_subcommand(
+      "submit",
+      "submit the pending cases as a Slurm job array (one case per task); the tasks write only run folders");
+  ssubmit->add_option("study", subopt.study_file, "study file (TOML)")->required();
+  ssubmit->add_option("--db", subopt.db_path, "results database (SQLite)")->required();
+  ssubmit->add_option("--scheduler", subopt.scheduler, "the batch system")->required();
+  ssubmit->add_option("--ranks", subopt.ranks, "MPI ranks per case")->capture_default_str();
+  ssubmit
+      ->add_option("--launcher", subopt.launcher, "how a case starts its ranks: srun (--mpi=pmix) or mpirun")
+      ->capture_default_str();
+  ssubmit->add_option("--time", subopt.time, "wall-time limit of each task (HH:MM:SS)");
+  ssubmit->add_option("--partition", subopt.partition, "Slurm partition");
+  ssubmit->add_option("--max-running", subopt.max_running, "array tasks at once (%K; 0: no limit)")
+      ->capture_default_str();
+  ssubmit->add_option("--retries", subopt.retries, "failed attempts retried per case")->capture_default_str();
+  ssubmit
+      ->add_option("--sbatch-arg", subopt.sbatch_args,
+                   "an extra sbatch option (repeatable), e.g. --sbatch-arg=--account=X")
+      ->allow_extra_args(false);
+  ssubmit->add_flag("--dry-run", subopt.dry_run, "print the batch script; write and submit nothing");
+  ssubmit->add_option("--solver-command", subopt.solver_command, "")->group("");
+  std::string collect_file, collect_db;
+  int collect_retries = 2;
+  auto* scollect = study_cmd->add_subcommand(
+      "collect", "record the run folders that tasks finished (study submit) in the database; safe to repeat");
+  scollect->add_option("study", collect_file, "study file (TOML)")->required();
+  scollect->add_option("--db", collect_db, "results database (SQLite)")->required();
+  scollect->add_option("--retries", collect_retries, "as given to study run")->capture_default_str();
 
   // ---- query ----
   auto* query_cmd = app.add_subcommand("query", "read results from a study database");
@@ -117,6 +153,9 @@ int main(int argc, char** argv) {
   qcurve->add_option("--group", q_group, "only this group");
   qcurve->add_option("--format", q_format, "table, csv or json")->capture_default_str();
   qcurve->add_option("--plot", q_plot, "also draw the curves (SVG, like Fig. 14 of the paper)");
+  bool q_overlay_paper = false;
+  qcurve->add_flag("--overlay-paper", q_overlay_paper,
+                   "with --plot: also the values the paper states (studies/reference/zeng2021.csv)");
   auto* qvalid = query_cmd->add_subcommand(
       "validation",
       "per finished case: the scene's measured errors against its reference, and the wall time");
@@ -145,6 +184,16 @@ int main(int argc, char** argv) {
       return boycott::driver::study_run(sopt);
     });
   }
+  if (ssubmit->parsed())
+    return run_guarded([&] {
+      require_db_path(subopt.db_path);
+      return boycott::driver::study_submit(subopt);
+    });
+  if (scollect->parsed())
+    return run_guarded([&] {
+      require_db_path(collect_db);
+      return boycott::driver::study_collect(collect_file, collect_db, collect_retries);
+    });
   if (sstatus->parsed())
     return run_guarded([&] {
       require_db_path(status_db);
@@ -153,6 +202,8 @@ int main(int argc, char** argv) {
   if (qcurve->parsed())
     return run_guarded([&] {
       const auto fmt_kind = boycott::driver::parse_curve_format(q_format);
+      if (q_overlay_paper && q_plot.empty())
+        throw boycott::InputError("--overlay-paper draws on the plot: give --plot FILE.svg too");
       auto db = open_for_query(q_db);
       const auto pts = boycott::driver::query_curve(db, q_study, q_group);
       if (pts.empty())
@@ -161,7 +212,9 @@ int main(int argc, char** argv) {
       std::fputs(boycott::driver::format_curve(pts, fmt_kind).c_str(), stdout);
       if (!q_plot.empty()) {
         std::ofstream out(q_plot);
-        out << boycott::driver::curve_svg(pts, fmt::format("study {}", q_study));
+        const auto paper = boycott::driver::parse_paper_values(boycott::driver::paper_reference_csv());
+        out << boycott::driver::curve_svg(pts, fmt::format("study {}", q_study),
+                                          q_overlay_paper ? &paper : nullptr);
         if (!out) throw std::runtime_error(fmt::format("cannot write '{}'", q_plot));
       }
       return 0;

@@ -26,13 +26,14 @@ std::string read_text(const fs::path& p) {
 
 /// The last non-empty line the solver wrote to its log since `offset_bytes`: its one-line reason.
 /// With prefer_error, the last line that starts "error: " when there is one (mpirun adds its own
-/// lines after the solver's reason when a rank aborts).
-std::string last_line(const fs::path& log, std::uintmax_t offset_bytes, bool prefer_error = false) {
+/// lines after the solver's reason when a rank aborts). Up to `end_bytes` when set.
+std::string last_line(const fs::path& log, std::uintmax_t offset_bytes, bool prefer_error = false,
+                      std::optional<std::uintmax_t> end_bytes = std::nullopt) {
   std::ifstream in(log);
   if (!in) return "";
   in.seekg(static_cast<std::streamoff>(offset_bytes));
   std::string line, last, last_error;
-  while (std::getline(in, line)) {
+  while ((!end_bytes || static_cast<std::uintmax_t>(in.tellg()) < *end_bytes) && std::getline(in, line)) {
     if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
     if (line.rfind("error: ", 0) == 0) last_error = line;
   }
@@ -75,7 +76,7 @@ AttemptEnd record_attempt_end(Database& db, const RunningCase& run, int exit_cod
   }
   if (exit_code == kExitStorageError) {
     // The storage failed, not the case: the solver kept its last good checkpoint.
-    std::string why = last_line(run.dir / "solver.log", run.log_offset_bytes, true);
+    std::string why = last_line(run.dir / "solver.log", run.log_offset_bytes, true, run.log_end_bytes);
     if (why.empty()) why = "storage error (exit 74)";
     finish_attempt(db, run.attempt, exit_code, why);
     return {AttemptEnd::Kind::kStorageFailed, exit_code, why};
@@ -83,13 +84,15 @@ AttemptEnd record_attempt_end(Database& db, const RunningCase& run, int exit_cod
   // A case run under mpirun that stopped on the driver's signal: mpirun, signalled too, exits
   // with 1 whatever its ranks returned; the summary this attempt wrote says what happened.
   if (exit_code != kExitInterrupted && wrote_interrupted_summary(run)) exit_code = kExitInterrupted;
-  if (exit_code == kExitInterrupted || exit_code == 128 + SIGTERM || exit_code == 128 + SIGINT) {
+  // 128 + SIGUSR1: a Slurm task's wall-time warning reached the solver before its handlers.
+  if (exit_code == kExitInterrupted || exit_code == 128 + SIGTERM || exit_code == 128 + SIGINT ||
+      exit_code == 128 + SIGUSR1) {
     finish_attempt(db, run.attempt, exit_code,
                    exit_code == kExitInterrupted ? "interrupted after a checkpoint"
                                                  : "stopped by a signal while starting");
     return {AttemptEnd::Kind::kInterrupted, exit_code, ""};
   }
-  std::string why = last_line(run.dir / "solver.log", run.log_offset_bytes);
+  std::string why = last_line(run.dir / "solver.log", run.log_offset_bytes, false, run.log_end_bytes);
   if (why.empty()) why = exit_code > 128 ? fmt::format("killed by signal {}", exit_code - 128) : "no message";
   finish_attempt(db, run.attempt, exit_code, why);
   return {AttemptEnd::Kind::kFailed, exit_code, why};
@@ -99,8 +102,11 @@ bool record_left_summary(Database& db, std::int64_t attempt, const std::string& 
                          const fs::path& run_dir) {
   if (!fs::exists(run_dir / "summary.json")) return false;
   try {
-    const auto summary = nlohmann::json::parse(read_text(run_dir / "summary.json"));
-    if (is_finished_status(summary.value("status", "")) && summary.value("case_id", "") == case_id) {
+    const auto text = read_text(run_dir / "summary.json");
+    const auto summary = nlohmann::json::parse(text);
+    // A run that finished at an earlier time.end than the case now has is continued, not recorded.
+    if (is_finished_status(summary.value("status", "")) && summary.value("case_id", "") == case_id &&
+        summary_reaches_end(db, case_id, text)) {
       record_result(db, attempt, case_id, summary);
       return true;
     }

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -10,12 +11,15 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
-#include "driver/case_id_migration.hpp"
+#include "driver/collect.hpp"
 #include "driver/curve.hpp"
 #include "driver/database.hpp"
+#include "driver/replica_rounds.hpp"
 #include "driver/scheduler.hpp"
+#include "driver/slurm.hpp"
 #include "driver/solver_process.hpp"
 #include "driver/store.hpp"
+#include "driver/store_slurm.hpp"
 #include "driver/study.hpp"
 
 namespace fs = std::filesystem;
@@ -47,26 +51,49 @@ int study_run(const StudyRunOptions& opt) {
   const Study study = expand_study_file(opt.study_file);
   Database db(opt.db_path, OpenMode::kCreate);
   const fs::path root = runs_root(opt.db_path);
-  // Ids of an older identity scheme become this one's before the study's cases are matched.
-  const IdMigration moved = migrate_case_ids(db, root);
-  if (moved.cases > 0)
+  prepare_study_database(db, study, root);
+  // What Slurm tasks (study submit) left in the run folders; the cases still in Slurm jobs stay
+  // theirs.
+  const CollectResult collected = collect_run_folders(db, study, root);
+  if (collected.results > 0 || collected.attempts > 0 || collected.abandoned > 0)
+    std::fprintf(stderr, "collected %d results and %d attempt ends, closed %d abandoned attempts\n",
+                 collected.results, collected.attempts, collected.abandoned);
+  if (!collected.in_slurm.empty())
     std::fprintf(stderr,
-                 "case identity version %d: %d case ids recomputed (%d merged), %d run folders renamed\n",
-                 kCaseIdVersion, moved.cases, moved.merged, moved.folders);
-  register_study(db, study);
+                 "%zu cases are in Slurm jobs (queued or running) and are left to them: `boycott study "
+                 "collect` records them when they end\n",
+                 collected.in_slurm.size());
   fs::create_directories(root);
   auto solver = solver_argv(opt.solver_command);
   install_stop_handlers();
 
-  Scheduler scheduler(db, study, case_states(db, study.name, opt.retries), opt, root, std::move(solver));
-  const bool stopped = scheduler.run();
-  if (!scheduler.storage_stop().empty()) {
+  auto states = case_states(db, study.name, opt.retries);
+  std::erase_if(states, [&](const CaseState& s) { return collected.in_slurm.count(s.id) > 0; });
+  Scheduler scheduler(db, study, states, opt, root, solver);
+  bool stopped = scheduler.run();
+  std::string storage_stop = scheduler.storage_stop();
+  // replicas_target_rel_error: more replicas, round by round, where the scatter is too large.
+  Study grown = study;
+  while (!stopped && storage_stop.empty() && has_replica_target(grown)) {
+    const ReplicaRound round = next_replica_round(db, grown);
+    if (round.added.empty()) break;
+    std::fprintf(stderr, "replicas: %zu points get one more (%d within the target, %d at replicas_max)\n",
+                 round.added.size(), round.precise, round.at_max);
+    grown.cases.insert(grown.cases.end(), round.added.begin(), round.added.end());
+    register_study(db, grown);
+    auto more_states = case_states(db, grown.name, opt.retries);
+    std::erase_if(more_states, [&](const CaseState& s) { return collected.in_slurm.count(s.id) > 0; });
+    Scheduler more(db, grown, more_states, opt, root, solver);
+    stopped = more.run();
+    storage_stop = more.storage_stop();
+  }
+  if (!storage_stop.empty()) {
     std::fprintf(stderr, "error: study %s stopped: %s; once the storage works again, run the same command\n",
-                 study.name.c_str(), scheduler.storage_stop().c_str());
+                 study.name.c_str(), storage_stop.c_str());
     return kExitStorageError;
   }
 
-  const int n_total = static_cast<int>(study.cases.size());
+  const int n_total = static_cast<int>(grown.cases.size());
   int done = 0, failed = 0;
   for (const auto& s : case_states(db, study.name, opt.retries)) {
     done += s.status == CaseStatus::kDone;
@@ -87,26 +114,52 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
   Database db(db_path, OpenMode::kReadOnly);
   std::map<std::string, CaseState> known;
   for (auto& s : case_states(db, study.name, retries)) known[s.id] = s;
+  // Cases submitted to Slurm (study submit): their array task and, where squeue answers, its state.
+  std::map<std::string, std::string> jobs;
+  std::optional<std::vector<SlurmJob>> queue;
+  std::string queue_why;
+  const auto open_slurm =
+      has_slurm_columns(db) ? slurm_attempts(db, study.name, true) : std::vector<SlurmAttempt>{};
+  if (!open_slurm.empty()) queue = squeue_jobs(&queue_why);
+  for (const auto& a : open_slurm) {
+    const SlurmJob* job = queue ? find_slurm_job(*queue, a.array_job_id, a.array_task_id, a.job_id) : nullptr;
+    jobs[a.case_id] = fmt::format("{}_{} {}", a.array_job_id.value_or(0), a.array_task_id.value_or(0),
+                                  !queue ? "?"
+                                  : job  ? job->state
+                                         : "ended");
+  }
+  int uncollected = 0;
   std::map<std::string, int> counts;
   std::string lines;
   for (const auto& c : study.cases) {
     auto it = known.find(c.id);
     const char* st = it == known.end() ? "pending" : to_string(it->second.status);
     // An open attempt whose folder nobody holds: its driver died (kill -9, power loss).
-    if (it != known.end() && it->second.status == CaseStatus::kRunning &&
+    const auto job = jobs.find(c.id);
+    if (it != known.end() && it->second.status == CaseStatus::kRunning && job == jobs.end() &&
         run_folder_unheld(fs::path(runs_root(db_path)) / c.id))
       st = "interrupted";
     ++counts[st];
+    if ((it == known.end() || it->second.status != CaseStatus::kDone) &&
+        finished_summary_in(fs::path(runs_root(db_path)) / c.id, c.id))
+      ++uncollected;
     const std::string ranks =
         it != known.end() && it->second.ranks > 0 ? std::to_string(it->second.ranks) : "-";
+    const std::string job_col =
+        jobs.empty() ? "" : fmt::format(" {:<22}", job == jobs.end() ? "-" : job->second);
     lines += fmt::format(
-        "{:<16} {:<12} {:6.1f} {:<12} {:>5} {}\n", c.id, c.group, c.params.gravity.angle_deg, st, ranks,
-        it != known.end() && it->second.status != CaseStatus::kDone ? it->second.last_error : "");
+        "{:<16} {:<12} {:6.1f} {:<12} {:>5}{} {}\n", c.id, c.group, c.params.gravity.angle_deg, st, ranks,
+        job_col, it != known.end() && it->second.status != CaseStatus::kDone ? it->second.last_error : "");
   }
   std::printf("study %s: %zu cases: %d done, %d running, %d failed, %d interrupted, %d pending\n",
               study.name.c_str(), study.cases.size(), counts["done"], counts["running"], counts["failed"],
               counts["interrupted"], counts["pending"]);
-  std::printf("%-16s %-12s %6s %-12s %5s %s\n", "case", "group", "angle", "status", "ranks", "last error");
+  if (!open_slurm.empty() && !queue) std::printf("Slurm job states unknown: %s\n", queue_why.c_str());
+  if (uncollected > 0)
+    std::printf("%d finished run folders are not recorded yet: boycott study collect %s --db %s\n",
+                uncollected, study_file.c_str(), db_path.c_str());
+  std::printf("%-16s %-12s %6s %-12s %5s%s %s\n", "case", "group", "angle", "status", "ranks",
+              jobs.empty() ? "" : fmt::format(" {:<22}", "slurm job").c_str(), "last error");
   std::fputs(lines.c_str(), stdout);
   return 0;
 }

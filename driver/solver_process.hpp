@@ -23,6 +23,9 @@ struct RunningCase {
   pid_t pid = -1;                       ///< also the solver's process group
   std::int64_t attempt = 0;             ///< attempts.id of this run
   std::uintmax_t log_offset_bytes = 0;  ///< size of solver.log before this attempt wrote to it
+  /// Where this attempt's output in solver.log ends; unset: at the end of the file (`study
+  /// collect` reads attempts that later attempts appended to).
+  std::optional<std::uintmax_t> log_end_bytes;
   std::chrono::steady_clock::time_point started;
   double t_start_s = 0;  ///< simulated time when this attempt started (resume)
   /// summary.json's modification time before this attempt (none: there was none), to tell a

@@ -53,9 +53,11 @@ void register_study(Database& db, const Study& s) {
     db.prepare("DELETE FROM study_cases WHERE study = ?1").bind(1, s.name).run();
     std::int64_t pos = 0;
     for (const auto& c : s.cases) {
+      // The same case may come back with a raised time.end (not part of its identity): the stored
+      // parameters follow the study, so that a result short of the new end is no longer done.
       db.prepare(
-            "INSERT OR IGNORE INTO cases(id, scene, angle_deg, params_json, created_at) VALUES "
-            "(?1,?2,?3,?4,?5)")
+            "INSERT INTO cases(id, scene, angle_deg, params_json, created_at) VALUES (?1,?2,?3,?4,?5) "
+            "ON CONFLICT(id) DO UPDATE SET params_json = excluded.params_json")
           .bind(1, c.id)
           .bind(2, c.params.scene)
           .bind(3, c.params.gravity.angle_deg)
@@ -123,7 +125,11 @@ void record_result(Database& db, std::int64_t attempt, const std::string& case_i
                    const nlohmann::json& summary) {
   nlohmann::json errors = nlohmann::json::object();
   for (const auto& [k, v] : summary.items())
-    if (k.find("error") != std::string::npos && k != "settling_velocity_stderr_m_s") errors[k] = v;
+    // The scene's errors against its reference; not the statistics of <<w_p>> (settling_velocity_*,
+    // warnings) nor the run's precision target (target_*).
+    if (k.find("error") != std::string::npos && k.rfind("settling_velocity_", 0) != 0 &&
+        k.rfind("target_", 0) != 0)
+      errors[k] = v;
   const auto params = summary.contains("params") ? summary["params"] : nlohmann::json();
   db.transaction([&] {
     const auto now = utc_now();
@@ -167,10 +173,41 @@ void record_result(Database& db, std::int64_t attempt, const std::string& case_i
   });
 }
 
+namespace {
+/// Whether a run's summary (S, JSON text) reached its case's time.end as the study now sets it
+/// (P, the case's params_json), or met the precision target the study now asks for: the case is
+/// done. A case without an end (ergun) or a summary without its time counts as done.
+std::string reaches_end_sql(const std::string& S, const std::string& P) {
+  return fmt::format(
+      "(json_extract({P}, '$.time.end') IS NULL OR json_extract({S}, '$.simulated_time_s') IS NULL OR "
+      "json_extract({S}, '$.simulated_time_s') >= json_extract({P}, '$.time.end') * (1 - 1e-9) OR "
+      "(json_extract({S}, '$.status') = 'converged' AND "
+      "IFNULL(json_extract({P}, '$.time.target_rel_error'), 0) >= json_extract({S}, '$.target_rel_error')))",
+      fmt::arg("S", S), fmt::arg("P", P));
+}
+const std::string kResultReachesEnd = reaches_end_sql("r.summary_json", "c.params_json");
+}  // namespace
+
+bool summary_reaches_end(Database& db, const std::string& case_id, const std::string& summary_json) {
+  auto st = db.prepare("SELECT " + reaches_end_sql("?2", "params_json") + " FROM cases WHERE id = ?1");
+  st.bind(1, case_id);
+  st.bind(2, summary_json);
+  // A case the database does not hold has no end to compare with.
+  return !st.step() || st.is_null(0) || st.integer(0) != 0;
+}
+
 bool has_result(Database& db, const std::string& case_id) {
-  auto st = db.prepare("SELECT 1 FROM results WHERE case_id = ?1");
+  auto st = db.prepare("SELECT 1 FROM results r JOIN cases c ON c.id = r.case_id WHERE r.case_id = ?1 AND " +
+                       kResultReachesEnd);
   st.bind(1, case_id);
   return st.step();
+}
+
+std::optional<double> result_settling_velocity(Database& db, const std::string& case_id) {
+  auto st = db.prepare("SELECT mean_settling_velocity_m_s FROM results WHERE case_id = ?1");
+  st.bind(1, case_id);
+  if (!st.step() || st.is_null(0)) return std::nullopt;
+  return st.real(0);
 }
 
 const char* to_string(CaseStatus s) {
@@ -193,9 +230,11 @@ std::vector<CaseState> case_states(Database& db, const std::string& study, int r
   std::vector<CaseState> out;
   auto st = db.prepare(
       "SELECT sc.study, sc.group_name, c.id, c.angle_deg, "
-      " EXISTS(SELECT 1 FROM results r WHERE r.case_id = c.id), "
+      " EXISTS(SELECT 1 FROM results r WHERE r.case_id = c.id AND " +
+      kResultReachesEnd +
+      "), "
       " (SELECT COUNT(*) FROM attempts a WHERE a.case_id = c.id AND a.exit_status IS NOT NULL "
-      "    AND a.exit_status NOT IN (0, 74, 75, 130, 143)), "
+      "    AND a.exit_status NOT IN (0, 74, 75, 130, 138, 143)), "
       " (SELECT COUNT(*) FROM attempts a WHERE a.case_id = c.id AND a.exit_status = 2 "
       "    AND a.program_version = ?2), "
       " EXISTS(SELECT 1 FROM attempts a WHERE a.case_id = c.id AND a.ended_at IS NULL), "
@@ -230,7 +269,7 @@ std::vector<CaseState> case_states(Database& db, const std::string& study, int r
       c.status = CaseStatus::kRunning;
     else if (c.input_error || c.failures > retries)
       c.status = CaseStatus::kFailed;
-    else if (c.last_exit == 75 || c.last_exit == 130 || c.last_exit == 143)
+    else if (c.last_exit == 75 || c.last_exit == 130 || c.last_exit == 138 || c.last_exit == 143)
       c.status = CaseStatus::kInterrupted;
     else
       c.status = CaseStatus::kPending;
@@ -256,10 +295,13 @@ std::vector<SweptValue> case_swept_values(Database& db, const std::string& case_
 }
 
 std::vector<CurvePoint> query_curve(Database& db, const std::string& study, const std::string& group) {
+  // Runs whose summary names no error method predate the autocorrelation estimate: batch means.
   auto st = db.prepare(
       "SELECT sc.group_name, c.id, c.angle_deg, r.mean_settling_velocity_m_s, "
       "r.settling_velocity_stderr_m_s, "
-      " MIN(sc.position) AS pos FROM study_cases sc JOIN cases c ON c.id = sc.case_id "
+      " MIN(sc.position) AS pos, "
+      " COALESCE(json_extract(r.summary_json, '$.settling_velocity_error_method'), 'batch_means') "
+      "FROM study_cases sc JOIN cases c ON c.id = sc.case_id "
       "JOIN results r ON r.case_id = c.id WHERE sc.study = ?1 AND (?2 = '' OR sc.group_name = ?2) "
       "AND r.mean_settling_velocity_m_s IS NOT NULL GROUP BY sc.group_name, c.id");
   st.bind(1, study).bind(2, group);
@@ -273,12 +315,15 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
     p.angle_deg = st.real(2);
     p.w_m_s = st.real(3);
     if (!st.is_null(4)) p.w_err_m_s = st.real(4);
+    p.error_method = st.text(6);
     auto& gp = group_pos.try_emplace(p.group, st.integer(5)).first->second;
     gp = std::min(gp, st.integer(5));
     setting_pos.emplace_back(st.integer(5));
     pts.push_back(p);
   }
   // The setting names only what varies within the group (a group's own `set` is its name's job).
+  // Replicas differ in the seed alone, which a study with replicas does not sweep: they share
+  // their setting and angle.
   std::vector<std::vector<SweptValue>> swept(pts.size());
   std::map<std::string, std::map<std::string, std::set<std::string>>>
       values_in_group;  // group -> key -> values
@@ -297,12 +342,53 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
     auto& fp = first_pos.try_emplace({pts[i].group, pts[i].setting}, setting_pos[i]).first->second;
     fp = std::min(fp, setting_pos[i]);
   }
-  std::stable_sort(pts.begin(), pts.end(), [&](const CurvePoint& a, const CurvePoint& b) {
+  std::vector<std::size_t> order(pts.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) {
+    const CurvePoint &a = pts[i], &b = pts[j];
     if (a.group != b.group) return group_pos[a.group] < group_pos[b.group];
     if (a.setting != b.setting) return first_pos[{a.group, a.setting}] < first_pos[{b.group, b.setting}];
-    return a.angle_deg < b.angle_deg;
+    if (a.angle_deg != b.angle_deg) return a.angle_deg < b.angle_deg;
+    return setting_pos[i] < setting_pos[j];  // replicas in study order
   });
-  // r_acc = w / w90 with first-order error propagation of independent standard errors.
+  // Replicas of one point (adjacent now) become one point.
+  std::vector<CurvePoint> merged;
+  for (std::size_t k = 0; k < order.size();) {
+    const CurvePoint& first = pts[order[k]];
+    std::size_t end = k;
+    while (end < order.size() && pts[order[end]].group == first.group &&
+           pts[order[end]].setting == first.setting && pts[order[end]].angle_deg == first.angle_deg)
+      ++end;
+    CurvePoint p = first;
+    p.n_replicas = static_cast<int>(end - k);
+    double sum = 0.0, err_sum = 0.0;
+    bool all_errors = true;
+    for (std::size_t m = k; m < end; ++m) {
+      const CurvePoint& r = pts[order[m]];
+      p.replica_case_ids.push_back(r.case_id);
+      p.replica_w_m_s.push_back(r.w_m_s);
+      sum += r.w_m_s;
+      if (r.w_err_m_s)
+        err_sum += *r.w_err_m_s;
+      else
+        all_errors = false;
+      if (r.error_method != p.error_method) p.error_method = "mixed";
+    }
+    const double n = static_cast<double>(p.n_replicas);
+    p.w_m_s = p.n_replicas == 1 ? first.w_m_s : sum / n;
+    if (all_errors) p.mean_within_run_stderr_m_s = p.n_replicas == 1 ? *first.w_err_m_s : err_sum / n;
+    if (p.n_replicas >= 2) {
+      double ss = 0.0;
+      for (double w : p.replica_w_m_s) ss += (w - p.w_m_s) * (w - p.w_m_s);
+      p.between_replica_stderr_m_s = std::sqrt(ss / (n - 1.0)) / std::sqrt(n);
+      p.w_err_m_s = p.between_replica_stderr_m_s;
+    }
+    merged.push_back(std::move(p));
+    k = end;
+  }
+  pts = std::move(merged);
+  // r_acc = w / w90 with first-order error propagation of independent standard errors (the
+  // replicas' scatter where there are replicas).
   for (auto& p : pts) {
     const CurvePoint* ref = nullptr;
     for (const auto& q : pts)

@@ -25,6 +25,11 @@ void record_result(Database& db, std::int64_t attempt, const std::string& case_i
                    const nlohmann::json& summary);
 /// Whether the case has a result (recorded by any driver on this database).
 bool has_result(Database& db, const std::string& case_id);
+/// Whether a finished run's summary.json (its text) reached the case's time.end as the stored
+/// case now sets it, or met its precision target: a result of it would make the case done.
+bool summary_reaches_end(Database& db, const std::string& case_id, const std::string& summary_json);
+/// The case's recorded <<w_p>>; unset without a result or a value.
+std::optional<double> result_settling_velocity(Database& db, const std::string& case_id);
 
 enum class CaseStatus { kPending, kRunning, kDone, kFailed, kInterrupted };
 const char* to_string(CaseStatus s);
@@ -44,15 +49,29 @@ struct CaseState {
 /// case counts as failed rather than pending.
 std::vector<CaseState> case_states(Database& db, const std::string& study, int retries);
 
+/// One point of a curve: a (group, setting, angle) and its finished replicas (the cases of the
+/// study that differ only in their seed; one without `replicas`).
 struct CurvePoint {
   std::string group;
   /// What else the study sets on the case besides the angle ("key=value; ..."), empty when the
   /// group sweeps only the angle: one curve per (group, setting), r_acc within it.
   std::string setting;
-  std::string case_id;
+  std::string case_id;  ///< the first replica's
   double angle_deg = 0;
-  double w_m_s = 0;
-  std::optional<double> w_err_m_s;  ///< standard error of <<w_p>>; unset when the run recorded none
+  double w_m_s = 0;  ///< <<w_p>>, the mean over the replicas
+  /// The standard error of w_m_s: between_replica_stderr_m_s with two replicas or more, else the
+  /// run's own error; unset when the run recorded none.
+  std::optional<double> w_err_m_s;
+  int n_replicas = 1;
+  std::vector<std::string> replica_case_ids;
+  std::vector<double> replica_w_m_s;  ///< each replica's <<w_p>>, in study order
+  /// Sample standard deviation of the replicas' <<w_p>> over sqrt(N); unset below two replicas.
+  std::optional<double> between_replica_stderr_m_s;
+  /// The mean of the replicas' own (within-run) errors; unset when any replica recorded none.
+  std::optional<double> mean_within_run_stderr_m_s;
+  /// How the runs estimated their own errors (summary.json's settling_velocity_error_method;
+  /// "batch_means" for runs that predate it), "mixed" when the replicas differ.
+  std::string error_method;
   /// <<w_p>>/<<w_p>>(90 deg), unset without a 90 deg case; its error unset when an error it
   /// depends on is.
   std::optional<double> r_acc, r_acc_err;
@@ -71,7 +90,9 @@ struct SweptValue {
 /// The swept values of one case, by key.
 std::vector<SweptValue> case_swept_values(Database& db, const std::string& case_id);
 
-/// The correlation curve of finished cases, per group in study order, by angle.
+/// The correlation curve of finished cases, per group in study order, by angle; the replicas of
+/// a point (cases that differ only in their seed) are averaged, r_acc's error propagated from
+/// their scatter.
 std::vector<CurvePoint> query_curve(Database& db, const std::string& study, const std::string& group = "");
 
 /// InputError "no study 'S' in 'FILE'" when the database has no study of that name.

@@ -1,14 +1,17 @@
 #include "driver/study.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
 #include "core/error.hpp"
+#include "core/scene_specs.hpp"
 
 namespace boycott::driver {
 namespace {
@@ -112,6 +115,56 @@ bool advance(std::vector<std::size_t>& idx, const std::vector<Axis>& axes) {
   return false;
 }
 
+/// The replica keys of one table (the study's top level or a group), unresolved.
+struct ReplicaKeys {
+  std::optional<std::int64_t> replicas, max;
+  std::optional<double> target_rel_error;
+};
+
+ReplicaKeys read_replica_keys(const toml::table& t, const std::string& where) {
+  ReplicaKeys r;
+  auto integer = [&](const char* key, std::int64_t lo) -> std::optional<std::int64_t> {
+    const auto* n = t.get(key);
+    if (!n) return std::nullopt;
+    const auto v = n->value_exact<std::int64_t>();
+    if (!v || *v < lo || *v > 1000)
+      throw InputError(fmt::format("{}: {} must be a whole number in [{}, 1000]", where, key, lo));
+    return v;
+  };
+  r.replicas = integer("replicas", 1);
+  r.max = integer("replicas_max", 2);
+  if (const auto* n = t.get("replicas_target_rel_error")) {
+    const auto v = n->value<double>();
+    if (!v || !(*v > 0.0 && *v < 1.0))
+      throw InputError(fmt::format(
+          "{}: replicas_target_rel_error must be a number in (0, 1), a fraction of |<<w_p>>|", where));
+    r.target_rel_error = v;
+  }
+  return r;
+}
+
+/// A group's plan: its own keys over the study's.
+ReplicaPlan resolve_replicas(const ReplicaKeys& study, const ReplicaKeys& group, const std::string& where) {
+  ReplicaPlan plan;
+  plan.replicas = static_cast<int>(group.replicas.value_or(study.replicas.value_or(1)));
+  plan.target_rel_error = group.target_rel_error ? group.target_rel_error : study.target_rel_error;
+  const auto max = group.max ? group.max : study.max;
+  if (!plan.target_rel_error) {
+    if (max)
+      throw InputError(fmt::format(
+          "{}: replicas_max = {} is the limit of replicas_target_rel_error, which is not set", where, *max));
+    plan.max = plan.replicas;
+    return plan;
+  }
+  // A between-replica error needs two replicas.
+  plan.replicas = std::max(plan.replicas, 2);
+  plan.max = static_cast<int>(max.value_or(std::max(ReplicaPlan::kDefaultReplicasMax, plan.replicas)));
+  if (plan.max < plan.replicas)
+    throw InputError(fmt::format("{}: replicas_max = {} is below the {} replicas every point starts with",
+                                 where, plan.max, plan.replicas));
+  return plan;
+}
+
 void apply_named(CaseParams& p, const std::string& key, const std::string& value, const std::string& where) {
   try {
     apply_override(p, key + "=" + value);
@@ -130,11 +183,15 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
     throw InputError(fmt::format("{}:{}:{}: malformed TOML: {}", origin, e.source().begin.line,
                                  e.source().begin.column, e.description()));
   }
-  static const std::set<std::string> kTopKeys = {"name", "base", "group", "matrix", "zip"};
+  static const std::set<std::string> kTopKeys = {
+      "name", "base", "group", "matrix", "zip", "replicas", "replicas_max", "replicas_target_rel_error"};
   for (const auto& [k, node] : root)
     if (!kTopKeys.count(std::string(k.str())))
-      throw InputError(fmt::format("{}: unknown study key '{}' (expected name, base, group, matrix, zip)",
-                                   origin, k.str()));
+      throw InputError(
+          fmt::format("{}: unknown study key '{}' (expected name, base, group, matrix, zip, replicas, "
+                      "replicas_target_rel_error, replicas_max)",
+                      origin, k.str()));
+  const ReplicaKeys study_replicas = read_replica_keys(root, origin);
 
   Study s;
   s.source_text = text;
@@ -163,6 +220,7 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
     std::string name;
     std::vector<std::pair<std::string, std::string>> sets;
     std::vector<Axis> axes;  ///< the group's own [group.matrix] / [group.zip], before the study's
+    ReplicaKeys replicas;
   };
   std::vector<Group> groups;
   if (const auto* ga = root["group"].as_array()) {
@@ -174,11 +232,16 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
       if (!gname || gname->empty())
         throw InputError("[[group]]: every group needs a non-empty string 'name'");
       g.name = *gname;
+      static const std::set<std::string> kGroupKeys = {
+          "name", "set", "matrix", "zip", "replicas", "replicas_max", "replicas_target_rel_error"};
       for (const auto& [k, node] : *gt) {
-        if (k.str() != "name" && k.str() != "set" && k.str() != "matrix" && k.str() != "zip")
+        if (!kGroupKeys.count(std::string(k.str())))
           throw InputError(
-              fmt::format("group '{}': unknown key '{}' (expected name, set, matrix, zip)", g.name, k.str()));
+              fmt::format("group '{}': unknown key '{}' (expected name, set, matrix, zip, replicas, "
+                          "replicas_target_rel_error, replicas_max)",
+                          g.name, k.str()));
       }
+      g.replicas = read_replica_keys(*gt, fmt::format("group '{}'", g.name));
       // A group may sweep its own keys (one setting varied at a time, as a work-precision study
       // does); they combine with the study's [matrix] as a product.
       try {
@@ -203,7 +266,7 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
   } else if (root.contains("group")) {
     throw InputError("'group' must be an array of tables: [[group]]");
   }
-  if (groups.empty()) groups.push_back(Group{"base", {}, {}});
+  if (groups.empty()) groups.push_back(Group{"base", {}, {}, {}});
 
   const auto axes = read_axes(root);
   std::map<std::string, std::string> seen;  // id -> "group (values)"
@@ -211,6 +274,19 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
     s.groups.push_back(g.name);
     std::vector<Axis> all = g.axes;
     all.insert(all.end(), axes.begin(), axes.end());
+    const std::string gwhere = fmt::format("group '{}'", g.name);
+    const ReplicaPlan plan = resolve_replicas(study_replicas, g.replicas, gwhere);
+    s.replica_plans[g.name] = plan;
+    const bool replicated = plan.replicas > 1 || plan.target_rel_error.has_value();
+    if (replicated)
+      for (const auto& ax : all)
+        for (const auto& k : ax.keys)
+          if (k == "seed")
+            throw InputError(fmt::format(
+                "{}: replicas = {} runs replica k with seed + k, and the study also varies 'seed' in a "
+                "[matrix] or [zip]: vary one or the other",
+                gwhere, plan.replicas));
+    const std::size_t first = s.cases.size();
     std::vector<std::size_t> idx(all.size(), 0);
     while (true) {
       StudyCase c;
@@ -234,6 +310,7 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
         throw InputError(fmt::format("{}: {}", label, e.what()));
       }
       c.id = case_id(c.params);
+      c.point_id = c.id;
       if (auto it = seen.find(c.id); it != seen.end())
         throw InputError(fmt::format("{} and {} are the same case {}", it->second, label, c.id));
       seen.emplace(c.id, label);
@@ -241,8 +318,41 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
       // Odometer over the axes, last axis fastest.
       if (!advance(idx, all)) break;
     }
+    // Replicas after the group's points, replica by replica: the first round gives a whole curve.
+    const std::size_t points = s.cases.size() - first;
+    for (int k = 1; k < plan.replicas; ++k)
+      for (std::size_t i = first; i < first + points; ++i) {
+        StudyCase r = [&] {
+          try {
+            return replica_of(s.cases[i], k);
+          } catch (const InputError& e) {
+            throw InputError(fmt::format("{}: replicas = {}: {}", gwhere, plan.replicas, e.what()));
+          }
+        }();
+        const std::string label = fmt::format("{} replica {} of case {}", gwhere, k, r.point_id);
+        if (auto it = seen.find(r.id); it != seen.end())
+          throw InputError(fmt::format("{} and {} are the same case {}", it->second, label, r.id));
+        seen.emplace(r.id, label);
+        s.cases.push_back(std::move(r));
+      }
   }
   return s;
+}
+
+StudyCase replica_of(const StudyCase& replica0, int k) {
+  if (replica0.replica != 0) throw std::logic_error("replica_of needs replica 0 of a point");
+  const SceneSpec& sc = scene_spec(replica0.params.scene);
+  if (!scene_reads(sc, "seed"))
+    throw InputError(fmt::format(
+        "replicas differ in their seed, which scene {} does not read (its replicas would be one case)",
+        sc.name));
+  StudyCase c = replica0;
+  c.replica = k;
+  c.point_id = replica0.id;
+  apply_override(c.params, fmt::format("seed={}", replica0.params.seed + k));
+  validate(c.params);
+  c.id = case_id(c.params);
+  return c;
 }
 
 Study expand_study_file(const std::string& path) {

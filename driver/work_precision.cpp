@@ -207,24 +207,51 @@ std::string format_work_precision(const WorkPrecision& wp, CurveFormat f) {
   return s;
 }
 
+namespace {
+
+/// The order of a group's varied setting: numbers as numbers, key by key.
+bool setting_before(const std::vector<SweptValue>& a, const std::vector<SweptValue>& b) {
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    if (a[i].key != b[i].key) return a[i].key < b[i].key;
+    if (a[i].value_num && b[i].value_num) {
+      if (*a[i].value_num != *b[i].value_num) return *a[i].value_num < *b[i].value_num;
+    } else if (a[i].value != b[i].value) {
+      return a[i].value < b[i].value;
+    }
+  }
+  return a.size() < b.size();
+}
+
+/// A point's label: the values of its setting ("5e-05", "[25, 3, 25]").
+std::string setting_label(const std::vector<SweptValue>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : "; ") + x.display();
+  return s;
+}
+
+}  // namespace
+
 std::string work_precision_svg(const WorkPrecision& wp, const std::string& title) {
   using report::xml_escape;
   constexpr double kFloor = kWorkPrecisionErrorFloor;
   std::vector<std::string> groups;
-  for (const auto& r : wp.rows)
+  std::vector<double> angles;
+  for (const auto& r : wp.rows) {
     if (std::find(groups.begin(), groups.end(), r.group) == groups.end()) groups.push_back(r.group);
+    if (std::find(angles.begin(), angles.end(), r.angle_deg) == angles.end()) angles.push_back(r.angle_deg);
+  }
+  std::sort(angles.begin(), angles.end());
+  if (angles.empty()) angles.push_back(90.0);
 
-  // Only positive wall times have a place on a log axis.
+  // Only positive wall times have a place on a log axis. The range is the points', not their
+  // error bars': a large bar is clipped at the frame rather than squeezing every point together.
   auto plotted = [](const WorkPrecisionRow& r) { return r.wall_time_s && *r.wall_time_s > 0; };
   double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
-  bool any_floor = false;
   for (const auto& r : wp.rows) {
     if (!plotted(r)) continue;
     xlo = std::min(xlo, *r.wall_time_s), xhi = std::max(xhi, *r.wall_time_s);
-    const double e = std::abs(r.rel_error_w);
-    any_floor = any_floor || e < kFloor;
-    ylo = std::min(ylo, std::max(e, kFloor));
-    yhi = std::max(yhi, std::max(e + r.rel_error_w_unc, kFloor));
+    const double e = std::max(std::abs(r.rel_error_w), kFloor);
+    ylo = std::min(ylo, e), yhi = std::max(yhi, e);
   }
   for (const auto& r : wp.references)
     if (r.wall_time_s && *r.wall_time_s > 0)
@@ -242,81 +269,107 @@ std::string work_precision_svg(const WorkPrecision& wp, const std::string& title
   }
   xlo /= 1.6, xhi *= 1.6, ylo /= 1.6, yhi *= 1.6;
 
-  const double x0 = 90, y0 = 50, w = 520, h = 380;
-  auto px = [&](double t) {
-    return x0 + (std::log10(t) - std::log10(xlo)) / (std::log10(xhi) - std::log10(xlo)) * w;
-  };
+  const double w = 360, h = 360, y0 = 60, gap = 80;
+  const double width = 90 + angles.size() * (w + gap) + 170, height = 490;
   auto py = [&](double e) {
+    e = std::clamp(e, ylo, yhi);
     return y0 + h - (std::log10(e) - std::log10(ylo)) / (std::log10(yhi) - std::log10(ylo)) * h;
   };
 
-  std::string s =
-      "<svg xmlns='http://www.w3.org/2000/svg' width='900' height='500' font-family='sans-serif' "
-      "font-size='13'>\n<rect width='900' height='500' fill='white'/>\n";
-  s += fmt::format("<text x='{:.1f}' y='26' text-anchor='middle' font-size='15'>{}</text>\n", x0 + w / 2,
-                   xml_escape(title));
-  s += fmt::format("<rect x='{}' y='{}' width='{}' height='{}' fill='none' stroke='black'/>\n", x0, y0, w, h);
-  for (double t : report::log_ticks(xlo, xhi))
+  std::string s = fmt::format(
+      "<svg xmlns='http://www.w3.org/2000/svg' width='{0:.0f}' height='{1:.0f}' font-family='sans-serif' "
+      "font-size='13'>\n<rect width='{0:.0f}' height='{1:.0f}' fill='white'/>\n",
+      width, height);
+  s += fmt::format("<text x='{:.1f}' y='24' text-anchor='middle' font-size='15'>{}</text>\n",
+                   (90 + angles.size() * (w + gap) - gap) / 2 + 45, xml_escape(title));
+  for (std::size_t a = 0; a < angles.size(); ++a) {
+    const double angle = angles[a], x0 = 90 + a * (w + gap);
+    auto px = [&](double t) {
+      return x0 + (std::log10(t) - std::log10(xlo)) / (std::log10(xhi) - std::log10(xlo)) * w;
+    };
     s += fmt::format(
-        "<line x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' stroke='#ddd'/><text x='{0:.1f}' "
-        "y='{3:.1f}' "
-        "text-anchor='middle'>{4:g}</text>\n",
-        px(t), y0, y0 + h, y0 + h + 18, t);
-  for (double e : report::log_ticks(ylo, yhi))
-    s += fmt::format(
-        "<line x1='{0:.1f}' y1='{1:.1f}' x2='{2:.1f}' y2='{1:.1f}' stroke='#ddd'/><text x='{3:.1f}' "
-        "y='{4:.1f}' "
-        "text-anchor='end'>{5:g}</text>\n",
-        x0, py(e), x0 + w, x0 - 6, py(e) + 4, e);
-  s += fmt::format("<text x='{:.1f}' y='{:.1f}' text-anchor='middle'>wall time (s)</text>\n", x0 + w / 2,
-                   y0 + h + 40);
-  s += fmt::format(
-      "<text transform='translate({:.1f},{:.1f}) rotate(-90)' text-anchor='middle'>|⟨⟨w_p⟩⟩ / ⟨⟨w_p⟩⟩_ref − "
-      "1| "
-      "(dimensionless)</text>\n",
-      x0 - 62, y0 + h / 2);
-  if (any_floor)
-    s += fmt::format(
-        "<line class='floor' x1='{0:.1f}' y1='{1:.1f}' x2='{2:.1f}' y2='{1:.1f}' stroke='#999' "
-        "stroke-dasharray='2,3'/>\n",
-        x0, py(kFloor), x0 + w);
-
-  // The reference runs' cost: how much cheaper each point is than the run it is measured against.
-  for (const auto& r : wp.references) {
-    if (!r.wall_time_s || *r.wall_time_s <= 0) continue;
-    const double x = px(*r.wall_time_s);
-    // The label runs up along its line, so that references close in wall time stay readable.
-    s += fmt::format(
-        "<line class='reference' data-angle='{3:g}' x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' "
-        "stroke='#555' stroke-dasharray='6,4'/><text transform='translate({4:.1f},{5:.1f}) rotate(-90)' "
-        "font-size='11' fill='#555'>{6} {3:g}°</text>\n",
-        x, y0, y0 + h, r.angle_deg, x - 4, y0 + h - 6, xml_escape(wp.reference_group));
-  }
-
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    const char* color = report::color(g);
-    const char* kind = report::marker_kind(g);
-    std::string line, marks;
-    for (const auto& r : wp.rows) {  // already by wall time within a group
-      if (r.group != groups[g] || !plotted(r)) continue;
-      const double e = std::abs(r.rel_error_w);
-      const bool at_floor = e < kFloor;
-      const double x = px(*r.wall_time_s), y = py(std::max(e, kFloor));
-      line += fmt::format("{:.1f},{:.1f} ", x, y);
-      if (r.rel_error_w_unc > 0)
-        marks += fmt::format("<line x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' stroke='{3}'/>\n", x,
-                             py(std::max(e - r.rel_error_w_unc, kFloor)),
-                             py(std::max(e + r.rel_error_w_unc, kFloor)), color);
-      marks += report::marker(kind, x, y, color, at_floor) + "\n";
+        "<clipPath id='frame{0}'><rect x='{1}' y='{2}' width='{3}' height='{4}'/></clipPath>\n"
+        "<rect class='panel' data-angle='{5:g}' x='{1}' y='{2}' width='{3}' height='{4}' fill='none' "
+        "stroke='black'/>\n<text x='{6:.1f}' y='{7:.1f}' text-anchor='middle'>θ = {5:g}°</text>\n",
+        a, x0, y0, w, h, angle, x0 + w / 2, y0 - 8);
+    for (double t : report::log_ticks(xlo, xhi))
+      s += fmt::format(
+          "<line x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' stroke='#ddd'/><text x='{0:.1f}' "
+          "y='{3:.1f}' text-anchor='middle'>{4:g}</text>\n",
+          px(t), y0, y0 + h, y0 + h + 18, t);
+    for (double e : report::log_ticks(ylo, yhi))
+      s += fmt::format(
+          "<line x1='{0:.1f}' y1='{1:.1f}' x2='{2:.1f}' y2='{1:.1f}' stroke='#ddd'/><text x='{3:.1f}' "
+          "y='{4:.1f}' text-anchor='end'>{5:g}</text>\n",
+          x0, py(e), x0 + w, x0 - 6, py(e) + 4, e);
+    s += fmt::format("<text x='{:.1f}' y='{:.1f}' text-anchor='middle'>wall time (s)</text>\n", x0 + w / 2,
+                     y0 + h + 40);
+    if (a == 0)
+      s += fmt::format(
+          "<text transform='translate({:.1f},{:.1f}) rotate(-90)' text-anchor='middle'>|⟨⟨w_p⟩⟩ / "
+          "⟨⟨w_p⟩⟩_ref − 1| (dimensionless)</text>\n",
+          x0 - 62, y0 + h / 2);
+    bool any_floor = false;
+    for (const auto& r : wp.rows)
+      if (r.angle_deg == angle && plotted(r) && std::abs(r.rel_error_w) < kFloor) any_floor = true;
+    if (any_floor)
+      s += fmt::format(
+          "<line class='floor' x1='{0:.1f}' y1='{1:.1f}' x2='{2:.1f}' y2='{1:.1f}' stroke='#999' "
+          "stroke-dasharray='2,3'/>\n",
+          x0, py(kFloor), x0 + w);
+    // The reference run's cost: how much cheaper each point is than the run it is measured against.
+    for (const auto& r : wp.references) {
+      if (r.angle_deg != angle || !r.wall_time_s || *r.wall_time_s <= 0) continue;
+      const double x = px(*r.wall_time_s);
+      s += fmt::format(
+          "<line class='reference' data-angle='{3:g}' x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' "
+          "stroke='#555' stroke-dasharray='6,4'/><text transform='translate({4:.1f},{5:.1f}) rotate(-90)' "
+          "font-size='11' fill='#555'>{6}</text>\n",
+          x, y0, y0 + h, r.angle_deg, x - 4, y0 + h - 6, xml_escape(wp.reference_group));
     }
-    s += fmt::format(
-        "<polyline class='group' data-group='{}' points='{}' fill='none' stroke='{}' stroke-width='1.5'/>\n",
-        xml_escape(groups[g]), line, color);
-    s += marks;
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      const char* color = report::color(g);
+      const char* kind = report::marker_kind(g);
+      std::vector<const WorkPrecisionRow*> mine;
+      for (const auto& r : wp.rows)
+        if (r.group == groups[g] && r.angle_deg == angle && plotted(r)) mine.push_back(&r);
+      if (mine.empty()) continue;
+      // Joined in the order of the varied setting, each point labelled with its value.
+      std::stable_sort(mine.begin(), mine.end(), [](const WorkPrecisionRow* p, const WorkPrecisionRow* q) {
+        return setting_before(p->setting, q->setting);
+      });
+      std::string line, bars, marks;
+      for (const auto* r : mine) {
+        const double e = std::abs(r->rel_error_w);
+        const bool at_floor = e < kFloor;
+        const double x = px(*r->wall_time_s), y = py(std::max(e, kFloor));
+        line += fmt::format("{:.1f},{:.1f} ", x, y);
+        if (r->rel_error_w_unc > 0) {
+          const double top = e + r->rel_error_w_unc, bottom = std::max(e - r->rel_error_w_unc, kFloor);
+          bars += fmt::format(
+              "<line x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' stroke='{3}'/>"
+              "<line x1='{4:.1f}' y1='{2:.1f}' x2='{5:.1f}' y2='{2:.1f}' stroke='{3}'/>\n",
+              x, py(bottom), py(top), color, x - 4, x + 4);
+        }
+        marks += report::marker(kind, x, y, color, at_floor) + "\n";
+        const std::string label = setting_label(r->setting);
+        if (!label.empty())
+          marks +=
+              fmt::format("<text class='setting' x='{:.1f}' y='{:.1f}' font-size='10' fill='{}'>{}</text>\n",
+                          x + 6, y - 6, color, xml_escape(label));
+      }
+      s += fmt::format(
+          "<polyline class='group' data-group='{}' points='{}' fill='none' stroke='{}' "
+          "stroke-width='1.5'/>\n",
+          xml_escape(groups[g]), line, color);
+      if (!bars.empty())
+        s += fmt::format("<g class='errorbars' clip-path='url(#frame{})'>\n{}</g>\n", a, bars);
+      s += marks;
+    }
   }
 
-  // Legend, right of the plot.
-  const double lx = x0 + w + 20;
+  // Legend, right of the panels.
+  const double lx = 90 + angles.size() * (w + gap) - gap + 20;
   double ly = y0 + 10;
   for (std::size_t g = 0; g < groups.size(); ++g, ly += 20)
     s += fmt::format("{}<text x='{:.1f}' y='{:.1f}'>{}</text>\n",
@@ -327,7 +380,8 @@ std::string work_precision_svg(const WorkPrecision& wp, const std::string& title
       "<text x='{3:.1f}' y='{4:.1f}'>reference wall time</text>\n",
       lx, ly, lx + 16, lx + 20, ly + 4);
   ly += 20;
-  if (any_floor)
+  if (std::any_of(wp.rows.begin(), wp.rows.end(),
+                  [&](const WorkPrecisionRow& r) { return plotted(r) && std::abs(r.rel_error_w) < kFloor; }))
     s += fmt::format("{}<text x='{:.1f}' y='{:.1f}'>|error| &lt; {:g}, drawn at {:g}</text>\n",
                      report::marker("circle", lx + 8, ly, "#555", true), lx + 20, ly + 4, kFloor, kFloor);
   s += "</svg>\n";

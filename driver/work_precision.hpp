@@ -55,8 +55,9 @@ std::string format_work_precision(const WorkPrecision& wp, CurveFormat f);
 
 /// Below this |relative error| a point is drawn on the floor of the log axis, hollow.
 inline constexpr double kWorkPrecisionErrorFloor = 1e-6;
-/// Log-log |rel_error_w| against wall time: one colour and marker per group, its points joined in
-/// order of wall time, error bars, the reference wall times as dashed vertical lines per angle.
+/// Log-log |rel_error_w| against wall time, one panel per angle: one colour and marker per group,
+/// its points joined in the order of the varied setting and labelled with its value, error bars
+/// clipped to the frame, the reference's wall time as a dashed vertical line.
 std::string work_precision_svg(const WorkPrecision& wp, const std::string& title);
 
 }  // namespace boycott::driver

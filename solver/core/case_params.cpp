@@ -97,6 +97,7 @@ void visit_keys(P& p, V&& v) {
   v("time.end", p.time.end_s, positive("s"));
   v("time.average_from", p.time.average_from_s, nonneg("s"));
   v("time.checkpoint_every", p.time.checkpoint_every_s, positive("s"));
+  v("time.target_rel_error", p.time.target_rel_error, optional(open_range(0.0, 1.0, true, true)));
 
   v("forces.drag", p.forces.drag, choice(drag_law_names()));
   v("forces.saffman_lift", p.forces.saffman_lift, any());
@@ -377,6 +378,11 @@ CaseParams case_from_json(const nlohmann::json& j) {
     auto ptr = pointer_of(key);
     if (j.contains(ptr)) from_json(key, j.at(ptr), ref);
   });
+  if (j.contains("branch")) {
+    from_json("branch.parent_id", j["branch"].value("parent_id", nlohmann::json("")), p.branch.parent_id);
+    from_json("branch.parent_time_s", j["branch"].value("parent_time_s", nlohmann::json(nullptr)),
+              p.branch.parent_time_s);
+  }
   // The canonical form holds resolved values (written after validate()).
   p.resolved = true;
   return p;
@@ -555,6 +561,8 @@ nlohmann::json to_json(const CaseParams& p) {
     if (std::string_view(key) == "scene" || !sc || scene_reads(*sc, key))
       j[pointer_of(key)] = json_value(ref);
   });
+  if (!p.branch.parent_id.empty())
+    j["branch"] = {{"parent_id", p.branch.parent_id}, {"parent_time_s", json_value(p.branch.parent_time_s)}};
   return j;
 }
 

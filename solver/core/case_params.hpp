@@ -70,6 +70,8 @@ struct TimeParams {
   double end_s = 20.0;
   double average_from_s = 5.0;
   double checkpoint_every_s = 1.0;  ///< simulated seconds
+  /// Stop once the relative standard error of <<w_p>> is below this (unset: run to end_s).
+  double target_rel_error = kUnset;
 };
 
 struct ForceParams {
@@ -142,6 +144,14 @@ struct CaseParams {
   OutputParams output;
   ErgunParams ergun;
   SedimentParams sediment;
+
+  /// A run branched from another run's checkpoint (`case run --from`): the parent case and the
+  /// time it starts from. Part of the identity (the same physics from another state is another
+  /// case), never a key of a case file.
+  struct Branch {
+    std::string parent_id;
+    double parent_time_s = kUnset;
+  } branch;
 
   // ---- provenance (not part of the case's values) ----
   /// Keys the user set (case file, --set, a study's base, group and matrix), sorted: the only

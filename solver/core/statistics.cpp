@@ -38,6 +38,59 @@ double BatchMeans::stderr_of_mean() const {
   return std::sqrt(v / static_cast<double>(B));
 }
 
+AutocorrelationError autocorrelation_error(const std::vector<double>& x) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  using AE = AutocorrelationError;
+  AE e;
+  const std::size_t n = x.size();
+  e.samples = static_cast<std::int64_t>(n);
+  double sum = 0.0;
+  for (double v : x) sum += v;
+  e.mean = n ? sum / static_cast<double>(n) : kNaN;
+  e.stderr_of_mean = e.tau_int = e.tau_int_upper = e.effective_samples = e.correlation_times = kNaN;
+  if (n < 8) return e;
+  const double N = static_cast<double>(n);
+  std::vector<double> y(n);
+  for (std::size_t i = 0; i < n; ++i) y[i] = x[i] - e.mean;
+  auto autocov = [&](std::size_t t) {
+    double s = 0.0;
+    for (std::size_t i = 0; i + t < n; ++i) s += y[i] * y[i + t];
+    return s / static_cast<double>(n - t);
+  };
+  const double c0 = autocov(0);
+  if (!(c0 > 0.0)) {  // a constant series: its mean is exact
+    e.stderr_of_mean = 0.0;
+    e.tau_int = e.tau_int_upper = 0.5;
+    e.effective_samples = N;
+    e.correlation_times = std::numeric_limits<double>::infinity();
+    e.window_closed = true;
+    return e;
+  }
+  // var(m) and tau_int for the window M, with the mean's bias solved for (see the header).
+  double S = c0;  // sum over |t| <= M of C(t)
+  auto var_of_mean = [&](std::size_t M) { return S / (N - 2.0 * static_cast<double>(M) - 1.0); };
+  auto tau_of = [&](double V) { return N * V / (2.0 * (c0 + V)); };
+  const std::size_t max_window = (n - 1) / 4;
+  std::size_t M = 0;
+  for (std::size_t m = 1; m <= max_window; ++m) {
+    S += 2.0 * autocov(m);
+    M = m;
+    if (static_cast<double>(m) >= AE::kWindowFactor * tau_of(var_of_mean(m))) {
+      e.window_closed = true;
+      break;
+    }
+  }
+  e.window = static_cast<std::int64_t>(M);
+  const double V = var_of_mean(M);
+  if (!(V > 0.0)) return e;  // anticorrelated noise summed below zero: no estimate
+  e.tau_int = tau_of(V);
+  e.tau_int_upper = e.tau_int * (1.0 + std::sqrt(2.0 * (2.0 * static_cast<double>(M) + 1.0) / N));
+  e.effective_samples = N / (2.0 * e.tau_int);
+  e.correlation_times = N / e.tau_int_upper;
+  if (e.correlation_times >= AE::kMinCorrelationTimes) e.stderr_of_mean = std::sqrt(V);
+  return e;
+}
+
 void Histogram::add(double x, double w) {
   total_ += w;
   if (!(x >= lo_ && x < hi_)) {

@@ -2,7 +2,9 @@
 // Time averages of correlated series. The standard error of the mean of an autocorrelated
 // series is underestimated by sigma/sqrt(N); batch means (Flyvbjerg & Petersen 1989, Law &
 // Kelton) group the series into B consecutive batches long enough to be nearly independent and
-// use the scatter of the batch means: SE = sd(batch means)/sqrt(B).
+// use the scatter of the batch means: SE = sd(batch means)/sqrt(B). Batch means never checks
+// that a batch is longer than the correlation time; autocorrelation_error() estimates the
+// correlation time itself from the whole series.
 #include <cstdint>
 #include <vector>
 
@@ -31,6 +33,45 @@ class BatchMeans {
   double open_sum_ = 0.0;     ///< the batch being filled
   std::int64_t open_n_ = 0;
 };
+
+/// The standard error of the mean of a stationary, autocorrelated series from its integrated
+/// autocorrelation time, with Sokal's automatic window (A. D. Sokal, "Monte Carlo methods in
+/// statistical mechanics: foundations and new algorithms", 1997, sec. 3; N. Madras & A. D. Sokal,
+/// J. Stat. Phys. 50, 109 (1988)). No model of the autocorrelation is assumed:
+///   C(t) = 1/(N-t) sum_i (x_i - m)(x_{i+t} - m),   tau_int(M) = 1/2 + sum_{t=1}^{M} rho(t),
+///   var(m) = 2 tau_int C(0) / N,
+/// with the window M the smallest one with M >= c tau_int(M) (c = 6), at most N/4. The sample
+/// mean m biases every C(t) low by var(m); summed over the 2M+1 lags of the window that is a
+/// relative bias of (2M+1)/N, which matters in short series, so var(m) is solved for
+/// self-consistently, var(m) = S / (N - 2M - 1) with S = sum_{|t|<=M} C(t), and C(0) + var(m)
+/// stands for the variance (first order in tau/N; Wolff, Comput. Phys. Commun. 156, 143 (2004),
+/// corrects the same bias to the same order).
+///
+/// How many correlation times the series holds, N / tau_int, decides how far the error can be
+/// trusted. tau_int's own standard error is tau sqrt(2(2M+1)/N) (Madras & Sokal), large in short
+/// series, whose estimates also scatter low: the count is taken at the upper end of that
+/// one-sigma range, K = N / (tau (1 + sqrt(2(2M+1)/N))). Below kWarnCorrelationTimes (or when
+/// the window could not close) the error comes with a warning; below kMinCorrelationTimes it is
+/// not reported (NaN).
+struct AutocorrelationError {
+  std::int64_t samples = 0;
+  double mean = 0.0;
+  double stderr_of_mean = 0.0;     ///< NaN: not available (too few correlation times, or none)
+  double tau_int = 0.0;            ///< integrated autocorrelation time, in samples
+  double tau_int_upper = 0.0;      ///< its one-sigma upper end, in samples
+  std::int64_t window = 0;         ///< M
+  bool window_closed = false;      ///< M >= c tau_int(M) was reached within N/4
+  double effective_samples = 0.0;  ///< N / (2 tau_int)
+  double correlation_times = 0.0;  ///< N / tau_int_upper (the conservative count above)
+  /// Whether the error is to be doubted: fewer than kWarnCorrelationTimes, or no closed window.
+  bool doubtful() const { return !window_closed || !(correlation_times >= kWarnCorrelationTimes); }
+  static constexpr double kWarnCorrelationTimes = 20.0;
+  static constexpr double kMinCorrelationTimes = 5.0;
+  static constexpr double kWindowFactor = 6.0;  ///< c
+};
+/// Needs 8 samples at least (fewer: everything NaN but samples and mean). A constant series has
+/// error 0.
+AutocorrelationError autocorrelation_error(const std::vector<double>& x);
 
 /// Fixed-range histogram normalised as a probability density (values outside are counted apart).
 class Histogram {

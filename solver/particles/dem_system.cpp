@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "core/constants.hpp"
 #include "core/error.hpp"
 #include "core/timers.hpp"
 #include "particles/min_image.hpp"
@@ -87,6 +88,29 @@ void DemSystem::update_uniform_mass() {
   uniform_mass_kg_ = s_.size() ? s_.mass[0] : 0.0;
   for (double m : s_.mass)
     if (m != uniform_mass_kg_) uniform_mass_kg_ = 0.0;
+}
+
+void DemSystem::set_particle_properties(double r, double rho) {
+  const double m = rho * 4.0 / 3.0 * kPi * r * r * r, inertia = 0.4 * m * r * r;
+  int changed = 0;
+  for (std::size_t i = 0; i < s_.n_local; ++i)
+    if (s_.radius[i] != r || s_.mass[i] != m) {
+      s_.radius[i] = r, s_.mass[i] = m, s_.inertia[i] = inertia;
+      changed = 1;
+    }
+  if (dd_.parallel()) {
+    MPI_Allreduce(MPI_IN_PLACE, &changed, 1, MPI_INT, MPI_MAX, dd_.comm);
+    if (!changed) return;
+    set_cutoff_and_mass();
+    rebuild_parallel();
+    return;
+  }
+  if (!changed) return;
+  double rmax = 0.0;
+  for (double v : s_.radius) rmax = std::max(rmax, v);
+  cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
+  update_uniform_mass();
+  rebuild();
 }
 
 void DemSystem::force_rebuild() {

@@ -60,6 +60,10 @@ class DemSystem {
   const ParticleStore& particles() const { return s_; }
   const DemConfig& config() const { return cfg_; }
 
+  /// Gives every particle (of all ranks) this radius (m) and density (kg/m^3), where they differ
+  /// from what they have, and rebuilds the neighbour list for them (a run branched from another
+  /// with smaller or lighter particles). Collective.
+  void set_particle_properties(double radius_m, double density_kg_m3);
   /// Adds a particle (before `initialize`, or followed by `force_rebuild`).
   void add_particle(std::int64_t gid, double x, double y, double z, double radius_m, double density_kg_m3);
   /// Random non-overlapping insertion of `count` spheres with centres in [lo, hi] (m), at least

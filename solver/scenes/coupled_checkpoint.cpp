@@ -149,10 +149,22 @@ void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run) {
 
 std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::filesystem::path& run_dir,
                                      bool quiet,
-                                     const std::function<void(const io::CheckpointReader&)>& load_scene) {
+                                     const std::function<void(const io::CheckpointReader&)>& load_scene,
+                                     const std::filesystem::path& branch_checkpoint) {
   // Listed once, before any is set aside, so that every rank walks the same list.
   const auto candidates = io::checkpoints_newest_first(run_dir);
-  if (candidates.empty()) return std::nullopt;
+  if (candidates.empty()) {
+    if (branch_checkpoint.empty()) return std::nullopt;
+    // A branch: the parent's state under this case's parameters (run_case checked what may
+    // differ); the particles take this case's size and density.
+    io::CheckpointReader r(branch_checkpoint);
+    import_coupled(read_coupled(r, run.params()), run, branch_checkpoint.string());
+    const auto& pp = run.params().particles;
+    run.dem().set_particle_properties(0.5 * pp.diameter_m, pp.density_kg_m3);
+    if (!quiet && output_rank())
+      std::fprintf(stderr, "branching from %s at t = %g s\n", branch_checkpoint.c_str(), run.time_s());
+    return 0.0;
+  }
   const std::string id = case_id(run.params());
   std::vector<std::string> refused;
   for (std::size_t k = 0; k < candidates.size(); ++k) {

@@ -37,14 +37,31 @@ class CoupledSceneOutput {
   template <class Row, class WriteCheckpoint>
   bool after_step(Row&& row, WriteCheckpoint&& write_checkpoint, SummaryBase& summary) {
     const double t = run_.time_s(), end = run_.params().time.end_s;
-    if (t >= next_out_s_ - 1e-12 || t >= end - 1e-12) {
+    // The last step's row is written whenever it falls, but it does not move the schedule: a
+    // run continued to a later end keeps the rows a run straight to that end writes.
+    const bool scheduled = t >= next_out_s_ - 1e-12;
+    if (scheduled || t >= end - 1e-12) {
       csv_.row(row());
-      next_out_s_ = t + out_every_s_;
+      if (scheduled) next_out_s_ = t + out_every_s_;
       if (ctx_.progress) ctx_.progress(t);
     }
     write_pictures(t);
     return checkpoint_or_stop(ctx_.should_stop(), ctx_.quiet, checkpoints_, t, end, csv_, write_checkpoint,
                               summary);
+  }
+  /// Instead of after_step, at the end of the step after which a run stops before time.end
+  /// (time.target_rel_error met): the step's row (whenever it falls; it does not move the
+  /// schedule), its pictures and a checkpoint, from which a stricter target continues.
+  template <class Row, class WriteCheckpoint>
+  void end_early(Row&& row, WriteCheckpoint&& write_checkpoint) {
+    const double t = run_.time_s();
+    const bool scheduled = t >= next_out_s_ - 1e-12;
+    csv_.row(row());
+    if (scheduled) next_out_s_ = t + out_every_s_;
+    if (ctx_.progress) ctx_.progress(t);
+    write_pictures(t);
+    csv_.flush();
+    write_checkpoint();
   }
   /// When the next time-series row is due (s): part of a scene's checkpoint.
   double next_out_s() const { return next_out_s_; }

@@ -1,8 +1,10 @@
 // Scene inclined_settling (paper sections IV-V, Table III): a suspension settling in a narrow
 // channel inclined at theta, periodic in x and z, walls at y = 0 and W, the slurry velocity held
 // at zero by the driving gradient G (Eq. 25). Measures <w_p>(t) and <w_f>(t) (Eq. 28), the
-// ensemble average <<w_p>> over [average_from, end] with a batch-means error bar (Eq. 29), and the
-// PDFs of particle y and w_p over the same window (Fig. 12).
+// ensemble average <<w_p>> over [average_from, end] with its error from the autocorrelation of the
+// whole <w_p> series over the window (scenes/mean_error.hpp; Eq. 29), and the PDFs of particle y
+// and w_p over the same window (Fig. 12). With time.target_rel_error it stops once <<w_p>> is that
+// precise (status converged).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +20,7 @@
 #include "io/state_io.hpp"
 #include "scenes/coupled_checkpoint.hpp"
 #include "scenes/coupled_output.hpp"
+#include "scenes/mean_error.hpp"
 #include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scenes_list.hpp"
@@ -73,28 +76,42 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   const double wrange = std::max(8.0 * vt, 0.05);
   Histogram pdf_w(-wrange, 0.5 * wrange, bins);
   BatchMeans wp_avg, wf_avg, slurry_avg;
+  // Every <w_p> sample of the window, for its error (20 s of 1 ms steps: 15 000 doubles).
+  std::vector<double> wp_series;
+  bool wp_series_whole = true;  // false after resuming a checkpoint of a build that kept none
+  PrecisionTarget target(p.time.target_rel_error);
   double slurry_max = 0.0, next_out = 0.0, wall_before = 0.0;  // next_out: the resumed output's, s
   // Stability record over the whole run (issue 7): alpha_f range and the largest kinetic energy.
   double alpha_min_seen = 1.0, alpha_max_seen = 0.0, ke_max_seen = 0.0;
 
   // Resume from the newest checkpoint, or start.
-  const auto resumed = resume_coupled(run, ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) {
-    io::load(r, "stats.wp.", wp_avg);
-    io::load(r, "stats.wf.", wf_avg);
-    io::load(r, "stats.slurry.", slurry_avg);
-    // The histograms are counts over all ranks: rank 0 carries them on, the others add theirs.
-    if (output_rank()) {
-      io::load(r, "stats.pdf_y.", pdf_y);
-      io::load(r, "stats.pdf_w.", pdf_w);
-    }
-    slurry_max = r.scalar("stats.slurry_max");
-    next_out = r.scalar("stats.next_out");
-    if (r.has("stats.alpha_min_seen")) {  // absent in checkpoints of earlier builds
-      alpha_min_seen = r.scalar("stats.alpha_min_seen");
-      alpha_max_seen = r.scalar("stats.alpha_max_seen");
-      ke_max_seen = r.scalar("stats.ke_max_seen");
-    }
-  });
+  const auto resumed = resume_coupled(
+      run, ctx.out_dir, ctx.quiet,
+      [&](const io::CheckpointReader& r) {
+        io::load(r, "stats.wp.", wp_avg);
+        io::load(r, "stats.wf.", wf_avg);
+        io::load(r, "stats.slurry.", slurry_avg);
+        // The histograms are counts over all ranks: rank 0 carries them on, the others add theirs.
+        if (output_rank()) {
+          io::load(r, "stats.pdf_y.", pdf_y);
+          io::load(r, "stats.pdf_w.", pdf_w);
+        }
+        slurry_max = r.scalar("stats.slurry_max");
+        next_out = r.scalar("stats.next_out");
+        if (r.has("stats.alpha_min_seen")) {  // absent in checkpoints of earlier builds
+          alpha_min_seen = r.scalar("stats.alpha_min_seen");
+          alpha_max_seen = r.scalar("stats.alpha_max_seen");
+          ke_max_seen = r.scalar("stats.ke_max_seen");
+        }
+        if (r.has("stats.wp_series")) {
+          wp_series = r.doubles("stats.wp_series");
+          const auto t = r.doubles("stats.target");
+          if (t.size() == 2) target.next_check_ = static_cast<std::int64_t>(t[0]), target.met_since_s_ = t[1];
+        } else {
+          wp_series_whole = wp_avg.count() == 0;
+        }
+      },
+      ctx.branch_checkpoint);
   if (resumed) {
     wall_before = *resumed;
   } else {
@@ -121,6 +138,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       w.put("stats.alpha_min_seen", alpha_min_seen);
       w.put("stats.alpha_max_seen", alpha_max_seen);
       w.put("stats.ke_max_seen", ke_max_seen);
+      w.put("stats.wp_series", wp_series);
+      w.put("stats.target",
+            std::vector<double>{static_cast<double>(target.next_check_), target.met_since_s_});
     });
   };
   int exit_code = kExitOk;
@@ -137,6 +157,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     ke_max_seen = std::max(ke_max_seen, run.dem().kinetic_energy_j());
     if (t > p.time.average_from_s + 1e-12) {
       wp_avg.add(wp);
+      wp_series.push_back(wp);
       wf_avg.add(wf);
       slurry_avg.add(slurry);
       slurry_max = std::max(slurry_max, std::abs(slurry));
@@ -158,6 +179,12 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
               run.coupler().totals().min_alpha_f,
               run.dem().kinetic_energy_j()};
     };
+    // time.target_rel_error met before time.end: the last row, a checkpoint, status converged.
+    if (wp_series_whole && target.reached(wp_series, p.time.average_from_s, t) && t < end - 1e-12) {
+      out.end_early(row, write_checkpoint);
+      sb.status = kStatusConverged;
+      break;
+    }
     if (out.after_step(row, write_checkpoint, sb)) {
       exit_code = kExitInterrupted;
       break;
@@ -177,8 +204,32 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   const std::int64_t particles = run.dem().global_count();
   sb.particle_steps = static_cast<double>(particles) * static_cast<double>(run.dem().steps());
   sb.mean_settling_velocity_m_s = wp_avg.count() ? wp_avg.mean() : kUnset;
-  sb.settling_velocity_stderr_m_s = wp_avg.stderr_of_mean();
+  const WindowError wp_err = window_error(wp_series, p.time.average_from_s, run.time_s());
+  sb.settling_velocity_stderr_m_s = wp_series_whole ? wp_err.e.stderr_of_mean : wp_avg.stderr_of_mean();
   auto j = make_summary(p, sb, timers);
+  const bool finished = is_finished_status(sb.status);
+  if (wp_series_whole) {
+    report_window_error(j, "settling_velocity_", "<w_p>", wp_err, finished);
+  } else {
+    j["settling_velocity_error_method"] = "batch_means";
+    if (finished)
+      add_warning(j,
+                  "resumed from a checkpoint of an earlier build, which kept no <w_p> series: the error of "
+                  "<<w_p>> is from batch means, which ignore the correlation time");
+  }
+  // The estimate that earlier builds reported, for comparison.
+  j["settling_velocity_stderr_batch_means_m_s"] = std::isfinite(wp_avg.stderr_of_mean())
+                                                      ? nlohmann::json(wp_avg.stderr_of_mean())
+                                                      : nlohmann::json(nullptr);
+  const double rel = std::abs(sb.settling_velocity_stderr_m_s / sb.mean_settling_velocity_m_s);
+  j["settling_velocity_rel_stderr"] = std::isfinite(rel) ? nlohmann::json(rel) : nlohmann::json(nullptr);
+  if (target.active()) {
+    j["target_rel_error"] = p.time.target_rel_error;
+    // Met: it stopped the run, or the whole window meets it at the end.
+    j["target_met"] = sb.status == kStatusConverged ||
+                      (wp_series_whole && rel < p.time.target_rel_error &&
+                       wp_err.e.correlation_times >= PrecisionTarget::kMinCorrelationTimes);
+  }
   j["ranks"] = run.rank_report();
   j["mean_fluid_velocity_m_s"] = wf_avg.count() ? wf_avg.mean() : kUnset;
   j["mean_slurry_velocity_m_s"] = slurry_avg.count() ? slurry_avg.mean() : kUnset;

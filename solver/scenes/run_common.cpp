@@ -65,6 +65,8 @@ nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const Mod
   MPI_Initialized(&initialized);
   if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   j["mpi_ranks"] = ranks;
+  if (!p.branch.parent_id.empty())
+    j["parent"] = {{"case_id", p.branch.parent_id}, {"time_s", num_or_null(p.branch.parent_time_s)}};
   return j;
 }
 

@@ -21,6 +21,12 @@ struct RunContext {
   bool quiet = false;
   /// Progress callback (simulated time s), for the driver's display; may be empty.
   std::function<void(double)> progress;
+  /// Branch (`case run --from DIR --at TIME`): start from DIR's newest kept checkpoint at or
+  /// before TIME (s; unset: the newest), with this case's parameters and fresh statistics.
+  std::filesystem::path branch_from;
+  double branch_at_s = kUnset;
+  /// The parent checkpoint run_case chose (set by run_case; scenes read it).
+  std::filesystem::path branch_checkpoint;
   /// Whether to stop at the end of this step. Collective under MPI (every rank calls it once per
   /// step): a signal that reached one rank stops all of them at the same step.
   bool should_stop() const;
@@ -35,7 +41,9 @@ SceneFn find_scene(const std::string& name);
 std::vector<std::string> registered_scenes();
 
 /// Validates, writes params.json beside the outputs (refusing a folder that holds another case)
-/// and runs the scene.
+/// and runs the scene. A folder whose run already reached time.end says so and returns 0; a
+/// time.end below the time it reached is refused; with ctx.branch_from, the parent checkpoint
+/// is chosen and checked against the case (what cannot change mid-run is refused).
 int run_case(CaseParams params, RunContext& ctx);
 
 }  // namespace boycott::scenes

@@ -138,15 +138,18 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   double alpha_min_seen = 1.0, ke_max_seen = 0.0, settle_s = 0.0, wall_before = 0.0;
   double next_out = 0.0;  // the resumed output's, s
   timers.activate("bed_pouring", "dry DEM until the bed rests");
-  const auto resumed = resume_coupled(run, ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) {
-    for (auto [name, b] : {std::pair{"q", &q_avg}, {"g", &g_avg}, {"wf", &wf_avg}, {"vp", &vp_avg}})
-      io::load(r, fmt::format("stats.{}.", name), *b);
-    alpha_min_seen = r.scalar("stats.alpha_min_seen");
-    ke_max_seen = r.scalar("stats.ke_max_seen");
-    next_out = r.scalar("stats.next_out");
-    settle_s = r.scalar("stats.bed_pouring_time_s");
-    profiles.load(r);
-  });
+  const auto resumed = resume_coupled(
+      run, ctx.out_dir, ctx.quiet,
+      [&](const io::CheckpointReader& r) {
+        for (auto [name, b] : {std::pair{"q", &q_avg}, {"g", &g_avg}, {"wf", &wf_avg}, {"vp", &vp_avg}})
+          io::load(r, fmt::format("stats.{}.", name), *b);
+        alpha_min_seen = r.scalar("stats.alpha_min_seen");
+        ke_max_seen = r.scalar("stats.ke_max_seen");
+        next_out = r.scalar("stats.next_out");
+        settle_s = r.scalar("stats.bed_pouring_time_s");
+        profiles.load(r);
+      },
+      ctx.branch_checkpoint);
   const double A = p.domain.length_x_m * p.domain.height_z_m, H = p.domain.width_y_m;
   const double d = p.particles.diameter_m, g = p.gravity.magnitude_m_s2;
   const double rho_p = p.particles.density_kg_m3, rho_f = p.fluid.density_kg_m3;

@@ -231,11 +231,13 @@ TEST(FakeSolverContract, SummaryKeysAndStatusesMatchTheRealSolver) {
   ASSERT_EQ(f.rc, 0) << f.err;
   const auto fake = nlohmann::json::parse(read(fake_dir / "summary.json"));
 
+  // Errors are n/a (null) when the averaging window holds fewer than 5 correlation times.
+  const std::set<std::string> kNullable = {"settling_velocity_stderr_m_s", "settling_velocity_rel_stderr"};
   std::set<std::string> missing;
   for (const auto& [k, v] : fake.items()) {
     if (!real.contains(k))
       missing.insert(k);
-    else
+    else if (!(kNullable.count(k) && (real[k].is_null() || v.is_null())))
       EXPECT_EQ(real[k].type_name(), std::string(v.type_name())) << k;
   }
   EXPECT_TRUE(missing.empty()) << "keys the test double writes and the real solver does not: "

@@ -5,9 +5,9 @@
 #   parallel_resume.sh BOYCOTT_BIN CASE.toml
 set -euo pipefail
 bin=$1; case_file=$2
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
-sets=(--set time.end=0.3 --set time.average_from=0.1 --set time.checkpoint_every=0.05)
+sets=(--set time.end=0.2 --set time.average_from=0.1 --set time.checkpoint_every=0.05)
 on() { local n=$1; shift; if [ "$n" -eq 1 ]; then "$bin" "$@"; else mpirun -n "$n" "$bin" "$@"; fi; }
 on 2 case run "$case_file" --out "$work/ref" "${sets[@]}" > /dev/null
 mpirun -n 2 "$bin" case run "$case_file" --out "$work/run" "${sets[@]}" > /dev/null 2> "$work/err.txt" &

@@ -117,11 +117,13 @@ class CheckpointFaults : public ::testing::Test {
   static void TearDownTestSuite() { fs::remove_all(root_); }
 
   static fs::path reference() { return root_ / "reference"; }
-  /// A copy of the reference run folder, to damage.
+  /// A copy of the reference run folder, to damage, as a run killed after its last checkpoint
+  /// leaves it: without its summary (a finished run is not resumed, only reported complete).
   static fs::path copy_of_reference(const std::string& name) {
     const fs::path d = root_ / name;
     fs::remove_all(d);
     fs::copy(reference(), d, fs::copy_options::recursive);
+    fs::remove(d / "summary.json");
     return d;
   }
   static fs::path ckpt(const fs::path& run, int step) { return io::checkpoint_path(run, step); }

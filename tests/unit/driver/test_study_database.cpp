@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -211,4 +212,62 @@ TEST(StudyDatabase, CurveRatioAndPropagatedErrorFollowTheRecordedResults) {
             "SELECT COUNT(*) FROM results WHERE validation_errors_json LIKE '%max_rel_error_vs_analytic%' "
             "AND average_from_s = 1.0 AND average_to_s = 2.0"),
       4);
+}
+
+TEST(StudyDatabase, CurveAveragesReplicasAndPropagatesTheirScatterIntoRacc) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(R"(
+name = "rep"
+replicas = 3
+[base.time]
+end = 2.0
+average_from = 1.0
+[matrix]
+"gravity.angle_deg" = [45, 90]
+)");
+  bd::register_study(db, study);
+  // Replica k: w = base (1 + 0.01 k (k - 1)); the within-run errors 1 % of |w|. The replicas at
+  // 45 deg carry the new method, those at 90 deg none (a run that predates it: batch means).
+  std::map<double, std::vector<double>> w_of;
+  for (const auto& c : study.cases) {
+    const double base = c.params.gravity.angle_deg == 90.0 ? -0.08 : -0.16;
+    const double w = base * (1.0 + 0.01 * c.replica * (c.replica - 1));
+    w_of[c.params.gravity.angle_deg].push_back(w);
+    nlohmann::json summary = {{"scene", "inclined_settling"},
+                              {"case_id", c.id},
+                              {"status", "completed"},
+                              {"mean_settling_velocity_m_s", w},
+                              {"settling_velocity_stderr_m_s", 0.01 * std::abs(w)},
+                              {"simulated_time_s", 2.0}};
+    if (c.params.gravity.angle_deg == 45.0)
+      summary["settling_velocity_error_method"] = "sokal_autocorrelation";
+    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, summary);
+  }
+  const auto pts = bd::query_curve(db, "rep");
+  ASSERT_EQ(pts.size(), 2u);
+  auto stats = [](const std::vector<double>& w) {
+    double m = 0.0, ss = 0.0;
+    for (double x : w) m += x / w.size();
+    for (double x : w) ss += (x - m) * (x - m);
+    return std::pair{m, std::sqrt(ss / (w.size() - 1.0)) / std::sqrt(double(w.size()))};
+  };
+  const auto [m45, e45] = stats(w_of[45.0]);
+  const auto [m90, e90] = stats(w_of[90.0]);
+  EXPECT_EQ(pts[0].n_replicas, 3);
+  EXPECT_EQ(pts[0].replica_case_ids.size(), 3u);
+  EXPECT_NEAR(pts[0].w_m_s, m45, 1e-15);
+  EXPECT_NEAR(*pts[0].between_replica_stderr_m_s, e45, 1e-15);
+  EXPECT_NEAR(*pts[0].w_err_m_s, e45, 1e-15);
+  double within = 0.0;
+  for (double x : w_of[45.0]) within += 0.01 * std::abs(x) / 3.0;
+  EXPECT_NEAR(*pts[0].mean_within_run_stderr_m_s, within, 1e-15);
+  EXPECT_EQ(pts[0].error_method, "sokal_autocorrelation");
+  EXPECT_EQ(pts[1].error_method, "batch_means");
+  EXPECT_NEAR(*pts[0].r_acc, m45 / m90, 1e-12);
+  EXPECT_NEAR(*pts[0].r_acc_err, std::abs(m45 / m90) * std::hypot(e45 / m45, e90 / m90), 1e-12);
+  EXPECT_EQ(*pts[1].r_acc_err, 0.0);
+  // The error keys of <<w_p>> are not validation errors.
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results WHERE validation_errors_json LIKE '%settling_velocity%'"),
+            0);
 }

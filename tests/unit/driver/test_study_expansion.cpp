@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <filesystem>
 #include <set>
 
@@ -241,4 +242,102 @@ TEST(StudyExpansion, DemoStudyIsValidWithThePaperSolidFraction) {
   const auto s = bd::expand_study_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/demo.toml");
   ASSERT_EQ(s.cases.size(), 4u);
   for (const auto& c : s.cases) EXPECT_NEAR(c.params.solid_fraction(), 0.113, 0.002);
+}
+
+namespace {
+const char* kReplicated = R"(
+name = "rep"
+replicas = 3
+[base]
+scene = "inclined_settling"
+seed = 5
+[base.time]
+end = 2.0
+average_from = 1.0
+[[group]]
+name = "base"
+[[group]]
+name = "visc"
+replicas = 2
+set = { "fluid.viscosity" = 1.0e-2 }
+[matrix]
+"gravity.angle_deg" = [60, 90]
+)";
+}  // namespace
+
+TEST(StudyReplicas, ReplicaKRunsWithSeedPlusKAndReplicaZeroIsTheCaseAsBefore) {
+  const auto s = bd::expand_study_string(kReplicated);
+  ASSERT_EQ(s.cases.size(), 2u * 3u + 2u * 2u);
+  EXPECT_EQ(ids_of(s).size(), s.cases.size());
+  EXPECT_EQ(s.replica_plans.at("base").replicas, 3);
+  EXPECT_EQ(s.replica_plans.at("visc").replicas, 2);
+  // Replica 0 of every point is the case of the same study without replicas.
+  std::string plain = kReplicated;
+  plain.replace(plain.find("replicas = 3"), 12, "");
+  plain.replace(plain.find("replicas = 2"), 12, "");
+  const auto without = bd::expand_study_string(plain);
+  std::set<std::string> zero;
+  for (const auto& c : s.cases) {
+    if (c.replica == 0) {
+      zero.insert(c.id);
+      EXPECT_EQ(c.point_id, c.id);
+    }
+    const auto& r0 = *std::find_if(s.cases.begin(), s.cases.end(),
+                                   [&](const bd::StudyCase& x) { return x.id == c.point_id; });
+    EXPECT_EQ(c.params.seed, 5 + c.replica);
+    EXPECT_EQ(c.group, r0.group);
+    EXPECT_EQ(c.params.gravity.angle_deg, r0.params.gravity.angle_deg);
+    EXPECT_EQ(c.swept, r0.swept) << "replicas share their point's swept values (no seed)";
+  }
+  EXPECT_EQ(zero, ids_of(without));
+  // The first round (replica 0 of every point of a group) comes first.
+  EXPECT_EQ(s.cases[0].replica, 0);
+  EXPECT_EQ(s.cases[1].replica, 0);
+  EXPECT_EQ(s.cases[2].replica, 1);
+}
+
+TEST(StudyReplicas, RefusedWithASweptSeedOrAScenelessSeedOrBadCounts) {
+  const std::string seeds = error_of(
+      "name = \"x\"\nreplicas = 2\n[base.time]\nend = 2.0\naverage_from = 1.0\n[matrix]\nseed = [1, 2]\n");
+  EXPECT_NE(seeds.find("replicas = 2"), std::string::npos) << seeds;
+  EXPECT_NE(seeds.find("'seed'"), std::string::npos) << seeds;
+  const std::string channel =
+      error_of("name = \"x\"\nreplicas = 2\n[base]\nscene = \"channel_flow\"\n[base.time]\nend = 0.1\n");
+  EXPECT_NE(channel.find("channel_flow does not read"), std::string::npos) << channel;
+  const std::string single = error_of(
+      "name = \"x\"\n[base]\nscene = \"single_particle\"\n[base.time]\nend = 0.1\naverage_from = 0.05\n"
+      "[[group]]\nname = \"g\"\nreplicas = 3\n");
+  EXPECT_NE(single.find("single_particle does not read"), std::string::npos) << single;
+  EXPECT_NE(error_of("name = \"x\"\nreplicas = 0\n").find("replicas must be a whole number"),
+            std::string::npos);
+  EXPECT_NE(error_of("name = \"x\"\nreplicas = 2.5\n").find("replicas must be a whole number"),
+            std::string::npos);
+  EXPECT_NE(error_of("name = \"x\"\nreplicas_max = 4\n[base.time]\nend = 2.0\naverage_from = 1.0\n")
+                .find("replicas_target_rel_error, which is not set"),
+            std::string::npos);
+  EXPECT_NE(error_of("name = \"x\"\nreplicas = 5\nreplicas_max = 3\nreplicas_target_rel_error = 0.01\n"
+                     "[base.time]\nend = 2.0\naverage_from = 1.0\n")
+                .find("replicas_max = 3 is below"),
+            std::string::npos);
+  EXPECT_NE(error_of("name = \"x\"\nreplicas_target_rel_error = 2\n").find("in (0, 1)"), std::string::npos);
+  // A seed set once for a group is not a sweep.
+  EXPECT_NO_THROW(bd::expand_study_string(
+      "name = \"x\"\nreplicas = 2\n[base.time]\nend = 2.0\naverage_from = 1.0\n[[group]]\nname = \"g\"\n"
+      "set = { seed = 7 }\n"));
+}
+
+TEST(StudyReplicas, ATargetStartsWithTwoReplicasUpToTenByDefault) {
+  const auto s = bd::expand_study_string(
+      "name = \"x\"\nreplicas_target_rel_error = 0.02\n[base.time]\nend = 2.0\naverage_from = 1.0\n"
+      "[[group]]\nname = \"a\"\n[[group]]\nname = \"b\"\nreplicas_max = 4\nreplicas = 3\n"
+      "set = { \"fluid.viscosity\" = 2e-3 }\n");
+  EXPECT_EQ(s.replica_plans.at("a").replicas, 2);
+  EXPECT_EQ(s.replica_plans.at("a").max, 10);
+  EXPECT_DOUBLE_EQ(*s.replica_plans.at("a").target_rel_error, 0.02);
+  EXPECT_EQ(s.replica_plans.at("b").replicas, 3);
+  EXPECT_EQ(s.replica_plans.at("b").max, 4);
+  EXPECT_EQ(s.cases.size(), 5u);
+  const auto r = bd::replica_of(s.cases[0], 7);
+  EXPECT_EQ(r.params.seed, s.cases[0].params.seed + 7);
+  EXPECT_EQ(r.point_id, s.cases[0].id);
 }

@@ -227,7 +227,7 @@ seed = [1, 2]
   for (const auto& id : ref_ids) EXPECT_NE(msg.find(id), std::string::npos) << msg;
 }
 
-TEST(WorkPrecision, SvgHasOneLinePerGroupReferenceLinesAndFlagsZeroErrors) {
+TEST(WorkPrecision, SvgHasAPanelPerAngleALinePerGroupInEachAndFlagsZeroErrors) {
   TempDir d;
   bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
   const auto study = bd::expand_study_string(kWorkPrecisionStudy);
@@ -241,11 +241,19 @@ TEST(WorkPrecision, SvgHasOneLinePerGroupReferenceLinesAndFlagsZeroErrors) {
   };
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
   EXPECT_EQ(svg.substr(svg.size() - 7), "</svg>\n");
-  EXPECT_EQ(count("<"), count(">"));  // every tag closed, text escaped
-  EXPECT_EQ(count("<polyline"), 2u);
-  EXPECT_EQ(count("data-group='dt_dem'"), 1u);
-  EXPECT_EQ(count("data-group='cells'"), 1u);
+  EXPECT_EQ(count("<"), count(">"));        // every tag closed, text escaped
+  EXPECT_EQ(count("class='panel'"), 2u);    // one per angle
+  EXPECT_EQ(count("data-angle='65'"), 2u);  // its panel and its reference line
+  EXPECT_EQ(count("<polyline"), 4u);        // one per group in each panel
+  EXPECT_EQ(count("data-group='dt_dem'"), 2u);
+  EXPECT_EQ(count("data-group='cells'"), 2u);
   EXPECT_EQ(count("class='reference'"), 2u);  // one per angle
+  // Error bars are clipped to their panel's frame.
+  EXPECT_EQ(count("<clipPath"), 2u);
+  EXPECT_EQ(count("clip-path='url(#frame"), count("class='errorbars'"));
+  // Each point is labelled with the value of its group's setting.
+  EXPECT_EQ(count("class='setting'"), 4u);
+  EXPECT_NE(svg.find(">4e-05</text>"), std::string::npos);
   EXPECT_NE(svg.find("wp &amp; co"), std::string::npos);
   EXPECT_NE(svg.find("wall time (s)"), std::string::npos);
   // cells at 65 deg equals the reference: drawn hollow on the floor of the log axis.

@@ -1,0 +1,76 @@
+#include "scenes/mean_error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <fmt/format.h>
+
+#include "scenes/run_common.hpp"
+
+namespace boycott::scenes {
+
+WindowError window_error(const std::vector<double>& series, double window_from_s, double now_s) {
+  WindowError w;
+  w.e = autocorrelation_error(series);
+  w.window_s = std::max(0.0, now_s - window_from_s);
+  w.sample_s = series.empty() ? 0.0 : w.window_s / static_cast<double>(series.size());
+  return w;
+}
+
+void add_warning(nlohmann::json& j, const std::string& text) {
+  if (!j.contains("warnings")) j["warnings"] = nlohmann::json::array();
+  j["warnings"].push_back(text);
+  if (output_rank()) std::fprintf(stderr, "warning: %s\n", text.c_str());
+}
+
+void report_window_error(nlohmann::json& j, const std::string& prefix, const std::string& what,
+                         const WindowError& w, bool warn) {
+  const auto& e = w.e;
+  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  j[prefix + "stderr_m_s"] = num(e.stderr_of_mean);
+  j[prefix + "correlation_time_s"] = num(w.correlation_time_s());
+  j[prefix + "correlation_time_upper_s"] = num(w.correlation_time_upper_s());
+  j[prefix + "effective_samples"] = num(e.effective_samples);
+  j[prefix + "window_correlation_times"] = num(e.correlation_times);
+  j[prefix + "error_method"] = "sokal_autocorrelation";
+  if (e.samples == 0 || !warn) return;
+  if (!std::isfinite(e.tau_int)) {
+    add_warning(
+        j, fmt::format("the averaging window ({:.4g} s, {} samples) gives no estimate of the correlation "
+                       "time of {}: its error is not reported",
+                       w.window_s, e.samples, what));
+    return;
+  }
+  if (!e.doubtful()) return;
+  const bool na = !std::isfinite(e.stderr_of_mean);
+  add_warning(
+      j,
+      fmt::format(
+          "the averaging window ({:.4g} s) holds only {:.1f} correlation times of {} (tau_int "
+          "{:.3g} s, at most {:.3g} s{}); {}: run longer or average from earlier",
+          w.window_s, e.correlation_times, what, w.correlation_time_s(), w.correlation_time_upper_s(),
+          e.window_closed ? "" : ", the autocorrelation window did not close",
+          na ? fmt::format("below {:g} its error is not reported", AutocorrelationError::kMinCorrelationTimes)
+             : fmt::format("below {:g} its error is itself uncertain",
+                           AutocorrelationError::kWarnCorrelationTimes)));
+}
+
+bool PrecisionTarget::reached(const std::vector<double>& series, double window_from_s, double now_s) {
+  if (!active() || static_cast<std::int64_t>(series.size()) < next_check_) return false;
+  // Checks every 2 % of the samples (at least 25): their cost grows with the window.
+  const auto n = static_cast<std::int64_t>(series.size());
+  next_check_ = n + std::max<std::int64_t>(25, n / 50);
+  const WindowError w = window_error(series, window_from_s, now_s);
+  const double rel = std::abs(w.e.stderr_of_mean / w.e.mean);
+  last_rel_error_ = rel;
+  const bool met = std::isfinite(rel) && rel < target_ && w.e.correlation_times >= kMinCorrelationTimes;
+  if (!met) {
+    met_since_s_ = -1.0;
+    return false;
+  }
+  if (met_since_s_ < 0.0) met_since_s_ = now_s;
+  return now_s - met_since_s_ >= kConfirmCorrelationTimes * w.correlation_time_upper_s();
+}
+
+}  // namespace boycott::scenes

@@ -1,0 +1,67 @@
+#pragma once
+// The error of a time average over a scene's averaging window, from the whole per-step series
+// (core/statistics.hpp: integrated autocorrelation time, Sokal's window), as summary.json reports
+// it; and time.target_rel_error, which ends a run once that error is small enough.
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/statistics.hpp"
+
+namespace boycott::scenes {
+
+/// The error of the mean of `series`, the per-step samples over [window_from_s, now_s].
+struct WindowError {
+  AutocorrelationError e;
+  double window_s = 0.0;  ///< now_s - window_from_s
+  double sample_s = 0.0;  ///< window_s / samples, the mean step (s)
+  double correlation_time_s() const { return e.tau_int * sample_s; }
+  double correlation_time_upper_s() const { return e.tau_int_upper * sample_s; }
+};
+WindowError window_error(const std::vector<double>& series, double window_from_s, double now_s);
+
+/// The summary keys of a time average's error, `prefix` + stderr_m_s, correlation_time_s,
+/// correlation_time_upper_s, effective_samples, window_correlation_times, error_method
+/// ("sokal_autocorrelation"); null where not available. With `warn` (a finished run), a warning
+/// goes to j["warnings"] and stderr when the window holds fewer than ~20 correlation times,
+/// saying when the error is not reported at all (fewer than ~5). `what` names the quantity.
+void report_window_error(nlohmann::json& j, const std::string& prefix, const std::string& what,
+                         const WindowError& w, bool warn);
+
+/// Appends a warning to j["warnings"] and prints it on stderr (output rank; also under --quiet,
+/// which silences progress, so that a study's solver.log keeps it).
+void add_warning(nlohmann::json& j, const std::string& text);
+
+/// time.target_rel_error: a run may stop once the standard error of <<w_p>> over its window is
+/// below target |<<w_p>>|, the window holds at least kMinCorrelationTimes correlation times
+/// (counted conservatively, AutocorrelationError::correlation_times), and the target has been
+/// met at every check over at least kConfirmCorrelationTimes correlation times (two checks that
+/// far apart, none failing between). Checks fall on a fixed schedule of sample counts, so a
+/// resumed run checks where the uninterrupted one did; the state goes into checkpoints.
+class PrecisionTarget {
+ public:
+  static constexpr double kMinCorrelationTimes = 50.0;
+  static constexpr double kConfirmCorrelationTimes = 10.0;
+  static constexpr std::int64_t kFirstCheck = 50;  ///< samples
+
+  /// target: time.target_rel_error (NaN: no target, never stops).
+  explicit PrecisionTarget(double target) : target_(target) {}
+  bool active() const { return target_ == target_; }
+  /// After a sample was added to `series`: true when the run may stop now.
+  bool reached(const std::vector<double>& series, double window_from_s, double now_s);
+  /// The last check's relative error (NaN before the first).
+  double last_rel_error() const { return last_rel_error_; }
+
+  // State, for checkpoints.
+  std::int64_t next_check_ = kFirstCheck;
+  double met_since_s_ = -1.0;  ///< time of the first check of the streak; < 0: not met
+
+ private:
+  double target_;
+  double last_rel_error_ = std::numeric_limits<double>::quiet_NaN();
+};
+
+}  // namespace boycott::scenes

@@ -1,0 +1,203 @@
+#!/usr/bin/env bash
+# `boycott study submit --scheduler slurm` against a real Slurm: a private single-node cluster
+# (munged, slurmctld, slurmd started here on free ports, state in a temporary folder) runs a 4-case
+# study as a job array two at a time; one running task gets the wall-time warning
+# (`scancel -b -s USR1`), checkpoints, requeues itself and resumes. `study collect` then gives the
+# database a local `study run` of the same study gives: every case done, the same <<w_p>> bit for
+# bit, no duplicate rows; the signalled case has its two attempts (exit 75 on restart 0, exit 0 on
+# restart 1 of the same job), and collecting again changes nothing.
+# Without a usable Slurm (packages missing, not root, daemons not starting) it skips (exit 77),
+# unless BOYCOTT_REQUIRE_SLURM=1 (.ci/run sets it): then it fails with the reason.
+set -euo pipefail
+bin=$1
+study_src=$2
+t0=$(date +%s)
+
+skip() {
+  if [ "${BOYCOTT_REQUIRE_SLURM:-0}" = 1 ]; then
+    echo "FAIL: BOYCOTT_REQUIRE_SLURM=1 but Slurm cannot run here: $1" >&2
+    exit 1
+  fi
+  echo "SKIP: Slurm cannot run here: $1"
+  exit 77
+}
+for p in munged slurmctld slurmd sbatch squeue scontrol scancel sinfo flock; do
+  command -v "$p" > /dev/null || skip "no $p (scripts/install_deps.sh installs slurmctld slurmd slurm-client munge)"
+done
+[ "$(id -u)" = 0 ] || skip "the private slurmd runs jobs as their user and must be started as root"
+[ -r /etc/munge/munge.key ] || skip "no /etc/munge/munge.key (the munge package creates it)"
+
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1
+work=$(mktemp -d /tmp/boycott-slurm.XXXXXX)
+chmod 755 "$work"  # munged, running as munge, must reach its socket below
+pids=()
+cleanup() {
+  set +e
+  if [ -n "${SLURM_CONF:-}" ]; then scancel --quiet --full "--name=boycott-slurm_tiny" 2> /dev/null; fi
+  for p in "${pids[@]}"; do kill "$p" 2> /dev/null; done
+  [ -f "$work/munge/munged.pid" ] && kill "$(cat "$work/munge/munged.pid")" 2> /dev/null
+  sleep 1
+  for p in "${pids[@]}"; do kill -9 "$p" 2> /dev/null; done
+  rm -rf "$work"
+}
+trap cleanup EXIT
+
+# ---- a private Slurm ----
+mkdir -p "$work/munge" "$work/state" "$work/spool" "$work/log"
+chown munge:munge "$work/munge"
+runuser -u munge -- munged --socket="$work/munge/sock" --pid-file="$work/munge/munged.pid" \
+  --seed-file="$work/munge/seed" --log-file="$work/munge/munged.log" --key-file=/etc/munge/munge.key ||
+  skip "munged does not start: $(tail -n 2 "$work/munge/munged.log" 2> /dev/null)"
+read -r ctld_port slurmd_port < <(python3 -c '
+import socket
+s = [socket.socket() for _ in range(2)]
+for x in s: x.bind(("127.0.0.1", 0))
+print(*[x.getsockname()[1] for x in s])')
+node=$(hostname -s)
+hw=$(slurmd -C | head -n 1 | sed 's/^NodeName=[^ ]* //; s/ UpTime=.*//')
+cpus=$(sed -n 's/.*CPUs=\([0-9]*\).*/\1/p' <<< "$hw")
+cat > "$work/slurm.conf" << EOF
+ClusterName=boycotttest
+SlurmctldHost=$node(127.0.0.1)
+SlurmctldPort=$ctld_port
+SlurmdPort=$slurmd_port
+SlurmUser=root
+SlurmdUser=root
+AuthType=auth/munge
+CredType=cred/munge
+AuthInfo=socket=$work/munge/sock,cred_expire=10
+StateSaveLocation=$work/state
+SlurmdSpoolDir=$work/spool
+SlurmctldPidFile=$work/slurmctld.pid
+SlurmdPidFile=$work/slurmd.pid
+SlurmctldLogFile=$work/log/slurmctld.log
+SlurmdLogFile=$work/log/slurmd.log
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+MpiDefault=none
+MailProg=/bin/true
+ReturnToService=2
+SchedulerType=sched/backfill
+SchedulerParameters=bf_interval=1,sched_interval=2
+SelectType=select/cons_tres
+SelectTypeParameters=CR_Core
+NodeName=$node NodeAddr=127.0.0.1 $hw State=UNKNOWN
+PartitionName=boycott Nodes=$node Default=YES MaxTime=INFINITE State=UP
+EOF
+export SLURM_CONF=$work/slurm.conf
+slurmctld -D -i > "$work/log/slurmctld.out" 2>&1 &
+pids+=($!)
+slurmd -D -N "$node" > "$work/log/slurmd.out" 2>&1 &
+pids+=($!)
+for _ in $(seq 100); do
+  [ "$(sinfo -h -o %T 2> /dev/null)" = idle ] && break
+  sleep 0.2
+done
+[ "$(sinfo -h -o %T 2> /dev/null)" = idle ] ||
+  skip "the private slurmctld/slurmd did not reach idle in 20 s: $(tail -n 3 "$work"/log/*.log 2> /dev/null | tr '\n' ' ')"
+echo "private Slurm up in $(($(date +%s) - t0)) s: node $node ($cpus CPUs), ports $ctld_port/$slurmd_port"
+
+cd "$work"
+cp "$study_src" study.toml
+
+# ---- dry run: the script, nothing written ----
+"$bin" study submit study.toml --db "$work/slurm.sqlite" --scheduler slurm --max-running 2 --time 00:30:00 \
+  --sbatch-arg=--comment=boycott-test --dry-run > dry.sh 2> dry.err
+grep -qx '#SBATCH --array=0-3%2' dry.sh
+grep -qx '#SBATCH --signal=B:USR1@120' dry.sh
+grep -qx '#SBATCH --comment=boycott-test' dry.sh
+bash -n dry.sh
+[ ! -e slurm.sqlite ] && [ ! -e slurm.sqlite.slurm ] || {
+  echo "FAIL: --dry-run wrote files" >&2
+  exit 1
+}
+
+# ---- submit; warn one running task once it has passed a checkpoint ----
+t_submit=$(date +%s)
+"$bin" study submit study.toml --db "$work/slurm.sqlite" --scheduler slurm --max-running 2 --time 00:30:00 | tee submit.txt
+array=$(sed -n 's/.*submitted job \([0-9]*\),.*/\1/p' submit.txt)
+[ -n "$array" ]
+tasks=$(ls -d "$work"/slurm.sqlite.slurm/*/tasks)
+signalled_job=
+signalled_case=
+for _ in $(seq 600); do
+  while read -r job idx; do
+    [ -n "$job" ] || continue
+    c=$(sed -n "$((idx + 1))p" "$tasks" | cut -d' ' -f1)
+    ts=$work/slurm.sqlite.runs/$c/timeseries.csv
+    [ -f "$ts" ] || continue
+    t=$(tail -n 1 "$ts" | cut -d, -f1)
+    if python3 -c "import sys; sys.exit(0 if 0.15 <= float('$t') <= 0.7 else 1)" 2> /dev/null; then
+      scancel -b -s USR1 "$job"
+      signalled_job=$job
+      signalled_case=$c
+      echo "warned job $job (case $c) at t = $t s, $(($(date +%s) - t_submit)) s after submitting"
+      break 2
+    fi
+  done < <(squeue -h -r -j "$array" -t RUNNING -o '%A %K')
+  sleep 0.1
+done
+[ -n "$signalled_job" ] || {
+  echo "FAIL: no task was seen running between t = 0.15 and 0.7 s to warn" >&2
+  exit 1
+}
+
+# ---- meanwhile the same study run locally ----
+t_local=$(date +%s)
+"$bin" study run study.toml --db "$work/local.sqlite" --jobs 1 > local.txt 2>&1
+echo "local study run: $(($(date +%s) - t_local)) s"
+
+for _ in $(seq 900); do
+  [ -z "$(squeue -h -j "$array" -o %i)" ] && break
+  sleep 0.2
+done
+[ -z "$(squeue -h -j "$array" -o %i)" ] || {
+  squeue -r -j "$array"
+  echo "FAIL: the array did not finish within 180 s of the local run" >&2
+  exit 1
+}
+echo "array $array done $(($(date +%s) - t_submit)) s after submitting"
+cat slurm.sqlite.slurm/*/slurm-*.out
+
+"$bin" study status study.toml --db "$work/slurm.sqlite" > status_before.txt
+"$bin" study collect study.toml --db "$work/slurm.sqlite" | tee collect1.txt
+sqlite3 slurm.sqlite "SELECT * FROM attempts ORDER BY id" > attempts1.txt
+"$bin" study collect study.toml --db "$work/slurm.sqlite" > collect2.txt
+sqlite3 slurm.sqlite "SELECT * FROM attempts ORDER BY id" > attempts2.txt
+cmp attempts1.txt attempts2.txt || {
+  echo "FAIL: a second collect changed the attempts" >&2
+  diff attempts1.txt attempts2.txt
+  exit 1
+}
+"$bin" study status study.toml --db "$work/slurm.sqlite" | tee status.txt
+grep -q ': 4 cases: 4 done' status.txt
+
+python3 - "$work" "$signalled_case" "$signalled_job" "$array" << 'PY'
+import json, sqlite3, sys, pathlib
+work, case, job, array = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
+s = sqlite3.connect(work / "slurm.sqlite")
+l = sqlite3.connect(work / "local.sqlite")
+q = "SELECT case_id, mean_settling_velocity_m_s, settling_velocity_stderr_m_s FROM results ORDER BY case_id"
+rs, rl = s.execute(q).fetchall(), l.execute(q).fetchall()
+assert len(rs) == 4 and [r[0] for r in rs] == [r[0] for r in rl], (rs, rl)
+print("case              <<w_p>> Slurm (m/s)      <<w_p>> local (m/s)")
+for a, b in zip(rs, rl):
+    print(f"{a[0]}  {a[1]!r:>22}  {b[1]!r:>22}")
+    assert a[1] == b[1] and a[2] == b[2], ("not bitwise equal", a, b)
+dups = s.execute("SELECT case_id, attempt_file, COUNT(*) FROM attempts WHERE attempt_file IS NOT NULL "
+                 "GROUP BY case_id, attempt_file HAVING COUNT(*) > 1").fetchall()
+assert not dups, dups
+assert s.execute("SELECT COUNT(*) FROM attempts WHERE ended_at IS NULL").fetchone()[0] == 0
+assert s.execute("SELECT COUNT(*) FROM attempts WHERE slurm_array_job_id IS NOT ?", (array,)).fetchone()[0] == 0
+for c, n in s.execute("SELECT case_id, COUNT(*) FROM attempts GROUP BY case_id"):
+    assert n == (2 if c == case else 1), (c, n)
+rows = s.execute("SELECT exit_status, slurm_job_id, slurm_restart, error_text, started_at, ended_at FROM attempts "
+                 "WHERE case_id = ? ORDER BY started_at", (case,)).fetchall()
+print("attempts of the warned case:", rows)
+assert [r[0] for r in rows] == [75, 0] and [r[2] for r in rows] == [0, 1], rows
+assert all(r[1] == job for r in rows), rows
+summary = json.load(open(work / "slurm.sqlite.runs" / case / "summary.json"))
+assert summary["status"] == "completed" and summary["resumed_from_checkpoint"], summary
+print("Slurm array == local study run, bit for bit; the warned task requeued and resumed")
+PY
+echo "total $(($(date +%s) - t0)) s"
