@@ -117,6 +117,7 @@ void visit_keys(P& p, V&& v) {
   v("numerics.cfl_max", p.numerics.cfl_max, open_range(0.0, 1.0, true, false));
   v("numerics.neighbor_skin", p.numerics.neighbor_skin_m, positive("m"));
   v("numerics.void_fraction_kernel", p.numerics.void_fraction_kernel, choice(kernel_names()));
+  v("numerics.sampling", p.numerics.sampling, choice(sampling_names()));
 
   v("output.timeseries_every", p.output.timeseries_every_s, optional(positive("s")));
   v("output.keep_checkpoints", p.output.keep_checkpoints, range(1, 1000));
@@ -585,7 +586,7 @@ struct LateKey {
   const char* key;
   const char* old_behaviour;  ///< the value as JSON text
 };
-constexpr std::array<LateKey, 0> kLateKeys{};
+constexpr std::array<LateKey, 1> kLateKeys{{{"numerics.sampling", "\"kernel\""}}};
 }  // namespace
 
 std::string case_id(const CaseParams& p) {

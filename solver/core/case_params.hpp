@@ -103,6 +103,10 @@ struct NumericsParams {
   double cfl_max = 0.5;
   double neighbor_skin_m = 0.3e-3;
   std::string void_fraction_kernel = "trilinear_smoothed";
+  /// How the fluid is read at the particles: "kernel" (the deposition kernel's weights, the
+  /// first round's way) or "trilinear" (each field from its own staggered nodes with its wall
+  /// rule; coupling/sampling.hpp).
+  std::string sampling = "kernel";
 };
 
 struct OutputParams {

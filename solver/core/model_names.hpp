@@ -10,12 +10,18 @@ namespace boycott {
 
 /// forces.drag
 inline const std::vector<std::string>& drag_law_names() {
-  static const std::vector<std::string> n = {"difelice_paper", "schiller_naumann", "stokes", "none"};
+  static const std::vector<std::string> n = {"difelice_paper", "difelice", "schiller_naumann", "stokes",
+                                             "none"};
   return n;
 }
 /// numerics.void_fraction_kernel
 inline const std::vector<std::string>& kernel_names() {
   static const std::vector<std::string> n = {"trilinear_smoothed", "trilinear", "cell"};
+  return n;
+}
+/// numerics.sampling
+inline const std::vector<std::string>& sampling_names() {
+  static const std::vector<std::string> n = {"kernel", "trilinear"};
   return n;
 }
 /// contact.model

@@ -24,6 +24,7 @@ CouplingSettings CouplingSettings::from_case(const CaseParams& p) {
   s.pressure_gradient = p.forces.pressure_gradient;
   s.viscous = p.forces.viscous;
   s.kernel = kernel_from_name(p.numerics.void_fraction_kernel);
+  s.sampling = sampling_from_name(p.numerics.sampling);
   s.rho_f_kg_m3 = p.fluid.density_kg_m3;
   s.mu_pa_s = p.fluid.viscosity_pa_s;
   s.top_slip = p.domain.top_wall == "slip";
@@ -52,14 +53,46 @@ Coupler::Stencil Coupler::stencil(double x, double y, double z) const {
       // The particle's periodic image that lies in this rank's window.
       const int nz = (int)g_.n[2], lo = solid_.k0, hi = solid_.k0 + solid_.nz;
       Weights1D& w = st.cell[2];
+      const int first = w.first;
       while (w.first < lo) w.first += nz;
       while (w.first + w.n + 1 > hi) w.first -= nz;
+      st.z_image = w.first - first;
       if (w.first < lo)
         throw PhysicsError(fmt::format(
             "a particle at z = {:.6g} m is outside the planes its rank holds ({} to {})", z, lo, hi - 1));
     }
     st.face[d] = face_weights(st.cell[d]);
   }
+  return st;
+}
+
+Coupler::LinearStencil Coupler::linear_stencil(double x, double y, double z, int z_image) const {
+  LinearStencil st;
+  const double hx = g_.dx(0), hy = g_.dx(1), hz = g_.dx(2);
+  const int nx = (int)g_.n[0], ny = (int)g_.n[1], nz = (int)g_.n[2];
+  const bool walls = !g_.periodic[1];
+  for (int f = 0; f < 2; ++f) {
+    const bool centred = f == 0;
+    st.x[f] = linear_weights(x, hx, centred, nx, false, WallRule::plain, WallRule::plain);
+    st.z[f] = linear_weights(z, hz, centred, nz, false, WallRule::plain, WallRule::plain);
+    if (window_) {
+      // The same periodic image as the kernel's (stencil()); the linear stencil reaches no
+      // further than the kernel's, whose planes the window holds.
+      Weights1D& w = st.z[f];
+      w.first += z_image;
+      const int lo = solid_.k0 + 1, hi = solid_.k0 + solid_.nz - 2;
+      if (w.first < lo || w.first + w.n > hi)
+        throw PhysicsError(fmt::format(
+            "a particle at z = {:.6g} m is outside the planes its rank holds ({} to {})", z, lo, hi - 1));
+    }
+  }
+  const WallRule top = s_.top_slip ? WallRule::constant : WallRule::zero;
+  const WallRule ex = WallRule::extrapolate;
+  st.y_tangential = linear_weights(y, hy, true, ny, walls, WallRule::zero, top);
+  st.y_normal = linear_weights(y, hy, false, ny, walls, WallRule::plain, WallRule::plain);
+  st.y_centre_extrapolated = linear_weights(y, hy, true, ny, walls, ex, ex);
+  st.y_face_extrapolated = linear_weights(y, hy, false, ny, walls, ex, ex);
+  st.y_alpha = linear_weights(y, hy, true, ny, walls, WallRule::constant, WallRule::constant);
   return st;
 }
 
@@ -126,23 +159,50 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
   auto& p = dem.particles();
   const double rho = s_.rho_f_kg_m3, mu = s_.mu_pa_s, nu = mu / rho;
   const auto& lo = dem.config().box.lo;
-  std::vector<double> lag(3, 0.0);  // this rank's share of totals_.lag_impulse_ns
+  const bool linear = s_.sampling == Sampling::trilinear;
+  std::vector<double> lag(3, 0.0);       // this rank's share of totals_.lag_impulse_ns
+  std::vector<double> mismatch(3, 0.0);  // and of totals_.sampling_mismatch_ns
   for (std::size_t i = 0; i < p.n_local; ++i) {
-    const Stencil st = stencil(p.x[i] - lo[0], p.y[i] - lo[1], p.z[i] - lo[2]);
+    const double px = p.x[i] - lo[0], py = p.y[i] - lo[1], pz = p.z[i] - lo[2];
+    const Stencil st = stencil(px, py, pz);
     const double d = 2.0 * p.radius[i];
     const double vp = kPi * d * d * d / 6.0;
     double uf[3], fe[3] = {0.0, 0.0, 0.0}, dudt[3] = {0.0, 0.0, 0.0};
+    double ufk[3], fek[3] = {0.0, 0.0, 0.0};  // read with the kernel's weights (trilinear: mismatch)
+    LinearStencil ls;
+    if (linear) ls = linear_stencil(px, py, pz, st.z_image);
     for (int c = 0; c < 3; ++c) {
       const Weights1D& wx = c == 0 ? st.face[0] : st.cell[0];
       const Weights1D& wy = c == 1 ? st.face[1] : st.cell[1];
       const Weights1D& wz = c == 2 ? st.face[2] : st.cell[2];
       // the face fields of component c share one layout
       const Offsets3 o = offsets(wx, wy, wz, fields_.velocity(c));
-      uf[c] = sample(o, fields_.velocity(c).a);
-      if (s_.pressure_gradient) fe[c] -= vp * sample(o, fields_.pressure_gradient(c).a);
-      if (s_.viscous) fe[c] += rho * vp * sample(o, fields_.viscous(c).a);
-      if (s_.added_mass) dudt[c] = sample(o, fields_.material_derivative(c).a);
+      if (!linear) {
+        uf[c] = sample(o, fields_.velocity(c).a);
+        if (s_.pressure_gradient) fe[c] -= vp * sample(o, fields_.pressure_gradient(c).a);
+        if (s_.viscous) fe[c] += rho * vp * sample(o, fields_.viscous(c).a);
+        if (s_.added_mass) dudt[c] = sample(o, fields_.material_derivative(c).a);
+        continue;
+      }
+      const Weights1D& lx = ls.x[c == 0 ? 1 : 0];
+      const Weights1D& lz = ls.z[c == 2 ? 1 : 0];
+      const Offsets3 ou = offsets(lx, c == 1 ? ls.y_normal : ls.y_tangential, lz, fields_.velocity(c));
+      const Offsets3 og =
+          offsets(lx, c == 1 ? ls.y_face_extrapolated : ls.y_centre_extrapolated, lz, fields_.velocity(c));
+      uf[c] = sample(ou, fields_.velocity(c).a);
+      ufk[c] = sample(o, fields_.velocity(c).a);
+      if (s_.pressure_gradient) {
+        fe[c] -= vp * sample(og, fields_.pressure_gradient(c).a);
+        fek[c] -= vp * sample(o, fields_.pressure_gradient(c).a);
+      }
+      if (s_.viscous) {
+        fe[c] += rho * vp * sample(og, fields_.viscous(c).a);
+        fek[c] += rho * vp * sample(o, fields_.viscous(c).a);
+      }
+      if (s_.added_mass) dudt[c] = sample(og, fields_.material_derivative(c).a);
     }
+    if (linear)
+      for (int c = 0; c < 3; ++c) mismatch[c] += dt_prev * (p.beta[i] * (ufk[c] - uf[c]) + (fek[c] - fe[c]));
     // Time-level lag (see coupler.hpp): what the fluid gave at level n+1 minus what the particle
     // received at level n over the last sub-cycle, both with these weights. Measured, not fed
     // back: handing it to the fluid as an explicit source undoes the implicit drag (a frozen
@@ -156,8 +216,10 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
       }
       p.drag_jx[i] = p.drag_jy[i] = p.drag_jz[i] = 0.0;
     }
-    const Offsets3 oc = offsets(st.cell[0], st.cell[1], st.cell[2], solid_);  // cell-centred fields
-    const double solid = sample(oc, solid_.a);
+    const Offsets3 oc = linear ? offsets(ls.x[0], ls.y_centre_extrapolated, ls.z[0], solid_)
+                               : offsets(st.cell[0], st.cell[1], st.cell[2], solid_);  // cell-centred fields
+    const double solid =
+        linear ? sample(offsets(ls.x[0], ls.y_alpha, ls.z[0], solid_), solid_.a) : sample(oc, solid_.a);
     const double alpha_f = 1.0 - solid;
     const double s0 = uf[0] - p.vx[i], s1 = uf[1] - p.vy[i], s2 = uf[2] - p.vz[i];
     const double slip = std::sqrt(s0 * s0 + s1 * s1 + s2 * s2);
@@ -196,6 +258,8 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
   }
   if (window_) lag = particles::ordered_sum(window_->comm(), lag);
   for (int c = 0; c < 3; ++c) totals_.lag_impulse_ns[c] = lag[c];
+  if (linear && window_) mismatch = particles::ordered_sum(window_->comm(), mismatch);
+  for (int c = 0; c < 3; ++c) totals_.sampling_mismatch_ns[c] = mismatch[c];
 }
 
 std::vector<double> Coupler::gather_whole(const GridField& f) const {
@@ -265,6 +329,7 @@ void Coupler::prepare(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
   const auto t0 = std::chrono::steady_clock::now();
   fields_.update(fs, dt_prev_s, s_.viscous, s_.added_mass, s_.saffman_lift);
   totals_.lag_impulse_ns = {0.0, 0.0, 0.0};
+  totals_.sampling_mismatch_ns = {0.0, 0.0, 0.0};
   visit_drag_law(s_.drag, [&](const auto& law) { prepare_impl(law, dem, dt_prev_s); });
   seconds_sample += seconds_since(t0);
 }
@@ -278,9 +343,10 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
   for (int c = 0; c < 3; ++c)
     for (GridField* f : {&K_[c], &KU_[c], &S_[c]}) std::fill(f->a.begin(), f->a.end(), 0.0);
   const bool forces = dt_s > 0.0;
-  const auto lag = totals_.lag_impulse_ns;
+  const auto lag = totals_.lag_impulse_ns, mismatch = totals_.sampling_mismatch_ns;
   totals_ = ExchangeTotals{};
   totals_.lag_impulse_ns = lag;
+  totals_.sampling_mismatch_ns = mismatch;
   std::vector<double> reaction(3, 0.0);
   for (std::size_t i = 0; i < p.n_local; ++i) {
     const Stencil st = stencil(p.x[i] - lo[0], p.y[i] - lo[1], p.z[i] - lo[2]);

@@ -12,6 +12,7 @@
 #include "core/scene_specs.hpp"
 #include "coupling/drag_laws.hpp"
 #include "coupling/kernels.hpp"
+#include "coupling/sampling.hpp"
 #include "particles/contact_models.hpp"
 #include "scenes/scene.hpp"
 
@@ -37,6 +38,11 @@ TEST(ModelRegistries, DragLawsResolveExactlyTheListedNames) {
 TEST(ModelRegistries, KernelsResolveExactlyTheListedNames) {
   for (const auto& name : kernel_names()) EXPECT_NO_THROW(coupling::kernel_from_name(name)) << name;
   EXPECT_THROW(coupling::kernel_from_name("gaussian"), InputError);
+}
+
+TEST(ModelRegistries, SamplingsResolveExactlyTheListedNames) {
+  for (const auto& name : sampling_names()) EXPECT_NO_THROW(coupling::sampling_from_name(name)) << name;
+  EXPECT_THROW(coupling::sampling_from_name("nearest"), InputError);
 }
 
 TEST(ModelRegistries, ContactAndRollingModelsResolveExactlyTheListedNames) {
