@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# A real replica study (replica_tiny_study.toml) through `boycott study run`; the curve's
+# between-replica error, mean, mean within-run error and r_acc error are recomputed here from the
+# database rows alone (results joined to the cases' stored parameters), grouping the replicas by
+# their angle and checking that they differ only in their seed, which is seed + k.
+set -euo pipefail
+bin=$1; study=$2
+work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
+"$bin" study run "$study" --db "$work/s.sqlite" --jobs 2 > "$work/out.txt"
+for f in json csv; do
+  "$bin" query curve --db "$work/s.sqlite" --study replica_tiny --format $f > "$work/curve.$f"
+done
+python3 - "$work" <<'PY'
+import csv, json, math, sqlite3, sys, pathlib
+work = pathlib.Path(sys.argv[1])
+db = sqlite3.connect(work / "s.sqlite")
+rows = db.execute(
+    "SELECT c.id, c.angle_deg, c.params_json, r.mean_settling_velocity_m_s, "
+    "r.settling_velocity_stderr_m_s FROM results r JOIN cases c ON c.id = r.case_id "
+    "JOIN study_cases sc ON sc.case_id = c.id WHERE sc.study = 'replica_tiny'").fetchall()
+assert len(rows) == 9, rows
+by_angle = {}
+for cid, angle, params, w, e in rows:
+    p = json.loads(params)
+    seed = p.pop("seed")
+    by_angle.setdefault(angle, []).append((seed, p, w, e, cid))
+stats = {}
+for angle, reps in by_angle.items():
+    reps.sort(key=lambda r: r[0])
+    assert [r[0] for r in reps] == [1, 2, 3], (angle, [r[0] for r in reps])
+    assert all(r[1] == reps[0][1] for r in reps), "replicas differ in more than their seed"
+    w = [r[2] for r in reps]
+    n = len(w)
+    m = sum(w) / n
+    sd = math.sqrt(sum((x - m) ** 2 for x in w) / (n - 1))
+    # Off the vertical, contacts with the wall and each other depend on the seed.
+    if angle != 90.0:
+        assert sd > 1e-3 * abs(m), ("replicas with different seeds gave the same result", angle, w)
+    stats[angle] = dict(mean=m, between=sd / math.sqrt(n), within=sum(r[3] for r in reps) / n,
+                        ids=sorted(r[4] for r in reps))
+curve = json.load(open(work / "curve.json"))
+assert len(curve) == 3, curve
+table = {float(r["angle_deg"]): r for r in csv.DictReader(open(work / "curve.csv"))}
+def close(a, b, rel=1e-12):
+    assert abs(a - b) <= rel * abs(b), (a, b)
+w90, e90 = stats[90.0]["mean"], stats[90.0]["between"]
+for row in curve:
+    s = stats[row["angle_deg"]]
+    assert row["n_replicas"] == 3, row
+    assert sorted(row["replica_case_ids"]) == s["ids"], row
+    close(row["mean_settling_velocity_m_s"], s["mean"])
+    close(row["between_replica_stderr_m_s"], s["between"])
+    close(row["stderr_m_s"], s["between"])
+    close(row["mean_within_run_stderr_m_s"], s["within"])
+    c = table[row["angle_deg"]]
+    assert int(c["n_replicas"]) == 3
+    close(float(c["between_replica_stderr_m_s"]), s["between"], 1e-8)
+    close(float(c["mean_within_run_stderr_m_s"]), s["within"], 1e-8)
+    r = s["mean"] / w90
+    close(row["r_acc"], r)
+    if row["angle_deg"] != 90.0:
+        close(row["r_acc_err"], abs(r) * math.hypot(s["between"] / s["mean"], e90 / w90), 1e-9)
+    print(f"angle {row['angle_deg']:g}: mean {s['mean']:.6g} m/s, between-replica error "
+          f"{s['between']:.3g}, mean within-run error {s['within']:.3g}")
+print("curve matches the database rows")
+PY
