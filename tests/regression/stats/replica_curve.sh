@@ -2,10 +2,18 @@
 # A real replica study (replica_tiny_study.toml) through `boycott study run`; the curve's
 # between-replica error, mean, mean within-run error and r_acc error are recomputed here from the
 # database rows alone (results joined to the cases' stored parameters), grouping the replicas by
-# their angle and checking that they differ only in their seed, which is seed + k.
+# their angle and checking that they differ only in their seed, which is seed + k. A study that
+# also sweeps the seed is refused first.
 set -euo pipefail
 bin=$1; study=$2
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
+# Replicas with a swept seed: refused (exit 2) with a message naming both, nothing written.
+{ cat "$study"; printf 'seed = [1, 2]\n'; } > "$work/seeds.toml"
+rc=0; "$bin" study run "$work/seeds.toml" --db "$work/seeds.sqlite" > "$work/seeds.txt" 2>&1 || rc=$?
+[ "$rc" = 2 ] || { echo "replicas with a swept seed: exit $rc, expected 2"; cat "$work/seeds.txt"; exit 1; }
+grep -q "replicas = 3 runs replica k with seed + k, and the study also varies 'seed'" "$work/seeds.txt" \
+  || { echo "no message naming replicas and the swept seed:"; cat "$work/seeds.txt"; exit 1; }
+[ ! -e "$work/seeds.sqlite" ] || { echo "a refused study wrote its database"; exit 1; }
 "$bin" study run "$study" --db "$work/s.sqlite" --jobs 2 > "$work/out.txt"
 for f in json csv; do
   "$bin" query curve --db "$work/s.sqlite" --study replica_tiny --format $f > "$work/curve.$f"
