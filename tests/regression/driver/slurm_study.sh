@@ -32,7 +32,13 @@ work=$(mktemp -d /tmp/boycott-slurm.XXXXXX)
 chmod 755 "$work"  # munged, running as munge, must reach its socket below
 pids=()
 cleanup() {
+  local rc=$?
   set +e
+  if [ "$rc" != 0 ] && [ "$rc" != 77 ]; then
+    echo "---- on failure: Slurm's logs and the tasks' output ($work) ----"
+    tail -n 20 "$work"/log/*.log "$work"/slurm.sqlite.slurm/*/slurm-*.out 2> /dev/null
+    tail -n 5 "$work"/slurm.sqlite.runs/*/solver.log 2> /dev/null
+  fi
   if [ -n "${SLURM_CONF:-}" ]; then scancel --quiet --full "--name=boycott-slurm_tiny" 2> /dev/null; fi
   for p in "${pids[@]}"; do kill "$p" 2> /dev/null; done
   [ -f "$work/munge/munged.pid" ] && kill "$(cat "$work/munge/munged.pid")" 2> /dev/null
@@ -128,7 +134,9 @@ for _ in $(seq 600); do
     [ -f "$ts" ] || continue
     t=$(tail -n 1 "$ts" | cut -d, -f1)
     if python3 -c "import sys; sys.exit(0 if 0.15 <= float('$t') <= 0.7 else 1)" 2> /dev/null; then
-      scancel -b -s USR1 "$job"
+      # The signal reaches the batch shell at once, but scancel may then report the requeueing job
+      # as "can not be altered now" and retry for ~15 s: the records below show whether it came.
+      timeout 3 scancel -b -s USR1 "$job" || echo "note: scancel exited $? after signalling job $job"
       signalled_job=$job
       signalled_case=$c
       echo "warned job $job (case $c) at t = $t s, $(($(date +%s) - t_submit)) s after submitting"
@@ -159,7 +167,13 @@ done
 echo "array $array done $(($(date +%s) - t_submit)) s after submitting"
 cat slurm.sqlite.slurm/*/slurm-*.out
 
+# status only reads: the tasks' finished folders are not results until collect records them.
 "$bin" study status study.toml --db "$work/slurm.sqlite" > status_before.txt
+grep -q '^4 finished run folders are not recorded yet' status_before.txt || {
+  cat status_before.txt
+  echo "FAIL: study status before collect does not name the 4 uncollected run folders" >&2
+  exit 1
+}
 "$bin" study collect study.toml --db "$work/slurm.sqlite" | tee collect1.txt
 sqlite3 slurm.sqlite "SELECT * FROM attempts ORDER BY id" > attempts1.txt
 "$bin" study collect study.toml --db "$work/slurm.sqlite" > collect2.txt
@@ -171,6 +185,13 @@ cmp attempts1.txt attempts2.txt || {
 }
 "$bin" study status study.toml --db "$work/slurm.sqlite" | tee status.txt
 grep -q ': 4 cases: 4 done' status.txt
+# Submitting again finds nothing pending and submits no job.
+"$bin" study submit study.toml --db "$work/slurm.sqlite" --scheduler slurm | tee submit2.txt
+grep -q 'nothing to submit' submit2.txt
+[ "$(ls -d slurm.sqlite.slurm/*/ | wc -l)" = 1 ] || {
+  echo "FAIL: a second submit of a finished study wrote a new submission" >&2
+  exit 1
+}
 
 python3 - "$work" "$signalled_case" "$signalled_job" "$array" << 'PY'
 import json, sqlite3, sys, pathlib
@@ -196,6 +217,9 @@ rows = s.execute("SELECT exit_status, slurm_job_id, slurm_restart, error_text, s
 print("attempts of the warned case:", rows)
 assert [r[0] for r in rows] == [75, 0] and [r[2] for r in rows] == [0, 1], rows
 assert all(r[1] == job for r in rows), rows
+records = sorted((work / "slurm.sqlite.runs" / case / "attempts").glob("*.json"))
+warned = [json.load(open(r))["warned"] for r in records]
+assert warned == [True, False], (records, warned)
 summary = json.load(open(work / "slurm.sqlite.runs" / case / "summary.json"))
 assert summary["status"] == "completed" and summary["resumed_from_checkpoint"], summary
 print("Slurm array == local study run, bit for bit; the warned task requeued and resumed")
