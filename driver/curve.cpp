@@ -61,10 +61,11 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
     s = "(no finished cases)\n";
   } else {
     // A missing error is "n/a", never a zero that reads as an exact value. With replicas the
-    // error of <<w_p>> is their scatter (between); "within" is the mean of the runs' own errors.
+    // error of <<w_p>> is their scatter (between, the error of their mean); "within" is the mean
+    // of the runs' own errors, one run's: honest run errors give between x sqrt(n) ~ within.
     auto mm = [](const std::optional<double>& v) { return v ? fmt::format("{:.4f}", *v * 1e3) : "n/a"; };
-    report::TextTable t({"group", "angle", "<<w_p>> (mm/s)", "n", "between (mm/s)", "within (mm/s)", "r_acc",
-                         "error method", "setting"},
+    report::TextTable t({"group", "angle", "<<w_p>> (mm/s)", "n", "between (mm/s)", "within, 1 run (mm/s)",
+                         "r_acc", "error method", "setting"},
                         {false, true, true, true, true, true, true, false, false});
     for (const auto& p : pts) {
       const std::string r = p.r_acc ? fmt::format("{:.3f} +- {}", *p.r_acc,
