@@ -243,11 +243,12 @@ t_ranks=$(date +%s)
 grep -qx '#SBATCH --ntasks=2' ranks.sqlite.slurm/*/job.sh
 grep -q '^launcher=(srun --mpi=pmix -n "$ranks")$' ranks.sqlite.slurm/*/job.sh
 array=$(sed -n 's/.*submitted job \([0-9]*\),.*/\1/p' submit_ranks.txt)
-"$bin" study run ranks.toml --db "$work/ranks_local.sqlite" --ranks 2 > ranks_local.txt 2>&1
 for _ in $(seq 600); do
   [ -z "$(squeue -h -j "$array" -o %i)" ] && break
   sleep 0.2
 done
+# Afterwards, not meanwhile: 4 ranks on 2 cores, each polling, would take minutes.
+"$bin" study run ranks.toml --db "$work/ranks_local.sqlite" --ranks 2 > ranks_local.txt 2>&1
 "$bin" study collect ranks.toml --db "$work/ranks.sqlite"
 q="SELECT case_id, mean_settling_velocity_m_s, settling_velocity_stderr_m_s FROM results"
 a=$(sqlite3 ranks.sqlite "$q")
