@@ -5,7 +5,9 @@
 # (`scancel -b -s USR1`), checkpoints, requeues itself and resumes. `study collect` then gives the
 # database a local `study run` of the same study gives: every case done, the same <<w_p>> bit for
 # bit, no duplicate rows; the signalled case has its two attempts (exit 75 on restart 0, exit 0 on
-# restart 1 of the same job), and collecting again changes nothing.
+# restart 1 of the same job), and collecting again changes nothing. Then one 2-rank case through
+# srun --mpi=pmix equals `study run --ranks 2` bit for bit, and, with the fake solver, a case that
+# fails once is retried in its task and one that keeps failing ends failed with its reason.
 # Without a usable Slurm (packages missing, not root, daemons not starting) it skips (exit 77),
 # unless BOYCOTT_REQUIRE_SLURM=1 (.ci/run sets it): then it fails with the reason.
 set -euo pipefail
@@ -259,4 +261,37 @@ echo "2 ranks, srun: $a; study run --ranks 2: $b ($(($(date +%s) - t_ranks)) s)"
   exit 1
 }
 grep -q '"mpi_ranks": 2,' ranks.sqlite.runs/*/summary.json
+
+# ---- failures inside a task, with the fake solver: seed 13 fails once and is retried in its task,
+# seed 14 fails on its try and its one retry and ends failed with its reason; not submitted again ----
+cat > fail.toml << 'EOF2'
+name = "slurm_fail"
+[base.particles]
+count = 1000
+[base.time]
+end = 0.3
+average_from = 0.1
+[matrix]
+seed = [1, 13, 14]
+EOF2
+fake=(--solver-command "python3 $(cd "$(dirname "$0")" && pwd)/fake_solver.py")
+FAKE_FAIL_SEED13=1 "$bin" study submit fail.toml --db "$work/fail.sqlite" --scheduler slurm --retries 1 "${fake[@]}" |
+  tee submit_fail.txt
+array=$(sed -n 's/.*submitted job \([0-9]*\),.*/\1/p' submit_fail.txt)
+for _ in $(seq 300); do
+  [ -z "$(squeue -h -j "$array" -o %i)" ] && break
+  sleep 0.2
+done
+"$bin" study collect fail.toml --db "$work/fail.sqlite" --retries 1
+"$bin" study status fail.toml --db "$work/fail.sqlite" --retries 1 | tee status_fail.txt
+n() { sqlite3 fail.sqlite "$1"; }
+[ "$(n 'SELECT COUNT(*) FROM results')" = 2 ] && [ "$(n 'SELECT COUNT(*) FROM attempts')" = 5 ] &&
+  [ "$(n 'SELECT COUNT(*) FROM attempts WHERE exit_status = 3')" = 3 ] &&
+  [ "$(n "SELECT COUNT(*) FROM attempts WHERE error_text = 'error: the run became unphysical: NaN in the pressure'")" = 1 ] &&
+  grep -q '3 cases: 2 done, 0 running, 1 failed' status_fail.txt && grep -q 'alpha_f = -0.2' status_fail.txt || {
+  n 'SELECT case_id, exit_status, slurm_job_id, attempt_file, error_text FROM attempts'
+  echo "FAIL: the failing cases under Slurm were not retried and recorded as study run records them" >&2
+  exit 1
+}
+"$bin" study submit fail.toml --db "$work/fail.sqlite" --scheduler slurm --retries 1 "${fake[@]}" | grep -q 'nothing to submit'
 echo "total $(($(date +%s) - t0)) s"
