@@ -1,14 +1,19 @@
 #include "driver/case_commands.hpp"
 
 #include <mpi.h>
+#include <unistd.h>
 
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "core/case_params.hpp"
 #include "core/error.hpp"
+#include "driver/case_progress.hpp"
 #include "fluid/petsc_session.hpp"
 #include "scenes/preflight.hpp"
 #include "scenes/scene.hpp"
@@ -36,6 +41,26 @@ CaseParams load(const std::string& file, const std::vector<std::string>& sets) {
   validate(p);
   return p;
 }
+/// One line at the end of a run: its status, how far, how long, and its main result.
+void print_outcome(const std::filesystem::path& dir) {
+  try {
+    std::ifstream in(dir / "summary.json");
+    if (!in) return;
+    const auto j = nlohmann::json::parse(in);
+    std::string result;
+    if (j.contains("mean_settling_velocity_m_s") && j["mean_settling_velocity_m_s"].is_number()) {
+      const auto& e = j.value("settling_velocity_stderr_m_s", nlohmann::json());
+      result = fmt::format(", <<w_p>> = {:.5g} m/s +- {}", j["mean_settling_velocity_m_s"].get<double>(),
+                           e.is_number() ? fmt::format("{:.2g}", e.get<double>()) : std::string("n/a"));
+    }
+    std::fprintf(stderr, "%s at t = %.6g s after %.1f s of wall time%s (%s)\n",
+                 j.value("status", "?").c_str(), j.value("simulated_time_s", 0.0),
+                 j.value("wall_time_s", 0.0), result.c_str(), (dir / "summary.json").c_str());
+  } catch (const std::exception&) {
+    // The summary is the record; a line about it is not worth failing the run.
+  }
+}
+
 }  // namespace
 
 int case_run(const CaseRunOptions& opt, int argc, char** argv) {
@@ -52,8 +77,25 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv) {
   ctx.quiet = opt.quiet;
   ctx.branch_from = opt.from_dir;
   if (opt.at_s >= 0.0) ctx.branch_at_s = opt.at_s;
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  CaseProgress progress(p.time.end_s, isatty(STDERR_FILENO) != 0, opt.progress_every_s);
+  if (rank == 0 && !opt.quiet) {
+    ctx.progress = [&](double t) { progress.at(t); };
+    ctx.progress_note = [&](const std::string& s) { progress.note(s); };
+  }
   try {
-    return scenes::run_case(p, ctx);
+    const int rc = scenes::run_case(p, ctx);
+    if (rank == 0 && !opt.quiet) {
+      progress.finish();
+      print_outcome(ctx.out_dir);
+    }
+    // A PETSc option nothing read is most often misspelt: say so rather than ignore it.
+    if (rank == 0)
+      for (const auto& o : fluid::PetscSession::unused_options())
+        std::fprintf(stderr, "warning: the PETSc option %s was given after -- but nothing used it\n",
+                     o.c_str());
+    return rc;
   } catch (const StorageError& e) {
     // Only the rank that writes (0) meets a failed write; on several ranks the others wait in
     // the run's next collective, and finalizing would wait for them forever: say why and end

@@ -10,8 +10,9 @@ struct CaseRunOptions {
   std::vector<std::string> overrides;
   std::vector<std::string> petsc_options;
   bool quiet = false;
-  std::string from_dir;  ///< branch from this run folder's checkpoint (empty: none)
-  double at_s = -1.0;    ///< ... the newest at or before this time, s (< 0: the newest)
+  double progress_every_s = 30.0;  ///< between plain progress lines (stderr not a terminal)
+  std::string from_dir;            ///< branch from this run folder's checkpoint (empty: none)
+  double at_s = -1.0;              ///< ... the newest at or before this time, s (< 0: the newest)
 };
 
 /// `boycott case run`: exit code as in design brief section 7.

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -60,6 +61,35 @@ boycott::driver::Database open_for_query(const std::string& path) {
   return boycott::driver::Database(path, boycott::driver::OpenMode::kReadOnly);
 }
 
+/// A command line the program did not understand: CLI11's message, naming the word, and exit 2
+/// (--help and --version exit 0).
+int usage_error(CLI::App& app, const CLI::ParseError& e, int argc, char** argv) {
+  if (e.get_exit_code() == 0) return app.exit(e);
+  // "A subcommand is required" after a word that is no command: name the word and the choices.
+  const CLI::App* level = &app;
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word.empty() || word[0] == '-') break;
+    const CLI::App* next = nullptr;
+    for (const auto* sub : level->get_subcommands({}))
+      if (sub->get_name() == word) next = sub;
+    if (next == nullptr) {
+      if (level->get_subcommands({}).empty()) break;
+      std::string names;
+      for (const auto* sub : level->get_subcommands({}))
+        names += (names.empty() ? "" : ", ") + sub->get_name();
+      std::fprintf(
+          stderr,
+          "error: unknown command '%s' (expected one of: %s)\nRun with --help for more information.\n",
+          word.c_str(), names.c_str());
+      return boycott::kExitInputError;
+    }
+    level = next;
+  }
+  std::fprintf(stderr, "error: %s\nRun with --help for more information.\n", e.what());
+  return boycott::kExitInputError;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -77,12 +107,15 @@ int main(int argc, char** argv) {
   run->add_option("--out", run_opt.out_dir, "run folder (params, checkpoints, outputs)")->required();
   run->add_option("--set", run_opt.overrides, "override a key: section.key=value")->take_all();
   run->add_flag("--quiet", run_opt.quiet, "no progress output");
+  run->add_option("--progress-every", run_opt.progress_every_s,
+                  "seconds between progress lines when stderr is not a terminal")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   run->add_option("--from", run_opt.from_dir,
                   "branch: start from this run folder's newest kept checkpoint (with this case's parameters)")
       ->check(CLI::ExistingDirectory);
   run->add_option("--at", run_opt.at_s, "with --from: the newest checkpoint at or before this time, s")
       ->check(CLI::NonNegativeNumber);
-  run->allow_extras();
 
   std::string check_file;
   std::vector<std::string> check_sets;
@@ -106,6 +139,12 @@ int main(int argc, char** argv) {
   srun->add_option("--retries", sopt.retries, "failed attempts retried per case")->capture_default_str();
   srun->add_option("--ranks", sopt.ranks, "MPI ranks per case (mpirun -n K)")->capture_default_str();
   // For tests and for other solver builds: the command that runs one case.
+  bool study_quiet = false;
+  srun->add_option("--progress-every", sopt.progress_every_s,
+                   "seconds between progress lines when stderr is not a terminal")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  srun->add_flag("--quiet", study_quiet, "no progress output");
   srun->add_option("--solver-command", sopt.solver_command, "")->group("");
   std::string status_file, status_db;
   int status_retries = 2;
@@ -175,10 +214,28 @@ int main(int argc, char** argv) {
   qcases->add_option("--db", q_db, "results database")->required();
   qcases->add_option("--study", q_study, "only this study");
 
-  CLI11_PARSE(app, argc, argv);
+  // Everything after the first `--` is for PETSc; before it, a word the program does not know is
+  // a usage error (exit 2), never handed on.
+  int cli_argc = argc;
+  for (int i = 1; i < argc; ++i)
+    if (std::string_view(argv[i]) == "--") {
+      cli_argc = i;
+      break;
+    }
+  try {
+    app.parse(cli_argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return usage_error(app, e, cli_argc, argv);
+  }
+  for (int i = cli_argc + 1; i < argc; ++i) run_opt.petsc_options.emplace_back(argv[i]);
+  if (!run->parsed() && cli_argc < argc) {
+    std::fprintf(stderr, "error: options after -- are PETSc's and only `case run` takes them\n");
+    return boycott::kExitInputError;
+  }
 
   if (srun->parsed()) {
-    sopt.progress = isatty(STDOUT_FILENO);
+    sopt.progress_live = !study_quiet && isatty(STDERR_FILENO);
+    if (study_quiet) sopt.progress_every_s = 0;
     return run_guarded([&] {
       require_db_path(sopt.db_path);
       return boycott::driver::study_run(sopt);
@@ -253,7 +310,6 @@ int main(int argc, char** argv) {
     });
 
   if (run->parsed()) {
-    run_opt.petsc_options = run->remaining();
     return run_guarded([&] { return boycott::driver::case_run(run_opt, argc, argv); });
   }
   if (check->parsed())

@@ -43,24 +43,29 @@ double simulated_time_s(const fs::path& run_dir) {
   return stop == line.c_str() ? 0.0 : t;
 }
 
-ProgressDisplay::ProgressDisplay(std::string study, int jobs, bool enabled)
+ProgressDisplay::ProgressDisplay(std::string study, int jobs, bool live, double plain_every_s)
     : study_(std::move(study)),
       jobs_(jobs),
-      enabled_(enabled),
-      last_draw_(Clock::now() - std::chrono::seconds(1)) {}
+      live_(live),
+      plain_every_s_(plain_every_s),
+      last_draw_(Clock::now()) {}
 
 void ProgressDisplay::redraw_if_due(const ProgressCounts& counts, const std::vector<RunningCase>& running) {
-  if (Clock::now() - last_draw_ > std::chrono::milliseconds(500)) {
+  const auto every =
+      live_ ? std::chrono::duration<double>(0.5) : std::chrono::duration<double>(plain_every_s_);
+  if ((live_ || plain_every_s_ > 0) && Clock::now() - last_draw_ >= every) {
     draw(counts, running);
     last_draw_ = Clock::now();
   }
 }
 
 void ProgressDisplay::draw(const ProgressCounts& counts, const std::vector<RunningCase>& running) {
-  if (!enabled_) return;
+  if (!live_ && plain_every_s_ <= 0) return;
   std::string s;
-  if (printed_lines_ > 0) s += fmt::format("\033[{}A", printed_lines_);
-  s += "\033[J";
+  if (live_) {
+    if (printed_lines_ > 0) s += fmt::format("\033[{}A", printed_lines_);
+    s += "\033[J";
+  }
   double remaining_s = 0, estimated_case_s = 0;
   int estimated = 0, unknown = 0;  // unknown: running cases without a sim_s_per_s yet
   std::string rows;
@@ -91,8 +96,8 @@ void ProgressDisplay::draw(const ProgressCounts& counts, const std::vector<Runni
                    counts.stopping ? " (stopping)" : "");
   s += rows;
   printed_lines_ = 1 + static_cast<int>(running.size());
-  std::fputs(s.c_str(), stdout);
-  std::fflush(stdout);
+  std::fputs(s.c_str(), stderr);
+  std::fflush(stderr);
 }
 
 }  // namespace boycott::driver

@@ -1,6 +1,7 @@
 #pragma once
-// The live display of `study run` (only when stdout is a terminal): a line of counts with an ETA,
-// then one line per running case with its simulated time and rate, redrawn in place.
+// The progress of `study run` on stderr: a line of counts with an ETA, then one line per running
+// case with its simulated time and rate; redrawn in place on a terminal, otherwise printed as
+// plain lines every `--progress-every` seconds (a Slurm log, `nohup`, `| tee`).
 #include <chrono>
 #include <cstddef>
 #include <filesystem>
@@ -25,21 +26,23 @@ struct ProgressCounts {
 
 class ProgressDisplay {
  public:
-  /// enabled false: draw() prints nothing.
-  ProgressDisplay(std::string study, int jobs, bool enabled);
+  /// live: redrawn in place (a terminal); else plain lines every plain_every_s seconds (<= 0:
+  /// nothing).
+  ProgressDisplay(std::string study, int jobs, bool live, double plain_every_s);
 
   /// A case finished in this run after `wall_s` seconds: the ETA's time per case from now on.
   void add_finished_case(double wall_s) { finished_wall_s_.push_back(wall_s); }
 
   /// Replaces the lines drawn last.
   void draw(const ProgressCounts& counts, const std::vector<RunningCase>& running);
-  /// draw(), at most twice a second.
+  /// draw(), at most twice a second live, else every plain_every_s.
   void redraw_if_due(const ProgressCounts& counts, const std::vector<RunningCase>& running);
 
  private:
   std::string study_;
   int jobs_;
-  bool enabled_;
+  bool live_;
+  double plain_every_s_;
   std::vector<double> finished_wall_s_;
   int printed_lines_ = 0;
   std::chrono::steady_clock::time_point last_draw_;

@@ -111,15 +111,18 @@ int study_run(const StudyRunOptions& opt) {
 
 int study_status(const std::string& study_file, const std::string& db_path, int retries) {
   const Study study = expand_study_file(study_file);
-  Database db(db_path, OpenMode::kReadOnly);
+  // No database yet: every case is pending, and status (which only reads) creates none.
+  std::optional<Database> db;
+  if (fs::exists(db_path)) db.emplace(db_path, OpenMode::kReadOnly);
   std::map<std::string, CaseState> known;
-  for (auto& s : case_states(db, study.name, retries)) known[s.id] = s;
+  if (db)
+    for (auto& s : case_states(*db, study.name, retries)) known[s.id] = s;
   // Cases submitted to Slurm (study submit): their array task and, where squeue answers, its state.
   std::map<std::string, std::string> jobs;
   std::optional<std::vector<SlurmJob>> queue;
   std::string queue_why;
   const auto open_slurm =
-      has_slurm_columns(db) ? slurm_attempts(db, study.name, true) : std::vector<SlurmAttempt>{};
+      db && has_slurm_columns(*db) ? slurm_attempts(*db, study.name, true) : std::vector<SlurmAttempt>{};
   if (!open_slurm.empty()) queue = squeue_jobs(&queue_why);
   for (const auto& a : open_slurm) {
     const SlurmJob* job = queue ? find_slurm_job(*queue, a.array_job_id, a.array_task_id, a.job_id) : nullptr;

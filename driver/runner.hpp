@@ -18,7 +18,8 @@ struct StudyRunOptions {
   int ranks = 1;    ///< > 1: each case under `mpirun -n ranks`
   /// The solver command line (split at spaces); empty: $BOYCOTT_SOLVER_COMMAND, else this program.
   std::string solver_command;
-  bool progress = false;  ///< live display (on when stdout is a terminal)
+  bool progress_live = false;      ///< redrawn in place (stderr is a terminal)
+  double progress_every_s = 30.0;  ///< otherwise a plain block this often (<= 0: none)
 };
 
 /// Exit code: 0 all cases done, 75 stopped by a signal, 1 some case failed for good, 74 stopped

@@ -53,7 +53,7 @@ Scheduler::Scheduler(Database& db, const Study& study, const std::vector<CaseSta
       opt_(opt),
       runs_root_(std::move(runs_root)),
       solver_(std::move(solver)),
-      progress_(study.name, opt.jobs, opt.progress) {
+      progress_(study.name, opt.jobs, opt.progress_live, opt.progress_every_s) {
   std::map<std::string, const StudyCase*> by_id;
   for (const auto& c : study.cases) by_id[c.id] = &c;
   for (const auto& s : states) {

@@ -26,4 +26,17 @@ bool PetscSession::active() {
   return g_active;
 }
 
+std::vector<std::string> PetscSession::unused_options() {
+  std::vector<std::string> out;
+  PetscInt n = 0;
+  char** names = nullptr;
+  char** values = nullptr;
+  if (!g_active || PetscOptionsLeftGet(nullptr, &n, &names, &values) != 0) return out;
+  // -no_signal_handler is the program's own, inserted after PETSc read its start-up options.
+  for (PetscInt i = 0; i < n; ++i)
+    if (std::string(names[i]) != "no_signal_handler") out.push_back(std::string("-") + names[i]);
+  PetscOptionsLeftRestore(nullptr, &n, &names, &values);
+  return out;
+}
+
 }  // namespace boycott::fluid

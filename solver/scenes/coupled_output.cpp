@@ -93,6 +93,7 @@ CoupledSceneOutput::CoupledSceneOutput(const coupling::CoupledSystem& run, const
     : run_(run),
       ctx_(ctx),
       timers_(timers),
+      first_quantity_(columns.size() > 1 ? columns[1] : ""),
       csv_(ctx.out_dir / "timeseries.csv", std::move(columns), resumed),
       next_out_s_(next_out_s),
       checkpoints_(run.params().time.checkpoint_every_s, run.time_s()),

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "core/case_params.hpp"
 #include "core/timers.hpp"
 #include "coupling/coupled_system.hpp"
@@ -41,9 +43,7 @@ class CoupledSceneOutput {
     // run continued to a later end keeps the rows a run straight to that end writes.
     const bool scheduled = t >= next_out_s_ - 1e-12;
     if (scheduled || t >= end - 1e-12) {
-      csv_.row(row());
-      if (scheduled) next_out_s_ = t + out_every_s_;
-      if (ctx_.progress) ctx_.progress(t);
+      report_row(row(), scheduled);
     }
     write_pictures(t);
     return checkpoint_or_stop(ctx_.should_stop(), ctx_.quiet, checkpoints_, t, end, csv_, write_checkpoint,
@@ -55,10 +55,7 @@ class CoupledSceneOutput {
   template <class Row, class WriteCheckpoint>
   void end_early(Row&& row, WriteCheckpoint&& write_checkpoint) {
     const double t = run_.time_s();
-    const bool scheduled = t >= next_out_s_ - 1e-12;
-    csv_.row(row());
-    if (scheduled) next_out_s_ = t + out_every_s_;
-    if (ctx_.progress) ctx_.progress(t);
+    report_row(row(), t >= next_out_s_ - 1e-12);
     write_pictures(t);
     csv_.flush();
     write_checkpoint();
@@ -68,11 +65,24 @@ class CoupledSceneOutput {
   void flush() { csv_.flush(); }
 
  private:
+  /// Writes a time-series row; a scheduled one moves the schedule. The progress callbacks get the
+  /// time and the row's first quantity after time.
+  template <class Values>
+  void report_row(const Values& values, bool scheduled) {
+    const double t = run_.time_s();
+    csv_.row(values);
+    if (scheduled) next_out_s_ = t + out_every_s_;
+    if (ctx_.progress_note && !first_quantity_.empty() && values.size() > 1)
+      ctx_.progress_note(first_quantity_ + " " + fmt::format("{:.5g}", static_cast<double>(values[1])));
+    if (ctx_.progress) ctx_.progress(t);
+  }
+
   void write_pictures(double t);
 
   const coupling::CoupledSystem& run_;
   const RunContext& ctx_;
   ModelTimers& timers_;
+  std::string first_quantity_;  ///< the column after time_s, for the progress line
   CsvWriter csv_;
   double out_every_s_ = 0.0, next_out_s_ = 0.0;
   CheckpointClock checkpoints_;

@@ -1,6 +1,7 @@
 #include "scenes/run_common.hpp"
 
 #include <mpi.h>
+#include <petscversion.h>
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -13,6 +14,7 @@
 
 #include <fmt/format.h>
 
+#include "core/build_info.hpp"
 #include "core/error.hpp"
 #include "core/version.hpp"
 #include "io/atomic_file.hpp"
@@ -47,7 +49,28 @@ namespace {
 nlohmann::json num_or_null(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
+/// The machine's CPU model ("model name" of /proc/cpuinfo; "unknown" elsewhere).
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(line.find_first_not_of(" \t", colon + 1));
+    }
+  return "unknown";
+}
+
 }  // namespace
+
+nlohmann::json build_info() {
+  return {{"compiler", kCompiler},
+          {"build_type", kBuildType},
+          {"flags", kCxxFlags},
+          {"petsc_version",
+           fmt::format("{}.{}.{}", PETSC_VERSION_MAJOR, PETSC_VERSION_MINOR, PETSC_VERSION_SUBMINOR)},
+          {"cpu_model", cpu_model()}};
+}
 
 nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const ModelTimers& timers) {
   nlohmann::json j;
@@ -61,6 +84,7 @@ nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const Mod
   j["settling_velocity_stderr_m_s"] = num_or_null(s.settling_velocity_stderr_m_s);
   j["models"] = timers.to_json();
   j["program_version"] = fmt::format("{}+{}", kVersion, kGitRevision);
+  j["build"] = build_info();
   int ranks = 1, initialized = 0;
   MPI_Initialized(&initialized);
   if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);

@@ -27,6 +27,9 @@ bool output_rank();
 /// StorageError naming the file and the cause; `path` is left as it was.
 void write_file_atomic(const std::filesystem::path& path, const std::string& text);
 
+/// Compiler, flags, PETSc version and CPU model of this run (summary.json "build").
+nlohmann::json build_info();
+
 /// Common summary keys. Scene-specific keys are added to the returned object by the scene.
 struct SummaryBase {
   std::string status{kStatusCompleted};  ///< core/run_status.hpp

@@ -21,6 +21,9 @@ struct RunContext {
   bool quiet = false;
   /// Progress callback (simulated time s), for the driver's display; may be empty.
   std::function<void(double)> progress;
+  /// A short note for the progress line before each progress call (a scene's main quantity so
+  /// far, e.g. "mean_wp_m_s -0.0816"); may be empty.
+  std::function<void(const std::string&)> progress_note;
   /// Branch (`case run --from DIR --at TIME`): start from DIR's newest kept checkpoint at or
   /// before TIME (s; unset: the newest), with this case's parameters and fresh statistics.
   std::filesystem::path branch_from;

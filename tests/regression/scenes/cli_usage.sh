@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# The command line as a user meets it: every usage error exits 2 and names the word it did not
+# understand (an unknown option before `--` included: it is not handed on to PETSc); PETSc options
+# after `--` that nothing used are reported; a run without a terminal prints a progress line every
+# --progress-every seconds and a last line with its outcome; summary.json records the build.
+#   cli_usage.sh BOYCOTT_BIN CASE.toml
+set -uo pipefail
+bin=$1; case_file=$2
+work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+expect_usage() {  # expect_usage WORD ARGS...: exit 2, the word named on stderr, no run folder
+  local word=$1; shift
+  "$bin" "$@" > "$work/out.txt" 2> "$work/err.txt"; local rc=$?
+  [ "$rc" -eq 2 ] || fail "'$*' exited $rc, not 2: $(cat "$work/err.txt")"
+  grep -qF -- "$word" "$work/err.txt" || fail "'$*' does not name '$word': $(cat "$work/err.txt")"
+  [ ! -e "$work/never" ] || fail "'$*' wrote a run folder"
+}
+expect_usage frobnicate frobnicate
+expect_usage frob case frob
+expect_usage --bogus case run "$case_file" --out "$work/never" --bogus
+expect_usage --sideways case run "$case_file" --out "$work/never" --at 0.1 --sideways
+expect_usage nofile.toml case run "$work/nofile.toml" --out "$work/never"
+expect_usage xml query curve --db "$work/none.db" --study s --format xml
+expect_usage "only \`case run\`" study status s.toml --db "$work/none.db" -- -ksp_view
+"$bin" --help > /dev/null || fail "--help did not exit 0"
+# status only reads: on a database that does not exist it lists the cases as pending, creates none.
+demo=$(dirname "$case_file")/../demo.toml
+"$bin" study status "$demo" --db "$work/new.db" > "$work/out.txt" 2>&1 || fail "status on no database: $(cat "$work/out.txt")"
+grep -q ' 4 pending' "$work/out.txt" || fail "status does not list the pending cases: $(cat "$work/out.txt")"
+[ ! -e "$work/new.db" ] || fail "status created a database"
+
+# Not a terminal (stderr is a file): plain progress lines, the outcome, the unused PETSc option.
+"$bin" case run "$case_file" --out "$work/run" --set time.end=0.15 --set time.average_from=0.05 \
+  --progress-every 0.5 -- -pressure_ksp_typ cg > /dev/null 2> "$work/err.txt" || fail "the run failed: $(cat "$work/err.txt")"
+n=$(grep -c '^progress: t = .* wall s per simulated s, ETA .*mean_wp_m_s' "$work/err.txt")
+[ "$n" -ge 2 ] || fail "expected progress lines, got: $(cat "$work/err.txt")"
+grep -q '^completed at t = 0.15 s after .* <<w_p>> = ' "$work/err.txt" || fail "no outcome line: $(cat "$work/err.txt")"
+grep -q 'PETSc option -pressure_ksp_typ .* nothing used it' "$work/err.txt" || fail "unused PETSc option not reported"
+grep -q 'no_signal_handler' "$work/err.txt" && fail "the program's own PETSc option reported as unused"
+"$bin" case run "$case_file" --out "$work/quiet" --set time.end=0.05 --set time.average_from=0.02 --quiet \
+  --progress-every 0.1 > /dev/null 2> "$work/err.txt" || fail "the quiet run failed"
+grep -q '^progress:' "$work/err.txt" && fail "--quiet printed progress"
+python3 - "$work/run/summary.json" <<'PY' || exit 1
+import json, sys
+b = json.load(open(sys.argv[1]))["build"]
+for k in ("compiler", "flags", "petsc_version", "cpu_model", "build_type"):
+    assert isinstance(b.get(k), str) and b[k], (k, b)
+assert b["petsc_version"].count(".") == 2 and "-ffp-contract=off" in b["flags"], b
+PY
+echo "[ report ] usage errors exit 2 naming the word; $n progress lines in 0.15 s of simulated time"
