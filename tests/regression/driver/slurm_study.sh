@@ -125,6 +125,13 @@ grep -qx '#SBATCH --array=0-3%2' dry.sh
 grep -qx '#SBATCH --signal=B:USR1@120' dry.sh
 grep -qx '#SBATCH --comment=boycott-test' dry.sh
 bash -n dry.sh
+# Another scheduler is refused as bad usage (exit 2), naming it.
+rc=0
+"$bin" study submit study.toml --db "$work/slurm.sqlite" --scheduler pbs --dry-run > /dev/null 2> pbs.err || rc=$?
+[ "$rc" = 2 ] && grep -q -- '--scheduler pbs' pbs.err || {
+  echo "FAIL: --scheduler pbs gave exit $rc and: $(cat pbs.err)" >&2
+  exit 1
+}
 [ ! -e slurm.sqlite ] && [ ! -e slurm.sqlite.slurm ] || {
   echo "FAIL: --dry-run wrote files" >&2
   exit 1
@@ -238,14 +245,14 @@ print("Slurm array == local study run, bit for bit; the warned task requeued and
 PY
 
 # ---- 2 ranks per case through srun --mpi=pmix (the default launcher): the same as study run --ranks 2 ----
-sed 's/^name = .*/name = "slurm_tiny_ranks"/; s/angle_deg" = .*/angle_deg" = [60]/; s/^end = .*/end = 0.2/;
-     s/^average_from = .*/average_from = 0.1/' study.toml > ranks.toml
+sed 's/^name = .*/name = "slurm_tiny_ranks"/; s/angle_deg" = .*/angle_deg" = [60]/; s/^end = .*/end = 0.1/;
+     s/^average_from = .*/average_from = 0.05/' study.toml > ranks.toml
 t_ranks=$(date +%s)
 "$bin" study submit ranks.toml --db "$work/ranks.sqlite" --scheduler slurm --ranks 2 | tee submit_ranks.txt
 grep -qx '#SBATCH --ntasks=2' ranks.sqlite.slurm/*/job.sh
 grep -q '^launcher=(srun --mpi=pmix -n "$ranks")$' ranks.sqlite.slurm/*/job.sh
 array=$(sed -n 's/.*submitted job \([0-9]*\),.*/\1/p' submit_ranks.txt)
-for _ in $(seq 600); do
+for _ in $(seq 750); do  # 3 s alone on 2 cores; 2 polling ranks slow down badly beside other work
   [ -z "$(squeue -h -j "$array" -o %i)" ] && break
   sleep 0.2
 done
