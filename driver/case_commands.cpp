@@ -13,6 +13,7 @@
 
 #include "core/case_params.hpp"
 #include "core/error.hpp"
+#include "core/key_docs.hpp"
 #include "driver/case_progress.hpp"
 #include "fluid/petsc_session.hpp"
 #include "scenes/preflight.hpp"
@@ -128,7 +129,9 @@ int case_check(const std::string& file, const std::vector<std::string>& sets) {
   return 0;
 }
 
-int case_keys(const std::string& scene) {
+int case_keys(const std::string& scene, const std::string& format) {
+  if (format != "table" && format != "json")
+    throw InputError(fmt::format("--format '{}': expected table or json", format));
   // A scene's keys at its own defaults (resolved for Table III's box), or every key.
   CaseParams p;
   if (!scene.empty()) {
@@ -136,13 +139,24 @@ int case_keys(const std::string& scene) {
     validate(p);
   }
   const auto j = to_json_all_keys(p);
-  if (!scene.empty()) std::printf("scene %s: %s\n", scene.c_str(), scene_spec(scene).measures.c_str());
+  nlohmann::json out = nlohmann::json::array();
+  std::string table;
   for (const auto& k : scene.empty() ? case_key_names() : case_key_names(scene)) {
     std::string ptr = "/" + k;
     for (auto& c : ptr)
       if (c == '.') c = '/';
-    std::printf("%-40s %s\n", k.c_str(), j.at(nlohmann::json::json_pointer(ptr)).dump().c_str());
+    const auto& value = j.at(nlohmann::json::json_pointer(ptr));
+    const auto doc = key_doc(k);
+    const std::string unit(doc ? doc->unit : ""), meaning(doc ? doc->meaning : "");
+    out.push_back({{"key", k}, {"default", value}, {"unit", unit}, {"meaning", meaning}});
+    table += fmt::format("{:<38} {:<22} {:<7} {}\n", k, value.dump(), unit, meaning);
   }
+  if (format == "json") {
+    std::printf("%s\n", out.dump(1).c_str());
+    return 0;
+  }
+  if (!scene.empty()) std::printf("scene %s: %s\n", scene.c_str(), scene_spec(scene).measures.c_str());
+  std::printf("%-38s %-22s %-7s %s\n%s", "key", "default", "unit", "meaning", table.c_str());
   return 0;
 }
 

@@ -21,6 +21,6 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv);
 int case_check(const std::string& file, const std::vector<std::string>& sets);
 /// `boycott case keys`: every key with its default.
 /// The case keys with their defaults: every key, or those `scene` reads at its defaults.
-int case_keys(const std::string& scene);
+int case_keys(const std::string& scene, const std::string& format = "table");
 
 }  // namespace boycott::driver

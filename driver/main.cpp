@@ -126,6 +126,8 @@ int main(int argc, char** argv) {
   std::string keys_scene;
   auto* keys = case_cmd->add_subcommand("keys", "list every case key and its default (or a scene's)");
   keys->add_option("--scene", keys_scene, "only the keys this scene reads, at its defaults");
+  std::string keys_format = "table";
+  keys->add_option("--format", keys_format, "table or json")->capture_default_str();
 
   // ---- study ----
   auto* study_cmd = app.add_subcommand("study", "run a study (a matrix of cases) into a database");
@@ -314,6 +316,6 @@ int main(int argc, char** argv) {
   }
   if (check->parsed())
     return run_guarded([&] { return boycott::driver::case_check(check_file, check_sets); });
-  if (keys->parsed()) return run_guarded([&] { return boycott::driver::case_keys(keys_scene); });
+  if (keys->parsed()) return run_guarded([&] { return boycott::driver::case_keys(keys_scene, keys_format); });
   return 0;
 }

@@ -11,6 +11,7 @@
 #include <toml++/toml.h>
 
 #include "core/error.hpp"
+#include "core/key_docs.hpp"
 #include "core/scene_specs.hpp"
 
 namespace boycott::driver {
@@ -50,7 +51,8 @@ void check_known_key(const std::string& key, const std::string& where) {
   static const auto names = case_key_names();
   for (const auto& n : names)
     if (n == key) return;
-  throw InputError(fmt::format("{}: unknown key '{}' (see `boycott case keys`)", where, key));
+  throw InputError(
+      fmt::format("{}: unknown key '{}'{} (see `boycott case keys`)", where, key, did_you_mean(key)));
 }
 
 /// One axis of the expansion: the keys it sets, and for each point their TOML values.

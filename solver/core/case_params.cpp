@@ -14,6 +14,7 @@
 #include "core/constants.hpp"
 #include "core/error.hpp"
 #include "core/hash.hpp"
+#include "core/key_docs.hpp"
 #include "core/model_names.hpp"
 
 namespace boycott {
@@ -320,7 +321,8 @@ CaseParams from_toml_table(const toml::table& tbl) {
   std::vector<std::string> present;
   collect_toml_keys(tbl, "", present);
   for (const auto& k : present) {
-    if (!known.count(k)) throw InputError(fmt::format("unknown key '{}' (see `boycott case keys`)", k));
+    if (!known.count(k))
+      throw InputError(fmt::format("unknown key '{}'{} (see `boycott case keys`)", k, did_you_mean(k)));
   }
   return p;
 }
@@ -421,7 +423,9 @@ void apply_override(CaseParams& p, const std::string& assignment) {
   std::string key = assignment.substr(0, eq);
   std::string value = assignment.substr(eq + 1);
   key.erase(key.find_last_not_of(" \t") + 1);
-  if (!set_key(p, key, value)) throw InputError(fmt::format("--set: unknown key '{}'", key));
+  if (!set_key(p, key, value))
+    throw InputError(
+        fmt::format("--set: unknown key '{}'{} (see `boycott case keys`)", key, did_you_mean(key)));
   p.set_keys.insert(std::lower_bound(p.set_keys.begin(), p.set_keys.end(), key), key);
   p.set_keys.erase(std::unique(p.set_keys.begin(), p.set_keys.end()), p.set_keys.end());
   // The particle load is given one way or the other; the later assignment wins (otherwise a

@@ -8,6 +8,7 @@
 
 #include "core/case_params.hpp"
 #include "core/error.hpp"
+#include "core/key_docs.hpp"
 #include "core/model_names.hpp"
 #include "core/scene_specs.hpp"
 #include "coupling/drag_laws.hpp"
@@ -66,6 +67,30 @@ TEST(ModelRegistries, EverySceneReadsOnlyKeysThatExist) {
     }
     for (const auto& [k, v] : sc.defaults)
       EXPECT_TRUE(scene_reads(sc, k)) << sc.name << " defaults unread " << k;
+  }
+}
+
+TEST(KeyDocs, EveryCaseKeyHasAUnitAndAMeaning) {
+  // `boycott case keys` prints these; a key added without them fails here.
+  for (const auto& k : case_key_names()) {
+    const auto doc = key_doc(k);
+    ASSERT_TRUE(doc.has_value()) << k << " has no entry in core/key_docs.cpp";
+    EXPECT_GT(doc->meaning.size(), 10u) << k;
+  }
+  EXPECT_FALSE(key_doc("fluid.viscosty").has_value());
+}
+
+TEST(KeyDocs, MisspeltKeysSuggestTheNearestAndUnrelatedWordsNothing) {
+  EXPECT_EQ(did_you_mean("fluid.viscosty"), " (did you mean 'fluid.viscosity'?)");
+  EXPECT_EQ(did_you_mean("time.dt_dme"), " (did you mean 'time.dt_dem'?)");
+  EXPECT_EQ(did_you_mean("gravity.viscosity"), " (did you mean 'fluid.viscosity'?)");  // wrong section
+  EXPECT_EQ(did_you_mean("zzzzzzzz.qqqq"), "");
+  try {
+    CaseParams p;
+    apply_override(p, "particles.diamter=1e-3");
+    FAIL() << "an unknown key was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("did you mean 'particles.diameter'"), std::string::npos) << e.what();
   }
 }
 
