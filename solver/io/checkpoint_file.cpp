@@ -241,6 +241,42 @@ void CheckpointWriter::put_string(const std::string& name, const std::string& s)
   put(name, bytes);
 }
 
+void CheckpointWriter::put_strings(const std::string& name, const std::vector<std::string>& list) {
+  std::size_t len = 1;
+  for (const auto& x : list) len = std::max(len, x.size() + 1);
+  std::vector<char> buf(len * list.size(), '\0');
+  for (std::size_t i = 0; i < list.size(); ++i)
+    std::copy(list[i].begin(), list[i].end(), buf.begin() + i * len);
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  H5Tset_size(type, len);
+  H5Tset_strpad(type, H5T_STR_NULLTERM);
+  const hsize_t n = list.size();
+  const hid_t space = H5Screate_simple(1, &n, nullptr);
+  const hid_t ds = H5Dcreate2(file_, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  const herr_t e = ds < 0 ? -1 : n > 0 ? H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) : 0;
+  if (ds >= 0) H5Dclose(ds);
+  H5Sclose(space);
+  H5Tclose(type);
+  if (e < 0) hdf5_failure(fmt::format("cannot write string list '{}'", name));
+}
+
+void CheckpointWriter::put_2d(const std::string& name, std::size_t rows, std::size_t cols,
+                              const std::vector<double>& v) {
+  const hsize_t d[2] = {rows, cols};
+  if (d[0] * d[1] != v.size())
+    throw std::logic_error(
+        fmt::format("dataset '{}': {} values for dimensions {}x{}", name, v.size(), d[0], d[1]));
+  const hid_t space = H5Screate_simple(2, d, nullptr);
+  const hid_t ds =
+      H5Dcreate2(file_, name.c_str(), H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  const herr_t e = ds < 0      ? -1
+                   : v.empty() ? 0
+                               : H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+  if (ds >= 0) H5Dclose(ds);
+  H5Sclose(space);
+  if (e < 0) hdf5_failure(fmt::format("cannot write dataset '{}'", name));
+}
+
 void CheckpointWriter::put_3d(const std::string& name, const std::array<std::size_t, 3>& dims,
                               const std::vector<double>& v) {
   const hsize_t d[3] = {dims[0], dims[1], dims[2]};
@@ -362,6 +398,40 @@ std::int64_t CheckpointReader::integer(const std::string& name) const {
 std::string CheckpointReader::string(const std::string& name) const {
   const auto v = int64s(name);
   return std::string(v.begin(), v.end());
+}
+std::vector<std::string> CheckpointReader::strings(const std::string& name) const {
+  const hid_t ds = H5Dopen2(file_, name.c_str(), H5P_DEFAULT);
+  if (ds < 0) throw CheckpointError(fmt::format("{}: dataset '{}' is missing", path_.string(), name));
+  const hid_t type = H5Dget_type(ds), space = H5Dget_space(ds);
+  const hssize_t npts = H5Sget_simple_extent_npoints(space);
+  const std::size_t n = npts < 0 ? 0 : static_cast<std::size_t>(npts);
+  const bool ok = H5Tget_class(type) == H5T_STRING && H5Tis_variable_str(type) == 0;
+  const std::size_t len = ok ? H5Tget_size(type) : 0;
+  std::vector<char> buf(len * n + 1, '\0');
+  const herr_t e = !ok ? -1 : n > 0 ? H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) : 0;
+  H5Sclose(space);
+  H5Tclose(type);
+  H5Dclose(ds);
+  if (e < 0)
+    throw CheckpointError(
+        fmt::format("{}: dataset '{}' is not a list of fixed-length strings", path_.string(), name));
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < n; ++i) {
+    const char* p = buf.data() + i * len;
+    out.emplace_back(p, std::find(p, p + len, '\0'));
+  }
+  return out;
+}
+std::vector<std::size_t> CheckpointReader::dims(const std::string& name) const {
+  const hid_t ds = H5Dopen2(file_, name.c_str(), H5P_DEFAULT);
+  if (ds < 0) throw CheckpointError(fmt::format("{}: dataset '{}' is missing", path_.string(), name));
+  const hid_t space = H5Dget_space(ds);
+  const int rank = H5Sget_simple_extent_ndims(space);
+  std::vector<hsize_t> d(rank > 0 ? static_cast<std::size_t>(rank) : 0);
+  if (rank > 0) H5Sget_simple_extent_dims(space, d.data(), nullptr);
+  H5Sclose(space);
+  H5Dclose(ds);
+  return std::vector<std::size_t>(d.begin(), d.end());
 }
 
 fs::path checkpoint_path(const fs::path& run_dir, std::int64_t step) {

@@ -31,7 +31,12 @@ class CheckpointWriter {
   void put(const std::string& name, const std::vector<std::int64_t>& v);
   void put(const std::string& name, double v) { put(name, std::vector<double>{v}); }
   void put_int(const std::string& name, std::int64_t v) { put(name, std::vector<std::int64_t>{v}); }
+  /// A string as its character codes (int64): how checkpoints have always stored them.
   void put_string(const std::string& name, const std::string& s);
+  /// A list of HDF5 strings (fixed length, null-terminated; h5dump and h5py show them as text).
+  void put_strings(const std::string& name, const std::vector<std::string>& list);
+  /// A 2-D array {rows, cols} stored row by row (N x 3 vectors: one row per point).
+  void put_2d(const std::string& name, std::size_t rows, std::size_t cols, const std::vector<double>& v);
   /// A 3-D array stored slowest-first with dimensions {n0, n1, n2} (z, y, x for grid fields).
   void put_3d(const std::string& name, const std::array<std::size_t, 3>& dims, const std::vector<double>& v);
   /// Creates a group (for names "group/dataset").
@@ -76,6 +81,10 @@ class CheckpointReader {
   double scalar(const std::string& name) const;
   std::int64_t integer(const std::string& name) const;
   std::string string(const std::string& name) const;
+  /// A list written by put_strings.
+  std::vector<std::string> strings(const std::string& name) const;
+  /// The dimensions of a dataset, slowest first (empty for a scalar).
+  std::vector<std::size_t> dims(const std::string& name) const;
   const std::filesystem::path& path() const { return path_; }
   Integrity integrity() const { return integrity_; }
 

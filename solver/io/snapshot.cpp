@@ -1,7 +1,10 @@
 #include "io/snapshot.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <numeric>
 #include <regex>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -13,12 +16,64 @@ namespace boycott::io {
 
 namespace fs = std::filesystem;
 
+double wrap_into_box(double x, double length) {
+  double r = std::fmod(x, length);
+  if (r < 0) r += length;
+  if (r >= length) r -= length;  // -tiny + length rounds to length
+  return r;
+}
+
 namespace {
 
-std::string data_item(const std::string& file, const std::string& name, const std::string& dims) {
+std::string data_item(const std::string& file, const std::string& name, const std::string& dims,
+                      const char* type = "Float") {
   return fmt::format(
-      "<DataItem Format=\"HDF\" NumberType=\"Float\" Precision=\"8\" Dimensions=\"{}\">{}:/{}</DataItem>",
+      "<DataItem Format=\"HDF\" NumberType=\"{}\" Precision=\"8\" Dimensions=\"{}\">{}:/{}</DataItem>", type,
       dims, file, name);
+}
+
+std::string attribute(const char* name, const char* kind, const char* center, const std::string& item) {
+  return fmt::format("<Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"{}\">{}</Attribute>\n", name, kind,
+                     center, item);
+}
+
+/// One time of the index: a spatial collection of the particle point set and the fluid grid.
+std::string index_entry(const fs::path& path, int idx, const GridSpec& g) {
+  CheckpointReader r(path, CheckpointReader::Verify::kNo);  // this run's own files, just written
+  const std::string f = path.filename().string();
+  std::string s = fmt::format(
+      "<Grid Name=\"snap_{:05d}\" GridType=\"Collection\" CollectionType=\"Spatial\">\n<Time "
+      "Value=\"{:.9g}\"/>\n",
+      idx, r.scalar("time"));
+  const std::size_t n = r.dims("particles/id").at(0);
+  if (n > 0) {
+    const std::string n1 = std::to_string(n), n3 = fmt::format("{} 3", n);
+    s += "<Grid Name=\"particles\" GridType=\"Uniform\">\n";
+    s += fmt::format(
+        "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" NodesPerElement=\"1\"/>\n", n);
+    s += "<Geometry GeometryType=\"XYZ\">" + data_item(f, "particles/position", n3) + "</Geometry>\n";
+    s += attribute("id", "Scalar", "Node", data_item(f, "particles/id", n1, "Int"));
+    s += attribute("radius", "Scalar", "Node", data_item(f, "particles/radius", n1));
+    s += attribute("velocity", "Vector", "Node", data_item(f, "particles/velocity", n3));
+    s += attribute("angular_velocity", "Vector", "Node", data_item(f, "particles/angular_velocity", n3));
+    s += "</Grid>\n";
+  }
+  const auto names = r.strings("fluid_fields");
+  if (!names.empty()) {
+    const std::string cells = fmt::format("{} {} {}", g.n[2], g.n[1], g.n[0]);
+    s += "<Grid Name=\"fluid\" GridType=\"Uniform\">\n";
+    s += fmt::format("<Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"{} {} {}\"/>\n", g.n[2] + 1,
+                     g.n[1] + 1, g.n[0] + 1);
+    s += "<Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n";
+    s += "<DataItem Format=\"XML\" Dimensions=\"3\">0 0 0</DataItem>\n";
+    s += fmt::format("<DataItem Format=\"XML\" Dimensions=\"3\">{:.9g} {:.9g} {:.9g}</DataItem>\n", g.dx(2),
+                     g.dx(1), g.dx(0));
+    s += "</Geometry>\n";
+    for (const auto& nm : names)
+      s += attribute(nm.c_str(), "Scalar", "Cell", data_item(f, "fluid/" + nm, cells));
+    s += "</Grid>\n";
+  }
+  return s + "</Grid>\n";
 }
 
 void write_index(const fs::path& dir, const GridSpec& g) {
@@ -31,58 +86,37 @@ void write_index(const fs::path& dir, const GridSpec& g) {
   }
   std::sort(files.begin(), files.end());
   std::string x = "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n";
-  std::string parts, fluid;
+  x += "<Grid Name=\"snapshots\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   for (const auto& [idx, path] : files) {
-    CheckpointReader r(path, CheckpointReader::Verify::kNo);  // this run's own files, just written
-    const double t = r.scalar("time");
-    const std::string f = path.filename().string();
-    const auto n = r.doubles("particles/x").size();
-    parts +=
-        fmt::format("<Grid Name=\"particles_{}\" GridType=\"Uniform\">\n<Time Value=\"{:.9g}\"/>\n", idx, t);
-    parts += fmt::format("<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\"/>\n", n);
-    parts += "<Geometry GeometryType=\"X_Y_Z\">\n";
-    for (const char* c : {"x", "y", "z"})
-      parts += data_item(f, std::string("particles/") + c, std::to_string(n)) + "\n";
-    parts += "</Geometry>\n";
-    for (const char* a : {"vx", "vy", "vz", "radius"})
-      parts += fmt::format("<Attribute Name=\"{}\" AttributeType=\"Scalar\" Center=\"Node\">{}</Attribute>\n",
-                           a, data_item(f, std::string("particles/") + a, std::to_string(n)));
-    parts += "</Grid>\n";
-    const auto names = r.string("fluid_fields");
-    if (!names.empty()) {
-      const std::string cells = fmt::format("{} {} {}", g.n[2], g.n[1], g.n[0]);
-      fluid +=
-          fmt::format("<Grid Name=\"fluid_{}\" GridType=\"Uniform\">\n<Time Value=\"{:.9g}\"/>\n", idx, t);
-      fluid += fmt::format("<Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"{} {} {}\"/>\n", g.n[2] + 1,
-                           g.n[1] + 1, g.n[0] + 1);
-      fluid += "<Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n";
-      fluid += "<DataItem Format=\"XML\" Dimensions=\"3\">0 0 0</DataItem>\n";
-      fluid += fmt::format("<DataItem Format=\"XML\" Dimensions=\"3\">{:.9g} {:.9g} {:.9g}</DataItem>\n",
-                           g.dx(2), g.dx(1), g.dx(0));
-      fluid += "</Geometry>\n";
-      std::size_t pos = 0;
-      while (pos < names.size()) {
-        const auto end = std::min(names.find(',', pos), names.size());
-        const std::string nm = names.substr(pos, end - pos);
-        fluid +=
-            fmt::format("<Attribute Name=\"{}\" AttributeType=\"Scalar\" Center=\"Cell\">{}</Attribute>\n",
-                        nm, data_item(f, "fluid/" + nm, cells));
-        pos = end + 1;
-      }
-      fluid += "</Grid>\n";
-    }
+    // A snapshot of the layout before particles/id (a run resumed across the change) is left out.
+    if (!CheckpointReader(path, CheckpointReader::Verify::kNo).has("particles/id")) continue;
+    x += index_entry(path, idx, g);
   }
-  x +=
-      "<Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n" + parts + "</Grid>\n";
-  if (!fluid.empty())
-    x += "<Grid Name=\"fluid\" GridType=\"Collection\" CollectionType=\"Temporal\">\n" + fluid + "</Grid>\n";
-  x += "</Domain>\n</Xdmf>\n";
+  x += "</Grid>\n</Domain>\n</Xdmf>\n";
   write_file_atomic(dir / "fields.xmf", x);
 }
 
 }  // namespace
 
 fs::path write_snapshot(const fs::path& run_dir, int index, const SnapshotData& d, const GridSpec& g) {
+  const std::size_t n = d.id.size();
+  for (const auto* v : {&d.x, &d.y, &d.z, &d.vx, &d.vy, &d.vz, &d.wx, &d.wy, &d.wz, &d.radius})
+    if (v->size() != n)
+      throw std::logic_error(fmt::format("snapshot: {} particle ids but an array of {}", n, v->size()));
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return d.id[a] < d.id[b]; });
+  std::vector<std::int64_t> ids(n);
+  std::vector<double> pos(3 * n), vel(3 * n), ang(3 * n), radius(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = order[k];
+    ids[k] = d.id[i];
+    radius[k] = d.radius[i];
+    const double p[3] = {d.x[i], d.y[i], d.z[i]};
+    for (int c = 0; c < 3; ++c) pos[3 * k + c] = g.periodic[c] ? wrap_into_box(p[c], g.length_m[c]) : p[c];
+    vel[3 * k] = d.vx[i], vel[3 * k + 1] = d.vy[i], vel[3 * k + 2] = d.vz[i];
+    ang[3 * k] = d.wx[i], ang[3 * k + 1] = d.wy[i], ang[3 * k + 2] = d.wz[i];
+  }
   const fs::path dir = run_dir / "snapshots";
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -92,16 +126,12 @@ fs::path write_snapshot(const fs::path& run_dir, int index, const SnapshotData& 
     CheckpointWriter w(path);
     w.put("time", d.time_s);
     w.put_group("particles");
-    for (const auto& [name, v] :
-         std::initializer_list<std::pair<const char*, const std::vector<double>*>>{{"x", &d.x},
-                                                                                   {"y", &d.y},
-                                                                                   {"z", &d.z},
-                                                                                   {"vx", &d.vx},
-                                                                                   {"vy", &d.vy},
-                                                                                   {"vz", &d.vz},
-                                                                                   {"radius", &d.radius}})
-      w.put(std::string("particles/") + name, *v);
-    std::string names;
+    w.put("particles/id", ids);
+    w.put_2d("particles/position", n, 3, pos);
+    w.put_2d("particles/velocity", n, 3, vel);
+    w.put_2d("particles/angular_velocity", n, 3, ang);
+    w.put("particles/radius", radius);
+    std::vector<std::string> names;
     if (!d.cell_fields.empty()) {
       w.put_group("fluid");
       for (const auto& [name, v] : d.cell_fields) {
@@ -109,10 +139,10 @@ fs::path write_snapshot(const fs::path& run_dir, int index, const SnapshotData& 
                  {static_cast<std::size_t>(g.n[2]), static_cast<std::size_t>(g.n[1]),
                   static_cast<std::size_t>(g.n[0])},
                  v);
-        names += (names.empty() ? "" : ",") + name;
+        names.push_back(name);
       }
     }
-    w.put_string("fluid_fields", names);
+    w.put_strings("fluid_fields", names);
     w.commit();
   }
   write_index(dir, g);

@@ -57,10 +57,15 @@ io::SnapshotData coupled_snapshot(const coupling::CoupledSystem& run) {
   io::SnapshotData d;
   d.time_s = run.time_s();
   const auto& s = run.dem().particles();
-  auto parts = gather_particles(run, {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.radius});
+  const std::vector<double> ids(s.id.begin(),
+                                s.id.begin() + static_cast<std::ptrdiff_t>(s.n_local));  // exact < 2^53
+  auto parts =
+      gather_particles(run, {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.radius, &ids});
   d.x = std::move(parts[0]), d.y = std::move(parts[1]), d.z = std::move(parts[2]);
   d.vx = std::move(parts[3]), d.vy = std::move(parts[4]), d.vz = std::move(parts[5]);
-  d.radius = std::move(parts[6]);
+  d.wx = std::move(parts[6]), d.wy = std::move(parts[7]), d.wz = std::move(parts[8]);
+  d.radius = std::move(parts[9]);
+  d.id.assign(parts[10].begin(), parts[10].end());
   const auto& g = run.fluid().settings().grid;
   const int nx = (int)g.n[0], ny = (int)g.n[1], nz = (int)g.n[2];
   const bool walls = !g.periodic[1];
@@ -122,9 +127,9 @@ void CoupledSceneOutput::write_pictures(double t) {
     const auto& s = run_.dem().particles();
     const auto parts = gather_particles(run_, {&s.x, &s.y, &s.z, &s.radius});
     if (!output_rank()) return;
-    const io::ParticleView view{&parts[0],          &parts[1],          &parts[2],
-                                &parts[3],          parts[0].size(),    p.domain.length_x_m,
-                                p.domain.width_y_m, p.domain.height_z_m};
+    const io::ParticleView view{&parts[0],          &parts[1],           &parts[2],
+                                &parts[3],          parts[0].size(),     p.domain.length_x_m,
+                                p.domain.width_y_m, p.domain.height_z_m, time};
     io::write_particle_png(ctx_.out_dir / fmt::format("particles_t{:.3f}.png", time), view);
   });
 }
