@@ -16,6 +16,7 @@
 #include "driver/collect.hpp"
 #include "driver/curve.hpp"
 #include "driver/database.hpp"
+#include "driver/plan.hpp"
 #include "driver/runner.hpp"
 #include "driver/slurm.hpp"
 #include "driver/store.hpp"
@@ -154,6 +155,21 @@ int main(int argc, char** argv) {
   sstatus->add_option("study", status_file, "study file (TOML)")->required();
   sstatus->add_option("--db", status_db, "results database (SQLite)")->required();
   sstatus->add_option("--retries", status_retries, "as given to study run")->capture_default_str();
+  boycott::driver::PlanOptions plan_opt;
+  auto* splan = study_cmd->add_subcommand(
+      "plan", "list the cases with their state and estimated cost, and the study's wall time; runs nothing");
+  splan->add_option("study", plan_opt.study_file, "study file (TOML)")->required()->check(CLI::ExistingFile);
+  splan->add_option("--db", plan_opt.db_path,
+                    "results database (read if it exists: states and the cost model)");
+  splan->add_option("--jobs", plan_opt.jobs, "cases run at once")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  splan->add_option("--ranks", plan_opt.ranks, "MPI ranks per case")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  splan->add_option("--format", plan_opt.format, "table or json")->capture_default_str();
+  splan->add_flag("--check-model", plan_opt.check_model,
+                  "also predict each finished case from the other finished runs only (leave one out)");
   boycott::driver::SlurmSubmitOptions subopt;
   auto* ssubmit = study_cmd->add_subcommand(
       "submit",
@@ -243,6 +259,7 @@ int main(int argc, char** argv) {
       return boycott::driver::study_run(sopt);
     });
   }
+  if (splan->parsed()) return run_guarded([&] { return boycott::driver::study_plan(plan_opt); });
   if (ssubmit->parsed())
     return run_guarded([&] {
       require_db_path(subopt.db_path);

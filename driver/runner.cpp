@@ -14,6 +14,7 @@
 #include "driver/collect.hpp"
 #include "driver/curve.hpp"
 #include "driver/database.hpp"
+#include "driver/plan.hpp"
 #include "driver/replica_rounds.hpp"
 #include "driver/scheduler.hpp"
 #include "driver/slurm.hpp"
@@ -69,6 +70,11 @@ int study_run(const StudyRunOptions& opt) {
 
   auto states = case_states(db, study.name, opt.retries);
   std::erase_if(states, [&](const CaseState& s) { return collected.in_slurm.count(s.id) > 0; });
+  std::vector<std::string> to_run;
+  for (const auto& s : states)
+    if (s.status != CaseStatus::kDone && s.status != CaseStatus::kFailed) to_run.push_back(s.id);
+  if (!to_run.empty())
+    std::fprintf(stderr, "%s\n", plan_summary_line(db, study, to_run, opt.jobs, opt.ranks).c_str());
   Scheduler scheduler(db, study, states, opt, root, solver);
   bool stopped = scheduler.run();
   std::string storage_stop = scheduler.storage_stop();

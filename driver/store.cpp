@@ -466,4 +466,13 @@ std::vector<SettlingResult> settling_results(Database& db, const std::string& st
   return out;
 }
 
+std::vector<FinishedCost> finished_costs(Database& db) {
+  std::vector<FinishedCost> out;
+  auto st = db.prepare(
+      "SELECT c.id, c.params_json, r.summary_json FROM results r JOIN cases c ON c.id = r.case_id "
+      "WHERE r.wall_time_s IS NOT NULL ORDER BY c.id");
+  while (st.step()) out.push_back({st.text(0), st.text(1), st.text(2)});
+  return out;
+}
+
 }  // namespace boycott::driver

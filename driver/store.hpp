@@ -125,4 +125,12 @@ struct SettlingResult {
 /// The study's cases with a recorded <<w_p>>, once per group they belong to, in study order.
 std::vector<SettlingResult> settling_results(Database& db, const std::string& study);
 
+/// A finished result's cost, for the cost model of `study plan`: every study's results count.
+struct FinishedCost {
+  std::string case_id;
+  std::string params_json;
+  std::string summary_json;
+};
+std::vector<FinishedCost> finished_costs(Database& db);
+
 }  // namespace boycott::driver

@@ -1,0 +1,63 @@
+#pragma once
+// What a case costs, for `study plan` and the estimate `study run` prints before it starts. Per
+// scene, core-seconds = a + b * particle-steps + c * fluid cell-steps, fitted to the finished runs
+// of the database (relative least squares, terms that would be negative dropped); with fewer than
+// three finished runs of a scene, the default coefficients below, scaled by the mean ratio of
+// the measured to the predicted cost of those there are.
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace boycott::driver {
+
+/// The work of a run: from its resolved parameters (params.json), over [from_s, to_s].
+struct CaseWork {
+  std::string scene;
+  double particle_steps = 0.0;    ///< particles x DEM steps
+  double fluid_cell_steps = 0.0;  ///< fluid cells x CFD steps (at dt_cfd, the CFL limit aside)
+};
+CaseWork case_work(const nlohmann::json& params, double from_s, double to_s);
+
+/// One finished run: its work and what it cost (wall time x ranks, core-seconds).
+struct MeasuredCost {
+  std::string case_id;
+  CaseWork work;
+  double core_s = 0.0;
+};
+/// The finished runs from their params.json and summary.json texts; unreadable ones are skipped.
+MeasuredCost measured_cost(const std::string& case_id, const std::string& params_json,
+                           const std::string& summary_json, bool* ok);
+
+class CostModel {
+ public:
+  /// Documented defaults, from the full Table III case over its first 1.2 s on one core of this
+  /// 2-core machine (docs/performance.md): 210 ns per particle-step for the particles (contacts
+  /// 123, neighbour lists 31, sampling 23, integration 23, deposition 11) and 74.5 ns per
+  /// particle-step for the fluid, i.e. 3.7 us per fluid cell-step at 50 DEM steps per CFD step
+  /// and one particle per cell (SIMPLE at ~13 iterations); a start-up of 2 s. 20 s of that case:
+  /// about 9 core-hours, as measured (~10).
+  static constexpr double kStartS = 2.0, kParticleStepS = 210e-9, kCellStepS = 3.7e-6;
+
+  explicit CostModel(const std::vector<MeasuredCost>& finished);
+  /// Core-seconds of this work.
+  double core_s(const CaseWork& w) const;
+  /// How the scene's coefficients were found: "fit to N runs", "default scaled by N runs", "default".
+  std::string basis(const std::string& scene) const;
+
+ private:
+  struct Coefficients {
+    double start_s = kStartS, particle_step_s = kParticleStepS, cell_step_s = kCellStepS;
+    int runs = 0;
+    bool fitted = false;
+  };
+  std::map<std::string, Coefficients> by_scene_;
+};
+
+/// Wall time of running these cases' core-seconds on `jobs` slots of `ranks` cores each, longest
+/// first on the slot that frees first (parallel efficiency 0.9 per doubling of ranks).
+double study_wall_s(std::vector<double> core_s, int jobs, int ranks);
+double ranks_efficiency(int ranks);
+
+}  // namespace boycott::driver

@@ -1,0 +1,153 @@
+#include "driver/plan.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <optional>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "driver/cost_model.hpp"
+#include "driver/store.hpp"
+
+namespace fs = std::filesystem;
+
+namespace boycott::driver {
+
+namespace {
+std::string duration(double s) {
+  if (!std::isfinite(s) || s < 0) return "?";
+  if (s >= 48 * 3600.0) return fmt::format("{:.1f} d", s / 86400.0);
+  if (s >= 3600.0) return fmt::format("{:.1f} h", s / 3600.0);
+  if (s >= 60.0) return fmt::format("{:.1f} min", s / 60.0);
+  return fmt::format("{:.0f} s", s);
+}
+
+std::vector<MeasuredCost> measured(Database& db) {
+  std::vector<MeasuredCost> out;
+  for (const auto& f : finished_costs(db)) {
+    bool ok = false;
+    auto m = measured_cost(f.case_id, f.params_json, f.summary_json, &ok);
+    if (ok) out.push_back(std::move(m));
+  }
+  return out;
+}
+
+CaseWork work_of(const StudyCase& c) {
+  return case_work(to_json(c.params), 0.0, c.params.time.end_s);
+}
+
+std::string swept_text(const StudyCase& c) {
+  std::string s;
+  for (const auto& [k, v] : c.swept) s += (s.empty() ? "" : " ") + k + "=" + v;
+  if (c.replica > 0) s += fmt::format("{}replica {}", s.empty() ? "" : " ", c.replica);
+  return s.empty() ? "-" : s;
+}
+}  // namespace
+
+std::string plan_summary_line(Database& db, const Study& study, const std::vector<std::string>& to_run_ids,
+                              int jobs, int ranks) {
+  const CostModel model(measured(db));
+  std::map<std::string, const StudyCase*> by_id;
+  for (const auto& c : study.cases) by_id[c.id] = &c;
+  std::vector<double> costs;
+  std::map<std::string, bool> scenes;
+  for (const auto& id : to_run_ids)
+    if (const auto it = by_id.find(id); it != by_id.end()) {
+      costs.push_back(model.core_s(work_of(*it->second)));
+      scenes[it->second->params.scene] = true;
+    }
+  std::string basis;
+  for (const auto& [scene, _] : scenes)
+    basis += (basis.empty() ? "" : ", ") + scene + ": " + model.basis(scene);
+  return fmt::format("plan: {} cases to run, estimated {} on {} jobs x {} ranks (cost model {})",
+                     costs.size(), duration(study_wall_s(costs, jobs, ranks)), jobs, ranks,
+                     basis.empty() ? "-" : basis);
+}
+
+int study_plan(const PlanOptions& opt) {
+  if (opt.format != "table" && opt.format != "json")
+    throw InputError(fmt::format("--format '{}': expected table or json", opt.format));
+  if (opt.jobs < 1 || opt.ranks < 1) throw InputError("--jobs and --ranks must be at least 1");
+  const Study study = expand_study_file(opt.study_file);
+  // The plan reads an existing database and creates none.
+  std::optional<Database> db;
+  if (!opt.db_path.empty() && fs::exists(opt.db_path)) db.emplace(opt.db_path, OpenMode::kReadOnly);
+  std::map<std::string, CaseState> states;
+  std::vector<MeasuredCost> finished;
+  if (db) {
+    for (auto& s : case_states(*db, study.name, 2)) states[s.id] = s;
+    finished = measured(*db);
+  }
+  const CostModel model(finished);
+  std::map<std::string, const MeasuredCost*> measured_by_id;
+  for (const auto& m : finished) measured_by_id[m.case_id] = &m;
+
+  nlohmann::json rows = nlohmann::json::array();
+  std::vector<double> pending_costs;
+  std::string table;
+  double total_core_s = 0.0;
+  for (const auto& c : study.cases) {
+    const auto it = states.find(c.id);
+    const CaseStatus st = it == states.end() ? CaseStatus::kPending : it->second.status;
+    const double est = model.core_s(work_of(c));
+    total_core_s += est;
+    if (st != CaseStatus::kDone) pending_costs.push_back(est);
+    nlohmann::json row = {{"group", c.group},
+                          {"swept", swept_text(c)},
+                          {"case_id", c.id},
+                          {"state", to_string(st)},
+                          {"estimated_core_s", est},
+                          {"scene", c.params.scene},
+                          {"cost_basis", model.basis(c.params.scene)}};
+    const auto m = measured_by_id.find(c.id);
+    if (m != measured_by_id.end()) row["measured_core_s"] = m->second->core_s;
+    if (opt.check_model && m != measured_by_id.end()) {
+      // Leave one out: the same model without this run.
+      std::vector<MeasuredCost> others;
+      for (const auto& f : finished)
+        if (f.case_id != c.id) others.push_back(f);
+      row["predicted_by_others_core_s"] = CostModel(others).core_s(m->second->work);
+    }
+    table += fmt::format("{:<10} {:<34} {:<16} {:<11} {:>10}{}\n", c.group, swept_text(c), c.id,
+                         to_string(st), duration(est),
+                         row.contains("predicted_by_others_core_s")
+                             ? fmt::format("  measured {}, from the others {}", duration(m->second->core_s),
+                                           duration(row["predicted_by_others_core_s"].get<double>()))
+                             : std::string());
+    rows.push_back(row);
+  }
+  const double wall = study_wall_s(pending_costs, opt.jobs, opt.ranks);
+  if (opt.format == "json") {
+    std::printf("%s\n", nlohmann::json{{"study", study.name},
+                                       {"cases", rows},
+                                       {"jobs", opt.jobs},
+                                       {"ranks", opt.ranks},
+                                       {"remaining_cases", pending_costs.size()},
+                                       {"estimated_wall_s", wall},
+                                       {"estimated_core_s_all_cases", total_core_s}}
+                            .dump(1)
+                            .c_str());
+    return 0;
+  }
+  std::printf("study %s: %zu cases, %zu to run\n", study.name.c_str(), study.cases.size(),
+              pending_costs.size());
+  std::printf("%-10s %-34s %-16s %-11s %10s\n%s", "group", "varied", "case", "state", "core time",
+              table.c_str());
+  std::printf(
+      "estimated wall time of the cases to run: %s on %d jobs x %d ranks (parallel efficiency %.2f)\n",
+      duration(wall).c_str(), opt.jobs, opt.ranks, ranks_efficiency(opt.ranks));
+  std::map<std::string, bool> scenes;
+  for (const auto& c : study.cases) scenes[c.params.scene] = true;
+  for (const auto& [scene, _] : scenes)
+    std::printf("cost model %s: %s%s\n", scene.c_str(), model.basis(scene).c_str(),
+                model.basis(scene) == "default"
+                    ? " (2 s + 210 ns per particle-step + 3.7 us per fluid cell-step)"
+                    : "");
+  return 0;
+}
+
+}  // namespace boycott::driver

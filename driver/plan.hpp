@@ -1,0 +1,28 @@
+#pragma once
+// `boycott study plan`: the cases of a study, their state and their estimated cost, and the
+// study's wall time on J jobs of N ranks, from the cost model calibrated on the database's
+// finished runs (cost_model.hpp). Runs nothing; reads the database only if it exists.
+#include <string>
+#include <vector>
+
+#include "driver/database.hpp"
+#include "driver/study.hpp"
+
+namespace boycott::driver {
+
+struct PlanOptions {
+  std::string study_file;
+  std::string db_path;  ///< may not exist
+  int jobs = 1;
+  int ranks = 1;
+  std::string format = "table";  ///< table or json
+  /// Also each finished case of the study predicted by a model fitted to the others only.
+  bool check_model = false;
+};
+int study_plan(const PlanOptions& opt);
+
+/// The line `study run` prints before it starts: cases to run and their estimated wall time.
+std::string plan_summary_line(Database& db, const Study& study, const std::vector<std::string>& to_run_ids,
+                              int jobs, int ranks);
+
+}  // namespace boycott::driver
