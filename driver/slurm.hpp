@@ -24,7 +24,9 @@ struct SlurmSubmitOptions {
   int max_running = 0;              ///< array tasks at once (%K); 0: as many as Slurm allows
   std::string time;  ///< --time of each task (HH:MM:SS, D-HH:MM:SS, ...); empty: the partition's
   std::string partition;
-  std::string launcher = "srun";         ///< how a case runs on several ranks: "srun" or "mpirun"
+  /// How a case runs on several ranks: "mpirun" (the default: 2-rank launches under
+  /// `srun --mpi=pmix` hung now and then here, docs/cluster.md) or "srun".
+  std::string launcher = "mpirun";
   std::vector<std::string> sbatch_args;  ///< extra #SBATCH lines, e.g. --account=X
   bool dry_run = false;                  ///< print the script, write and submit nothing
   /// The solver command line (split at spaces); empty: $BOYCOTT_SOLVER_COMMAND, else this program.

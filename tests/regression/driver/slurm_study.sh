@@ -2,11 +2,11 @@
 # `boycott study submit --scheduler slurm` against a real Slurm: a private single-node cluster
 # (munged, slurmctld, slurmd started here on free ports, state in a temporary folder) runs a 4-case
 # study as a job array two at a time; one running task gets the wall-time warning
-# (`scancel -b -s USR1`), checkpoints, requeues itself and resumes. `study collect` then gives the
+# (USR1 to its batch shell), checkpoints, requeues itself and resumes. `study collect` then gives the
 # database a local `study run` of the same study gives: every case done, the same <<w_p>> bit for
 # bit, no duplicate rows; the signalled case has its two attempts (exit 75 on restart 0, exit 0 on
 # restart 1 of the same job), and collecting again changes nothing. Then one 2-rank case through
-# srun --mpi=pmix equals `study run --ranks 2` bit for bit, and, with the fake solver, a case that
+# mpirun inside the job equals `study run --ranks 2` bit for bit, and, with the fake solver, a case that
 # fails once is retried in its task and one that keeps failing ends failed with its reason.
 # Without a usable Slurm (packages missing, not root, daemons not starting) it skips (exit 77),
 # unless BOYCOTT_REQUIRE_SLURM=1 (.ci/run sets it): then it fails with the reason.
@@ -54,14 +54,18 @@ cleanup() {
   [ -f "$work/munge/munged.pid" ] && kill "$(cat "$work/munge/munged.pid")" 2> /dev/null
   sleep 1
   for p in "${pids[@]}"; do kill -9 "$p" 2> /dev/null; done
-  # Whatever still runs from this test's folder (a task's solver the cancel did not reach).
+  # Whatever still runs from this test's folder (a task's solver the cancel did not reach) and the
+  # step daemons of this Slurm (their environment names its slurm.conf).
   for p in $(pgrep -f -- "$work/" 2> /dev/null); do kill -9 "$p" 2> /dev/null; done
+  for p in $(pgrep -x slurmstepd 2> /dev/null); do
+    tr '\0' '\n' < "/proc/$p/environ" 2> /dev/null | grep -qx "SLURM_CONF=$work/slurm.conf" && kill -9 "$p" 2> /dev/null
+  done
   rm -rf "$work"
 }
 trap cleanup EXIT
 
 # ---- a private Slurm ----
-mkdir -p "$work/munge" "$work/state" "$work/spool" "$work/log"
+mkdir -p "$work/munge" "$work/state" "$work/spool" "$work/log" "$work/tmp"
 chown munge:munge "$work/munge"
 runuser -u munge -- munged --socket="$work/munge/sock" --pid-file="$work/munge/munged.pid" \
   --seed-file="$work/munge/seed" --log-file="$work/munge/munged.log" --key-file=/etc/munge/munge.key ||
@@ -86,6 +90,9 @@ CredType=cred/munge
 AuthInfo=socket=$work/munge/sock,cred_expire=10
 StateSaveLocation=$work/state
 SlurmdSpoolDir=$work/spool
+# PMIx's per-step folders (spmix_appdir_<uid>_<job>.<step>) go here, not to /tmp: job ids start
+# at 1 in every private cluster, and a folder left by an earlier one made srun's launch fail or hang.
+TmpFS=$work/tmp
 SlurmctldPidFile=$work/slurmctld.pid
 SlurmdPidFile=$work/slurmd.pid
 SlurmctldLogFile=$work/log/slurmctld.log
@@ -152,10 +159,16 @@ for _ in $(seq 600); do
     ts=$work/slurm.sqlite.runs/$c/timeseries.csv
     [ -f "$ts" ] || continue
     t=$(tail -n 1 "$ts" | cut -d, -f1)
-    if python3 -c "import sys; sys.exit(0 if 0.15 <= float('$t') <= 0.7 else 1)" 2> /dev/null; then
-      # The signal reaches the batch shell at once, but scancel may then report the requeueing job
-      # as "can not be altered now" and retry for ~15 s: the records below show whether it came.
-      timeout 3 scancel -b -s USR1 "$job" || echo "note: scancel exited $? after signalling job $job"
+    # Once it has a checkpoint (timeseries.csv grows in bursts: t is only a bound) and well before
+    # its end (~4 s of wall time left).
+    if [ -n "$(ls "$work/slurm.sqlite.runs/$c/checkpoints" 2> /dev/null)" ] && [ ! -f "$work/slurm.sqlite.runs/$c/summary.json" ] &&
+      awk -v t="$t" 'BEGIN { exit !(t <= 0.2) }'; then
+      # What --signal=B:USR1 does: USR1 to the task's batch shell only. Sent here with kill, since
+      # `scancel -b -s USR1` answered "can not be altered now" and retried for 15 s, and once the
+      # warning came too late.
+      shell=$(pgrep -f "$work/spool/job$(printf %05d "$job")/slurm_script" | head -n 1)
+      [ -n "$shell" ] || continue
+      kill -USR1 "$shell"
       signalled_job=$job
       signalled_case=$c
       echo "warned job $job (case $c) at t = $t s, $(($(date +%s) - t_submit)) s after submitting"
@@ -165,7 +178,7 @@ for _ in $(seq 600); do
   sleep 0.1
 done
 [ -n "$signalled_job" ] || {
-  echo "FAIL: no task was seen running between t = 0.15 and 0.7 s to warn" >&2
+  echo "FAIL: no task was seen running with a checkpoint and t <= 0.2 s to warn" >&2
   exit 1
 }
 
@@ -229,14 +242,14 @@ dups = s.execute("SELECT case_id, attempt_file, COUNT(*) FROM attempts WHERE att
 assert not dups, dups
 assert s.execute("SELECT COUNT(*) FROM attempts WHERE ended_at IS NULL").fetchone()[0] == 0
 assert s.execute("SELECT COUNT(*) FROM attempts WHERE slurm_array_job_id IS NOT ?", (array,)).fetchone()[0] == 0
+records = sorted((work / "slurm.sqlite.runs" / case / "attempts").glob("*.json"))
 for c, n in s.execute("SELECT case_id, COUNT(*) FROM attempts GROUP BY case_id"):
-    assert n == (2 if c == case else 1), (c, n)
+    assert n == (2 if c == case else 1), (c, n, [json.load(open(r)) for r in records] if c == case else "")
 rows = s.execute("SELECT exit_status, slurm_job_id, slurm_restart, error_text, started_at, ended_at FROM attempts "
                  "WHERE case_id = ? ORDER BY started_at", (case,)).fetchall()
 print("attempts of the warned case:", rows)
 assert [r[0] for r in rows] == [75, 0] and [r[2] for r in rows] == [0, 1], rows
 assert all(r[1] == job for r in rows), rows
-records = sorted((work / "slurm.sqlite.runs" / case / "attempts").glob("*.json"))
 warned = [json.load(open(r))["warned"] for r in records]
 assert warned == [True, False], (records, warned)
 summary = json.load(open(work / "slurm.sqlite.runs" / case / "summary.json"))
@@ -244,13 +257,15 @@ assert summary["status"] == "completed" and summary["resumed_from_checkpoint"], 
 print("Slurm array == local study run, bit for bit; the warned task requeued and resumed")
 PY
 
-# ---- 2 ranks per case through srun --mpi=pmix (the default launcher): the same as study run --ranks 2 ----
+# ---- 2 ranks per case through mpirun inside the job (the default launcher): the same as study run
+# --ranks 2. Not through srun --mpi=pmix: here about one launch in five hung, one rank ending in an
+# exception while the other waited in a barrier (docs/cluster.md); mpirun did not.
 sed 's/^name = .*/name = "slurm_tiny_ranks"/; s/angle_deg" = .*/angle_deg" = [60]/; s/^end = .*/end = 0.1/;
      s/^average_from = .*/average_from = 0.05/' study.toml > ranks.toml
 t_ranks=$(date +%s)
 "$bin" study submit ranks.toml --db "$work/ranks.sqlite" --scheduler slurm --ranks 2 | tee submit_ranks.txt
 grep -qx '#SBATCH --ntasks=2' ranks.sqlite.slurm/*/job.sh
-grep -q '^launcher=(srun --mpi=pmix -n "$ranks")$' ranks.sqlite.slurm/*/job.sh
+grep -q '^launcher=(mpirun -n "$ranks" --allow-run-as-root)$' ranks.sqlite.slurm/*/job.sh
 array=$(sed -n 's/.*submitted job \([0-9]*\),.*/\1/p' submit_ranks.txt)
 for _ in $(seq 750); do  # 3 s alone on 2 cores; 2 polling ranks slow down badly beside other work
   [ -z "$(squeue -h -j "$array" -o %i)" ] && break
@@ -262,9 +277,9 @@ done
 q="SELECT case_id, mean_settling_velocity_m_s, settling_velocity_stderr_m_s FROM results"
 a=$(sqlite3 ranks.sqlite "$q")
 b=$(sqlite3 ranks_local.sqlite "$q")
-echo "2 ranks, srun: $a; study run --ranks 2: $b ($(($(date +%s) - t_ranks)) s)"
+echo "2 ranks, mpirun in the job: $a; study run --ranks 2: $b ($(($(date +%s) - t_ranks)) s)"
 [ -n "$a" ] && [ "$a" = "$b" ] || {
-  echo "FAIL: the 2-rank case under srun differs from study run --ranks 2 (or did not finish)" >&2
+  echo "FAIL: the 2-rank case under Slurm differs from study run --ranks 2 (or did not finish)" >&2
   exit 1
 }
 grep -q '"mpi_ranks": 2,' ranks.sqlite.runs/*/summary.json
