@@ -22,6 +22,7 @@
 #include "driver/store.hpp"
 #include "driver/store_slurm.hpp"
 #include "driver/study.hpp"
+#include "driver/validation_query.hpp"
 
 namespace fs = std::filesystem;
 
@@ -111,7 +112,13 @@ int study_run(const StudyRunOptions& opt) {
     return kExitInterrupted;
   }
   std::printf("study %s: %d of %d cases done, %d failed\n", study.name.c_str(), done, n_total, failed);
-  std::fputs(format_curve(query_curve(db, study.name), CurveFormat::kTable).c_str(), stdout);
+  // The settling curve where the study has one; otherwise (ergun, single_particle, channel_flow,
+  // sediment_transport) each finished case's validation errors against their tolerances.
+  const auto curve = query_curve(db, study.name);
+  if (!curve.empty() || done == 0)
+    std::fputs(format_curve(curve, CurveFormat::kTable).c_str(), stdout);
+  else
+    std::fputs(format_validation(query_validation(db, study.name), CurveFormat::kTable).c_str(), stdout);
   return failed > 0 ? kExitFailure : kExitOk;
 }
 

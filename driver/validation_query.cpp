@@ -1,9 +1,11 @@
 #include "driver/validation_query.hpp"
 
+#include <cmath>
 #include <set>
 
 #include <fmt/format.h>
 
+#include "core/scene_specs.hpp"
 #include "driver/report_util.hpp"
 
 namespace boycott::driver {
@@ -42,6 +44,19 @@ nlohmann::json opt_json(const std::optional<double>& v) {
   return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
 }
 
+/// The tolerance the scene holds this error to, or null.
+const SceneSpec::Tolerance* tolerance_of(const std::string& scene, const std::string& key) {
+  for (const auto& spec : scene_specs())
+    if (spec.name == scene)
+      for (const auto& t : spec.tolerances)
+        if (t.error_key == key) return &t;
+  return nullptr;
+}
+
+bool passes(const SceneSpec::Tolerance& tol, const nlohmann::json& v) {
+  return v.is_number() && std::abs(v.get<double>()) <= tol.max_abs;
+}
+
 }  // namespace
 
 std::vector<ValidationRow> query_validation(Database& db, const std::string& study) {
@@ -76,13 +91,23 @@ std::string format_validation(const std::vector<ValidationRow>& rows, CurveForma
     for (const auto& r : rows) {
       nlohmann::json values = nlohmann::json::object(), errors = nlohmann::json::object();
       for (const auto& v : r.values) values[v.key] = report::value_json(v);
-      for (const auto& [k, v] : r.errors) errors[k] = v;
+      nlohmann::json checks = nlohmann::json::array();
+      for (const auto& [k, v] : r.errors) {
+        errors[k] = v;
+        if (const auto* tol = tolerance_of(r.scene, k))
+          checks.push_back({{"error", k},
+                            {"value", v},
+                            {"tolerance", tol->max_abs},
+                            {"against", tol->against},
+                            {"pass", passes(*tol, v)}});
+      }
       j.push_back({{"study", r.study},
                    {"group", r.group},
                    {"case_id", r.case_id},
                    {"scene", r.scene},
                    {"values", values},
                    {"errors", errors},
+                   {"checks", checks},
                    {"mean_settling_velocity_m_s", opt_json(r.w_m_s)},
                    {"wall_time_s", opt_json(r.wall_time_s)}});
     }
@@ -117,9 +142,12 @@ std::string format_validation(const std::vector<ValidationRow>& rows, CurveForma
                       {false, false, false, false, true, true, false, false});
   for (const auto& r : rows) {
     std::string errs;
-    for (const auto& [k, v] : r.errors)
+    for (const auto& [k, v] : r.errors) {
       errs += fmt::format("{}{}={}", errs.empty() ? "" : "  ", k,
                           table_text(v, k.find("rel") != std::string::npos));
+      if (const auto* tol = tolerance_of(r.scene, k))
+        errs += fmt::format(" (|.| <= {:g} %: {})", 100.0 * tol->max_abs, passes(*tol, v) ? "pass" : "FAIL");
+    }
     t.add({r.study, r.group, r.case_id, r.scene, r.w_m_s ? fmt::format("{:.4f}", *r.w_m_s * 1e3) : "-",
            r.wall_time_s ? report::seconds(*r.wall_time_s) : "-", report::join_values(r.values),
            errs.empty() ? "-" : errs});

@@ -83,6 +83,15 @@ std::vector<SceneSpec> make_specs() {
        {{"forces.drag", "\"none\""}},
        true,
        a3});
+  // The tolerances of the validation studies (tests/regression/driver/validation_studies.sh).
+  for (auto& spec : s) {
+    if (spec.name == "inclined_settling")
+      spec.tolerances = {{"hindered_settling_rel_error", 0.15, "Richardson-Zaki, periodic suspension"}};
+    if (spec.name == "single_particle")
+      spec.tolerances = {{"rel_error", 0.02, "the drag law's isolated terminal velocity"}};
+    if (spec.name == "ergun")
+      spec.tolerances = {{"max_rel_error_f_star", 0.005, "the Ergun equation (the paper's 0.5 %)"}};
+  }
   return s;
 }
 

@@ -21,6 +21,14 @@ struct SceneSpec {
   bool has_particles = true;
   /// Solid fraction of the default particle load (Table III's, or the scene's own).
   double default_solid_fraction = 0.0;
+  /// The validation errors the scene reports (summary.json keys) with the tolerance each is
+  /// held to, for `query validation`'s pass/fail (the validation tests hold the same ones).
+  struct Tolerance {
+    std::string error_key;
+    double max_abs = 0.0;
+    std::string against;  ///< what the error is measured against
+  };
+  std::vector<Tolerance> tolerances = {};
 };
 
 /// Table III's solid fraction: 120 000 particles of 0.6 mm in the 0.2 x 0.006 x 0.1 m box.

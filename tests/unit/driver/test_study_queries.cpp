@@ -359,3 +359,41 @@ set = { "fluid.density" = 1000.0 }
     EXPECT_NEAR(*p.r_acc, expect, 1e-12) << p.setting << " at " << p.angle_deg;
   }
 }
+
+TEST(ValidationQuery, ErrorsWithAToleranceShowItAndPassOrFail) {
+  // Two single_particle cases: one within the scene's 2 % of the drag law's terminal velocity,
+  // one outside it. An error without a tolerance (none for this key) gets no verdict.
+  TempDir d;
+  bd::Database db((d.path / "v.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(R"(
+name = "sp"
+[base]
+scene = "single_particle"
+[matrix]
+"fluid.viscosity" = [0.001, 0.002]
+)");
+  bd::register_study(db, study);
+  const double rel[] = {0.012, -0.031};
+  for (std::size_t i = 0; i < study.cases.size(); ++i) {
+    const auto& c = study.cases[i];
+    nlohmann::json s = {{"scene", "single_particle"}, {"case_id", c.id},      {"status", "completed"},
+                        {"simulated_time_s", 2.0},    {"wall_time_s", 3.0},   {"particle_steps", 10},
+                        {"rel_error", rel[i]},        {"drift_error_m", 1e-9}};
+    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, s);
+  }
+  const auto rows = bd::query_validation(db, "sp");
+  const auto json = nlohmann::json::parse(bd::format_validation(rows, bd::CurveFormat::kJson));
+  ASSERT_EQ(json.size(), 2u);
+  std::map<double, bool> verdicts;
+  for (const auto& r : json) {
+    ASSERT_EQ(r["checks"].size(), 1u) << r.dump();  // rel_error only
+    EXPECT_EQ(r["checks"][0]["error"], "rel_error");
+    EXPECT_DOUBLE_EQ(r["checks"][0]["tolerance"].get<double>(), 0.02);
+    verdicts[r["checks"][0]["value"].get<double>()] = r["checks"][0]["pass"].get<bool>();
+  }
+  EXPECT_TRUE(verdicts.at(0.012));
+  EXPECT_FALSE(verdicts.at(-0.031));
+  const auto table = bd::format_validation(rows, bd::CurveFormat::kTable);
+  EXPECT_NE(table.find("(|.| <= 2 %: pass)"), std::string::npos) << table;
+  EXPECT_NE(table.find("(|.| <= 2 %: FAIL)"), std::string::npos) << table;
+}
