@@ -66,7 +66,12 @@ MeasuredCost measured_cost(const std::string& case_id, const std::string& params
     // A branch started from its parent's time: only its own interval was paid for.
     const double from = s.contains("parent") ? s["parent"].value("time_s", 0.0) : 0.0;
     m.work = case_work(p, from, t);
-    m.core_s = wall * std::max(1, s.value("mpi_ranks", 1));
+    // One attempt from the start: its CPU time (steadier on a shared machine); a resumed run's
+    // earlier attempts are only in its wall time.
+    const bool one_attempt = !s.value("resumed_from_checkpoint", false);
+    m.core_s = one_attempt && s.contains("attempt_cpu_time_s") && s["attempt_cpu_time_s"].is_number()
+                   ? s["attempt_cpu_time_s"].get<double>()
+                   : wall * std::max(1, s.value("mpi_ranks", 1));
     *ok = true;
   } catch (const std::exception&) {
     // An unreadable row does not calibrate anything.

@@ -20,7 +20,8 @@ struct CaseWork {
 };
 CaseWork case_work(const nlohmann::json& params, double from_s, double to_s);
 
-/// One finished run: its work and what it cost (wall time x ranks, core-seconds).
+/// One finished run: its work and what it cost in core-seconds (the CPU time of a run done in
+/// one attempt, else wall time x ranks).
 struct MeasuredCost {
   std::string case_id;
   CaseWork work;

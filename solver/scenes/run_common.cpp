@@ -4,6 +4,7 @@
 #include <petscversion.h>
 
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -89,6 +90,14 @@ nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const Mod
   MPI_Initialized(&initialized);
   if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   j["mpi_ranks"] = ranks;
+  // CPU seconds of this process since it started (user + system), times the ranks: this
+  // attempt's cost, steadier than its wall time on a shared machine (study plan's cost model).
+  rusage use{};
+  getrusage(RUSAGE_SELF, &use);
+  const auto secs = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+  };
+  j["attempt_cpu_time_s"] = (secs(use.ru_utime) + secs(use.ru_stime)) * ranks;
   if (!p.branch.parent_id.empty())
     j["parent"] = {{"case_id", p.branch.parent_id}, {"time_s", num_or_null(p.branch.parent_time_s)}};
   return j;
