@@ -5,17 +5,9 @@
 
 #include <fmt/format.h>
 
-namespace boycott::driver {
+#include "driver/progress.hpp"
 
-namespace {
-std::string duration(double s) {
-  if (!std::isfinite(s) || s < 0) return "?";
-  const long v = std::lround(s);
-  if (v >= 3600) return fmt::format("{}h{:02d}m", v / 3600, static_cast<int>(v % 3600 / 60));
-  if (v >= 60) return fmt::format("{}m{:02d}s", v / 60, static_cast<int>(v % 60));
-  return fmt::format("{}s", v);
-}
-}  // namespace
+namespace boycott::driver {
 
 CaseProgress::CaseProgress(double end_s, bool live, double every_s)
     : end_s_(end_s), live_(live), every_s_(every_s), wall0_(Clock::now()), last_print_(Clock::now()) {}
@@ -28,7 +20,7 @@ std::string CaseProgress::line(double t_s) const {
   std::string s = fmt::format("t = {:.4g} / {:g} s ({:.0f} %)", t_s, end_s_, 100.0 * t_s / end_s_);
   if (std::isfinite(wall_per_sim))
     s += fmt::format(", {:.3g} wall s per simulated s, ETA {}", wall_per_sim,
-                     duration(wall_per_sim * (end_s_ - t_s)));
+                     eta_text(wall_per_sim * (end_s_ - t_s)));
   if (!note_.empty()) s += ", " + note_;
   return s;
 }

@@ -16,15 +16,15 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::string fmt_duration(double s) {
+}  // namespace
+
+std::string eta_text(double s) {
   if (!std::isfinite(s) || s < 0) return "?";
   const long v = std::lround(s);
   if (v >= 3600) return fmt::format("{}h{:02d}m", v / 3600, static_cast<int>(v % 3600 / 60));
   if (v >= 60) return fmt::format("{}m{:02d}s", v / 60, static_cast<int>(v % 60));
   return fmt::format("{}s", v);
 }
-
-}  // namespace
 
 double simulated_time_s(const fs::path& run_dir) {
   std::ifstream in(run_dir / "timeseries.csv", std::ios::ate);
@@ -92,7 +92,7 @@ void ProgressDisplay::draw(const ProgressCounts& counts, const std::vector<Runni
   }
   const double eta_s = (remaining_s + static_cast<double>(counts.pending + unknown) * per_case_s) / jobs_;
   s += fmt::format("study {}: {} done, {} running, {} failed, {} pending; ETA {}{}\n", study_, counts.done,
-                   running.size(), counts.failed, counts.pending, fmt_duration(eta_s),
+                   running.size(), counts.failed, counts.pending, eta_text(eta_s),
                    counts.stopping ? " (stopping)" : "");
   s += rows;
   printed_lines_ = 1 + static_cast<int>(running.size());

@@ -12,6 +12,9 @@
 
 namespace boycott::driver {
 
+/// A remaining time for a progress line: "42s", "3m07s", "2h05m"; "?" when unknown.
+std::string eta_text(double seconds);
+
 /// Simulated time of a running case: first column of the last line of <run_dir>/timeseries.csv;
 /// 0 before the solver wrote one.
 double simulated_time_s(const std::filesystem::path& run_dir);
