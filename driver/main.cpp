@@ -97,6 +97,10 @@ int main(int argc, char** argv) {
   CLI::App app{
       "boycott: unresolved CFD-DEM of proppant settling in inclined narrow channels, and its study driver"};
   app.require_subcommand(1);
+  app.footer(
+      "Exit codes: 0 done; 2 bad input or usage; 3 unphysical state; 4 unusable checkpoint or run folder; 74 "
+      "storage error (nothing lost); 75 interrupted after a checkpoint (run again to resume); 1 other "
+      "failure.");
   app.set_version_flag("--version", fmt::format("boycott {}+{}", boycott::kVersion, boycott::kGitRevision));
 
   auto* case_cmd = app.add_subcommand("case", "run or check a single case");
