@@ -16,6 +16,7 @@
 #include "core/run_status.hpp"
 #include "driver/case_id_migration.hpp"
 #include "driver/recording.hpp"
+#include "driver/run_tree.hpp"
 #include "driver/runner.hpp"
 #include "driver/slurm.hpp"
 #include "driver/solver_process.hpp"
@@ -215,6 +216,7 @@ int study_collect(const std::string& study_file, const std::string& db_path, int
   const fs::path root = runs_root(db_path);
   prepare_study_database(db, study, root);
   const CollectResult r = collect_run_folders(db, study, root);
+  update_run_tree(study, db_path, root);
   std::map<CaseStatus, int> n;
   for (const auto& s : case_states(db, study.name, retries)) ++n[s.status];
   std::printf(

@@ -16,6 +16,7 @@
 #include "driver/database.hpp"
 #include "driver/plan.hpp"
 #include "driver/replica_rounds.hpp"
+#include "driver/run_tree.hpp"
 #include "driver/scheduler.hpp"
 #include "driver/slurm.hpp"
 #include "driver/solver_process.hpp"
@@ -57,6 +58,7 @@ int study_run(const StudyRunOptions& opt) {
   // What Slurm tasks (study submit) left in the run folders; the cases still in Slurm jobs stay
   // theirs.
   const CollectResult collected = collect_run_folders(db, study, root);
+  update_run_tree(study, opt.db_path, root);
   if (collected.results > 0 || collected.attempts > 0 || collected.abandoned > 0)
     std::fprintf(stderr, "collected %d results and %d attempt ends, closed %d abandoned attempts\n",
                  collected.results, collected.attempts, collected.abandoned);
@@ -88,6 +90,7 @@ int study_run(const StudyRunOptions& opt) {
                  round.added.size(), round.precise, round.at_max);
     grown.cases.insert(grown.cases.end(), round.added.begin(), round.added.end());
     register_study(db, grown);
+    update_run_tree(grown, opt.db_path, root);
     auto more_states = case_states(db, grown.name, opt.retries);
     std::erase_if(more_states, [&](const CaseState& s) { return collected.in_slurm.count(s.id) > 0; });
     Scheduler more(db, grown, more_states, opt, root, solver);

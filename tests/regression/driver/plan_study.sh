@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # `study plan`: before any run it lists the cases as pending and creates no database; after the
 # study ran, each finished case's cost (its CPU time) predicted by the model fitted to the other
-# five (leave one out) is within 30 % of its measured cost; bad --jobs exits 2; `study run` prints the plan
-# line before it starts.
+# five (leave one out) is within 30 % of its measured cost; bad --jobs exits 2; `study run` prints
+# the plan line before it starts and writes the tree of readable names beside the run folders.
 #   plan_study.sh BOYCOTT_BIN STUDY.toml
 set -euo pipefail
 bin=$1; study=$2
@@ -20,6 +20,10 @@ if "$bin" study plan "$study" --jobs 0 > /dev/null 2>&1; then echo "--jobs 0 acc
 "$bin" case keys > /dev/null
 "$bin" study run "$study" --db "$db" --jobs 1 > /dev/null 2> "$work/run_err.txt"
 grep -q '^plan: 6 cases to run, estimated ' "$work/run_err.txt" || { cat "$work/run_err.txt"; exit 1; }
+# Beside the hash folders, a tree of readable names linking to them (one component per varied key).
+leaf="$db.names/plan_check/base/particles.volume_fraction=0.03/domain.cells=20,6,40/domain.height_z=0.04"
+[ -L "$leaf" ] && [ -f "$leaf/summary.json" ] || { echo "no run-tree link $leaf:"; find "$db.names"; exit 1; }
+[ "$(find "$db.names" -type l | wc -l)" -eq 6 ] || { echo "expected 6 links:"; find "$db.names"; exit 1; }
 "$bin" study plan "$study" --db "$db" --check-model --format json > "$work/plan.json"
 python3 - "$work/plan.json" <<'PY'
 import json, sys

@@ -1,0 +1,76 @@
+#include "driver/run_tree.hpp"
+
+#include <cstdio>
+#include <cstdlib>
+#include <system_error>
+
+#include <fmt/format.h>
+
+namespace fs = std::filesystem;
+
+namespace boycott::driver {
+
+namespace {
+/// A value as a path component: strings unquoted, arrays without spaces or brackets, and the
+/// characters a file name cannot hold replaced.
+std::string component_value(std::string v) {
+  if (v.size() >= 2 && v.front() == '"' && v.back() == '"') v = v.substr(1, v.size() - 2);
+  std::string out;
+  for (char ch : v) {
+    if (ch == ' ' || ch == '[' || ch == ']') continue;
+    out += (ch == '/' || ch == '\0') ? '_' : ch;
+  }
+  // TOML text of a double may carry the binary expansion (0.029999999999999999): print it as the
+  // shortest text that reads back the same.
+  char* end = nullptr;
+  const double d = std::strtod(out.c_str(), &end);
+  if (end != out.c_str() && *end == '\0' && out.find_first_of(".eE") != std::string::npos)
+    out = fmt::format("{}", d);
+  return out.empty() ? "_" : out;
+}
+}  // namespace
+
+fs::path names_root(const std::string& db_path) {
+  return fs::path(db_path + ".names");
+}
+
+fs::path case_name_path(const Study& study, const StudyCase& c) {
+  fs::path p = fs::path(component_value(study.name)) / component_value(c.group);
+  for (const auto& [key, value] : c.swept) p /= key + "=" + component_value(value);
+  if (c.replica > 0) p /= fmt::format("replica={}", c.replica);
+  return p;
+}
+
+int update_run_tree(const Study& study, const std::string& db_path, const fs::path& runs_root) {
+  int failed = 0;
+  const fs::path root = names_root(db_path);
+  for (const auto& c : study.cases) {
+    std::error_code ec;
+    fs::path leaf = root / case_name_path(study, c);
+    // A case with nothing varied is its group's only case: the group itself is the link.
+    if (c.swept.empty() && c.replica == 0)
+      leaf = root / component_value(study.name) / component_value(c.group);
+    const fs::path target =
+        fs::relative(fs::absolute(runs_root / c.id, ec), fs::absolute(leaf.parent_path(), ec), ec);
+    if (ec) {
+      ++failed;
+      continue;
+    }
+    if (fs::is_symlink(leaf, ec)) {
+      if (fs::read_symlink(leaf, ec) == target) continue;
+      fs::remove(leaf, ec);
+    } else if (fs::exists(leaf, ec)) {
+      ++failed;  // something that is not our link: left as it is
+      continue;
+    }
+    fs::create_directories(leaf.parent_path(), ec);
+    if (!ec) fs::create_directory_symlink(target, leaf, ec);
+    if (ec) ++failed;
+  }
+  if (failed > 0)
+    std::fprintf(stderr, "note: %d links of %s could not be written (the run folders are unaffected)\n",
+                 failed, root.c_str());
+  return failed;
+}
+
+}  // namespace boycott::driver
