@@ -74,16 +74,11 @@ SlurmAttempt upsert_task_attempt(Database& db, const TaskAttemptRecord& r) {
       if (st.step()) id = st.integer(0);
     }
     if (!id) {
+      // A new row with its case; the UPDATE below writes every other field, as for a known row.
       db.prepare(
-            "INSERT INTO attempts(case_id, started_at, host, ranks, program_version, run_dir, attempt_file) "
-            "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)")
+            "INSERT INTO attempts(case_id, started_at, host, ranks, program_version) VALUES (?1, '', '', 0, "
+            "'')")
           .bind(1, r.case_id)
-          .bind(2, r.started_at)
-          .bind(3, r.host)
-          .bind(4, r.ranks)
-          .bind(5, r.program_version)
-          .bind(6, r.run_dir)
-          .bind(7, r.file)
           .run();
       auto st = db.prepare("SELECT last_insert_rowid()");
       st.step();
