@@ -97,16 +97,17 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv) {
         std::fprintf(stderr, "warning: the PETSc option %s was given after -- but nothing used it\n",
                      o.c_str());
     return rc;
-  } catch (const StorageError& e) {
-    // Only the rank that writes (0) meets a failed write; on several ranks the others wait in
-    // the run's next collective, and finalizing would wait for them forever: say why and end
-    // them all with the storage error's code.
+  } catch (const std::exception& e) {
+    // On several ranks an error is most often met by one rank (the writer, or the one whose
+    // particles went wrong) while the others wait in the run's next collective: finalizing, or
+    // returning to main, would wait for them forever (seen under srun --mpi=pmix). Say why, on
+    // the rank that knows, and end them all with the error's own exit code.
     int size = 1;
     MPI_Comm_size(MPI_COMM_WORLD, &size);
     if (size == 1) throw;
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error (rank %d of %d): %s\n", rank, size, e.what());
     std::fflush(stderr);
-    MPI_Abort(MPI_COMM_WORLD, kExitStorageError);
+    MPI_Abort(MPI_COMM_WORLD, exit_code_of(e));
     throw;
   }
 }

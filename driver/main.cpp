@@ -28,26 +28,14 @@ namespace {
 int run_guarded(const std::function<int()>& fn) {
   try {
     return fn();
-  } catch (const boycott::InputError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return boycott::kExitInputError;
-  } catch (const boycott::PhysicsError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return boycott::kExitPhysicsError;
-  } catch (const boycott::CheckpointError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return boycott::kExitCheckpointError;
-  } catch (const boycott::StorageError& e) {
-    // A write failed (disk full, I/O error); the last good checkpoint is kept.
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return boycott::kExitStorageError;
   } catch (const boycott::driver::DatabaseError& e) {
     // An unusable database (unwritable path, newer schema) is bad input to the driver.
     std::fprintf(stderr, "error: %s\n", e.what());
     return boycott::kExitInputError;
   } catch (const std::exception& e) {
+    // A failed write (disk full, I/O error) keeps the last good checkpoint: StorageError, 74.
     std::fprintf(stderr, "error: %s\n", e.what());
-    return boycott::kExitFailure;
+    return boycott::exit_code_of(e);
   }
 }
 

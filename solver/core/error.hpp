@@ -42,4 +42,13 @@ class StorageError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The exit code that names an error's kind (kExitFailure for any other exception).
+inline int exit_code_of(const std::exception& e) {
+  if (dynamic_cast<const InputError*>(&e)) return kExitInputError;
+  if (dynamic_cast<const PhysicsError*>(&e)) return kExitPhysicsError;
+  if (dynamic_cast<const CheckpointError*>(&e)) return kExitCheckpointError;
+  if (dynamic_cast<const StorageError*>(&e)) return kExitStorageError;
+  return kExitFailure;
+}
+
 }  // namespace boycott

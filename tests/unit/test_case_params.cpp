@@ -207,3 +207,12 @@ TEST(CaseParams, OverridesUseTomlSyntax) {
   EXPECT_EQ(p.domain.cells[0], 20);
   EXPECT_THROW(apply_override(p, "nope.key=1"), InputError);
 }
+
+TEST(ExitCodes, EachErrorKindMapsToItsDocumentedCode) {
+  // Design brief section 7: 2 input, 3 physics, 4 checkpoint, 74 storage, 1 anything else.
+  EXPECT_EQ(exit_code_of(InputError("x")), 2);
+  EXPECT_EQ(exit_code_of(PhysicsError("x")), 3);
+  EXPECT_EQ(exit_code_of(CheckpointError("x")), 4);
+  EXPECT_EQ(exit_code_of(StorageError("x")), 74);
+  EXPECT_EQ(exit_code_of(std::runtime_error("x")), 1);
+}
