@@ -232,29 +232,32 @@ int run_case(CaseParams params, RunContext& ctx) {
   if (!pre.errors.empty()) throw InputError(pre.errors.front());
   if (!pre.machine_errors.empty()) throw InputError(pre.machine_errors.front());
   if (!ctx.branch_from.empty()) prepare_branch(params, ctx);
-  check_run_folder(ctx.out_dir, params);
-  if (already_complete(params, ctx)) return kExitOk;
+  // The folder is judged by rank 0 alone, and the others follow its answer: a rank that looked for
+  // itself while rank 0 wrote params.json would see only its temporary file, refuse the folder
+  // alone and leave rank 0 waiting in the barrier below forever. When rank 0 refuses it, the
+  // others wait in the broadcast until its error ends them all (case run's MPI_Abort).
+  int rank = 0;
+  if (initialized) MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  int complete = 0;
+  if (rank == 0) {
+    check_run_folder(ctx.out_dir, params);
+    complete = already_complete(params, ctx) ? 1 : 0;
+  }
+  if (initialized && ranks > 1) MPI_Bcast(&complete, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (complete != 0) return kExitOk;
   std::filesystem::create_directories(ctx.out_dir);
   const auto params_path = ctx.out_dir / "params.json";
   const auto canonical = to_json(params);
   {
     // Also over an existing one: the same case, perhaps with a raised time.end.
     // One writer: under mpirun every rank runs this, and they would race on the temporary file.
-    int rank = 0, initialized = 0;
-    MPI_Initialized(&initialized);
-    if (initialized) MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     if (rank == 0) write_file_atomic(params_path, canonical.dump(2) + "\n");
     if (initialized) MPI_Barrier(MPI_COMM_WORLD);
   }
-  {
-    int rank = 0, initialized = 0;
-    MPI_Initialized(&initialized);
-    if (initialized) MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-    if (rank == 0) {
-      write_file_atomic(ctx.out_dir / "preflight.json", pre.to_json().dump(2) + "\n");
-      if (!ctx.quiet)
-        for (const auto& w : pre.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-    }
+  if (rank == 0) {
+    write_file_atomic(ctx.out_dir / "preflight.json", pre.to_json().dump(2) + "\n");
+    if (!ctx.quiet)
+      for (const auto& w : pre.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   }
   return fn(params, ctx);
 }
