@@ -123,7 +123,7 @@ CoupledStep CoupledSystem::step() {
   st.dt_s = dt;
   coupler_->prepare(*dem_, *fluid_, dt_prev_);
   if (opt_.move_particles) {
-    for (int k = 0; k < st.dem_substeps; ++k) dem_->step();
+    dem_->advance(st.dem_substeps);
   } else {
     // A frozen bed takes the whole drag impulse beta (u_f - v) dt (it is held in place).
     auto& s = dem_->particles();

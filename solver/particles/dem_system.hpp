@@ -85,6 +85,10 @@ class DemSystem {
   void initialize();
   /// One velocity-Verlet step of dt.
   void step();
+  /// `count` velocity-Verlet steps of dt, as many calls of step() would make them (bit for bit),
+  /// with the closing half kick of each step, the opening one of the next and its drift fused
+  /// into one pass over the particle arrays.
+  void advance(int count);
   /// Rebuilds the neighbour list now (re-sorts and wraps; forces and histories are kept).
   void force_rebuild();
 
@@ -138,6 +142,12 @@ class DemSystem {
   void compute_forces();
   void kick(double h, bool predict);
   void drift();
+  /// The closing half kick h of a step, the next step's opening one with its prediction, and its
+  /// drift: kick(h, false); kick(h, true); drift() in one pass.
+  void kick_kick_drift(double h);
+  void copy_ghost_predictions();
+  /// After the drift: the list rebuilt or the ghosts refreshed, then the forces.
+  void advance_to_forces();
   bool needs_rebuild() const;
   void rebuild();
   void collect_histories();

@@ -55,7 +55,7 @@ double settle_bed(particles::DemSystem& dem, const CaseParams& p) {
   const int check_every = std::max(1, static_cast<int>(std::lround(0.01 / p.time.dt_dem_s)));
   double t = 0.0;
   while (t < 2.0) {
-    for (int k = 0; k < check_every; ++k) dem.step();
+    dem.advance(check_every);
     t += check_every * p.time.dt_dem_s;
     if (s.n_local == 0 || dem.kinetic_energy_j() / static_cast<double>(s.n_local) < threshold) break;
   }
