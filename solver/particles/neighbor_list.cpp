@@ -78,6 +78,15 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
     else
       offs[d] = {-1, 0, 1};
   }
+  // Each direction's neighbour coordinate for coordinate k and offset o at wrap[d][k + 1 + o]
+  // (-1 outside a wall): no integer division per particle and cell.
+  std::array<std::vector<int>, 3> wrap;
+  for (int d = 0; d < 3; ++d) {
+    wrap[d].resize(static_cast<std::size_t>(nc_[d]) + 2);
+    for (int k = -1; k <= nc_[d]; ++k)
+      wrap[d][static_cast<std::size_t>(k + 1)] =
+          g.periodic[d] ? (k + nc_[d]) % nc_[d] : (k < 0 || k >= nc_[d] ? -1 : k);
+  }
   offsets.assign(n + 1, 0);
   neighbors.clear();
   neighbors.reserve(n * 8);
@@ -89,42 +98,53 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
   bool by_cell = rows == n;
   for (std::size_t i = 0; i < n && by_cell; ++i)
     by_cell = cell_items_[i] == i && (i == 0 || cell_of_[i - 1] <= cell_of_[i]);
+  // The geometry as locals: through the BoxGeometry reference (which the list's own stores
+  // might alias) the compiler would divide by each length again for every distance test.
+  const double P0 = g.period(0), P1 = g.period(1), P2 = g.period(2);
+  const double iL0 = g.inv_len(0), iL1 = g.inv_len(1), iL2 = g.inv_len(2);
+  const double* __restrict X = s.x.data();
+  const double* __restrict Y = s.y.data();
+  const double* __restrict Z = s.z.data();
+  // The neighbour cells of the current particle's cell, in the scan order (z, y, x offsets);
+  // particles stored by cell share them with their predecessor.
+  int cached = -1;
+  int nb_cells[27];
+  int n_nb = 0;
   for (std::size_t i = 0; i < rows; ++i) {
     const int c = cell_of_[i];
-    const int cx = c % nc_[0], cy = (c / nc_[0]) % nc_[1], cz = c / (nc_[0] * nc_[1]);
-    for (int oz : offs[2]) {
-      int kz = cz + oz;
-      if (g.periodic[2])
-        kz = (kz + nc_[2]) % nc_[2];
-      else if (kz < 0 || kz >= nc_[2])
-        continue;
-      for (int oy : offs[1]) {
-        int ky = cy + oy;
-        if (g.periodic[1])
-          ky = (ky + nc_[1]) % nc_[1];
-        else if (ky < 0 || ky >= nc_[1])
-          continue;
-        for (int ox : offs[0]) {
-          int kx = cx + ox;
-          if (g.periodic[0])
-            kx = (kx + nc_[0]) % nc_[0];
-          else if (kx < 0 || kx >= nc_[0])
-            continue;
-          const int nb = kx + nc_[0] * (ky + nc_[1] * kz);
-          std::uint32_t q0 = cell_start_[nb];
-          if (by_cell) {
-            if (nb < c) continue;
-            if (nb == c) q0 = static_cast<std::uint32_t>(i + 1);
-          }
-          for (std::uint32_t q = q0; q < cell_start_[nb + 1]; ++q) {
-            const std::uint32_t j = cell_items_[q];
-            if (j <= i) continue;
-            const double dx = min_image(s.x[i] - s.x[j], g.period(0), g.inv_len(0));
-            const double dy = min_image(s.y[i] - s.y[j], g.period(1), g.inv_len(1));
-            const double dz = min_image(s.z[i] - s.z[j], g.period(2), g.inv_len(2));
-            if (dx * dx + dy * dy + dz * dz < cut2) neighbors.push_back(j);
+    if (c != cached) {
+      cached = c;
+      n_nb = 0;
+      const int cx = c % nc_[0], cy = (c / nc_[0]) % nc_[1], cz = c / (nc_[0] * nc_[1]);
+      for (int oz : offs[2]) {
+        const int kz = wrap[2][static_cast<std::size_t>(cz + 1 + oz)];
+        if (kz < 0) continue;
+        for (int oy : offs[1]) {
+          const int ky = wrap[1][static_cast<std::size_t>(cy + 1 + oy)];
+          if (ky < 0) continue;
+          for (int ox : offs[0]) {
+            const int kx = wrap[0][static_cast<std::size_t>(cx + 1 + ox)];
+            if (kx < 0) continue;
+            const int nb = kx + nc_[0] * (ky + nc_[1] * kz);
+            if (by_cell && nb < c) continue;
+            nb_cells[n_nb++] = nb;
           }
         }
+      }
+    }
+    const double xi = X[i], yi = Y[i], zi = Z[i];
+    for (int b = 0; b < n_nb; ++b) {
+      const int nb = nb_cells[b];
+      std::uint32_t q0 = cell_start_[nb];
+      if (by_cell && nb == c) q0 = static_cast<std::uint32_t>(i + 1);
+      const std::uint32_t q1 = cell_start_[nb + 1];
+      for (std::uint32_t q = q0; q < q1; ++q) {
+        const std::uint32_t j = cell_items_[q];
+        if (j <= i) continue;
+        const double dx = min_image(xi - X[j], P0, iL0);
+        const double dy = min_image(yi - Y[j], P1, iL1);
+        const double dz = min_image(zi - Z[j], P2, iL2);
+        if (dx * dx + dy * dy + dz * dz < cut2) neighbors.push_back(j);
       }
     }
     offsets[i + 1] = static_cast<std::uint32_t>(neighbors.size());
