@@ -47,7 +47,79 @@ void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const st
     for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p)
       pair_i_[p] = static_cast<std::uint32_t>(i);
   if (ida.empty()) return;
-  // Sorted (key, slot) table; only pairs that overlap now can carry a history (it is reset
+  if (!restore_histories_by_row(ida, idb, h)) restore_histories_by_key(ida, idb, h);
+}
+
+void DemSystem::restore_history(std::uint32_t p, std::size_t i, std::uint32_t j, const double* hq) {
+  // The carried history is seen from the lower id; the list slot sees it from its row i.
+  const double sg = s_.id[i] < s_.id[j] ? 1.0 : -1.0;
+  h_[3 * p] = sg * hq[0];
+  h_[3 * p + 1] = sg * hq[1];
+  h_[3 * p + 2] = sg * hq[2];
+  pair_mark_[p] = 1;
+  prev_contacts_.push_back(p);
+}
+
+bool DemSystem::restore_histories_by_row(const std::vector<std::int64_t>& ida,
+                                         const std::vector<std::int64_t>& idb, const std::vector<double>& h) {
+  // Each carried pair of ids goes to the list row it belongs to now (its lower storage index),
+  // by a counting sort in carried order; each list pair then scans its row's few entries. The
+  // rows are visited in storage (spatial) order, so this stays in cache where a global search
+  // table would miss on every lookup. Needs each stored id once (ghost images of one particle
+  // twice would be ambiguous) and ids of the order of the particle count.
+  const std::size_t n = s_.size();
+  constexpr std::uint32_t kNone = 0xffffffffu;
+  std::int64_t max_id = -1;
+  for (std::int64_t v : s_.id) max_id = std::max(max_id, v);
+  if (max_id < 0 || static_cast<std::uint64_t>(max_id) > 8 * static_cast<std::uint64_t>(n) + 1024)
+    return false;
+  slot_of_id_.assign(static_cast<std::size_t>(max_id) + 1, kNone);
+  for (std::size_t k = 0; k < n; ++k) {
+    std::uint32_t& slot = slot_of_id_[static_cast<std::size_t>(s_.id[k])];
+    if (slot != kNone) return false;
+    slot = static_cast<std::uint32_t>(k);
+  }
+  auto slot_of = [&](std::int64_t id) {
+    return id < 0 || id > max_id ? kNone : slot_of_id_[static_cast<std::size_t>(id)];
+  };
+  row_start_.assign(n + 1, 0);
+  for (std::size_t q = 0; q < ida.size(); ++q) {
+    const std::uint32_t a = slot_of(ida[q]), b = slot_of(idb[q]);
+    if (a != kNone && b != kNone) ++row_start_[std::min(a, b) + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) row_start_[i + 1] += row_start_[i];
+  row_partner_.resize(row_start_[n]);
+  row_entry_.resize(row_start_[n]);
+  {
+    std::vector<std::uint32_t>& fill = row_fill_;
+    fill.assign(row_start_.begin(), row_start_.end() - 1);
+    for (std::size_t q = 0; q < ida.size(); ++q) {
+      const std::uint32_t a = slot_of(ida[q]), b = slot_of(idb[q]);
+      if (a == kNone || b == kNone) continue;
+      const std::uint32_t at = fill[std::min(a, b)]++;
+      row_partner_[at] = std::max(a, b);
+      row_entry_[at] = static_cast<std::uint32_t>(q);
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t e0 = row_start_[i], e1 = row_start_[i + 1];
+    if (e0 == e1) continue;
+    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
+      const std::uint32_t j = nl_.neighbors[p];
+      // The first carried entry of this pair, as the search by key takes it.
+      std::uint32_t e = e0;
+      while (e < e1 && row_partner_[e] != j) ++e;
+      // Only pairs that overlap now keep a history (it is reset whenever a pair separates).
+      if (e == e1 || pair_overlap(i, j) <= 0.0) continue;
+      restore_history(p, i, j, &h[3 * static_cast<std::size_t>(row_entry_[e])]);
+    }
+  }
+  return true;
+}
+
+void DemSystem::restore_histories_by_key(const std::vector<std::int64_t>& ida,
+                                         const std::vector<std::int64_t>& idb, const std::vector<double>& h) {
+  // Sorted (key, entry) table; only pairs that overlap now can carry a history (it is reset
   // whenever a pair separates), so only those are looked up.
   std::vector<std::pair<std::uint64_t, std::uint32_t>> table(ida.size());
   for (std::size_t q = 0; q < ida.size(); ++q)
@@ -61,12 +133,7 @@ void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const st
       const std::uint64_t key = pair_key(std::min(a, b), std::max(a, b));
       auto it = std::lower_bound(table.begin(), table.end(), std::pair<std::uint64_t, std::uint32_t>{key, 0});
       if (it == table.end() || it->first != key) continue;
-      const double sg = a < b ? 1.0 : -1.0;
-      h_[3 * p] = sg * h[3 * it->second];
-      h_[3 * p + 1] = sg * h[3 * it->second + 1];
-      h_[3 * p + 2] = sg * h[3 * it->second + 2];
-      pair_mark_[p] = 1;
-      prev_contacts_.push_back(p);
+      restore_history(p, i, j, &h[3 * static_cast<std::size_t>(it->second)]);
     }
 }
 

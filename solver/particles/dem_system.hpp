@@ -162,6 +162,13 @@ class DemSystem {
   void predict_velocities();
   void restore_histories(const std::vector<std::int64_t>& ida, const std::vector<std::int64_t>& idb,
                          const std::vector<double>& h);
+  /// The fast way (false when it cannot be used) and the general one; the same result.
+  bool restore_histories_by_row(const std::vector<std::int64_t>& ida, const std::vector<std::int64_t>& idb,
+                                const std::vector<double>& h);
+  void restore_histories_by_key(const std::vector<std::int64_t>& ida, const std::vector<std::int64_t>& idb,
+                                const std::vector<double>& h);
+  /// List slot p (row i, partner j) takes the carried history hq (3 values, seen from the lower id).
+  void restore_history(std::uint32_t p, std::size_t i, std::uint32_t j, const double* hq);
 
   DemConfig cfg_;
   SlabDecomposition dd_;
@@ -195,6 +202,9 @@ class DemSystem {
   std::vector<std::vector<std::uint32_t>> prev_wall_contacts_;
   std::vector<std::uint32_t> wall_contact_;
   std::vector<std::int64_t> carry_a_, carry_b_;
+  // Scratch of restore_histories_by_row: storage slot of each id, and the carried entries per
+  // list row (partner slot, entry index).
+  std::vector<std::uint32_t> slot_of_id_, row_start_, row_fill_, row_partner_, row_entry_;
   std::vector<double> carry_h_;
   double time_ = 0.0;
   std::int64_t steps_ = 0, rebuilds_ = 0, contacts_ = 0;
