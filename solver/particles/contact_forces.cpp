@@ -45,6 +45,37 @@ std::size_t find_contacts(std::size_t np, const std::uint32_t* __restrict pair_i
   return nc;
 }
 
+/// The particles [0, n) closer to wall W than their radius, appended to wc; returns their number.
+/// Like find_contacts: a branch-free test into a byte per particle (vectorised), then the
+/// append. A wall normal to a coordinate axis (every wall of the scenes) reads that coordinate
+/// only: (x - px) 0 + (y - py) ny + (z - pz) 0 is (y - py) ny for finite coordinates, up to the
+/// sign of a zero, which neither the test nor the overlap r - dist sees.
+std::size_t find_wall_contacts(std::size_t n, const PlaneWall& W, const double* __restrict x,
+                               const double* __restrict y, const double* __restrict z,
+                               const double* __restrict rad, std::uint8_t* __restrict flag,
+                               std::uint32_t* __restrict wc) {
+  const int axis = W.nx != 0.0 && W.ny == 0.0 && W.nz == 0.0   ? 0
+                   : W.nx == 0.0 && W.ny != 0.0 && W.nz == 0.0 ? 1
+                   : W.nx == 0.0 && W.ny == 0.0 && W.nz != 0.0 ? 2
+                                                               : -1;
+  if (axis >= 0) {
+    const double* __restrict c = axis == 0 ? x : axis == 1 ? y : z;
+    const double p = axis == 0 ? W.px : axis == 1 ? W.py : W.pz;
+    const double nrm = axis == 0 ? W.nx : axis == 1 ? W.ny : W.nz;
+    for (std::size_t i = 0; i < n; ++i) flag[i] = (c[i] - p) * nrm < rad[i];
+  } else {
+    const double nx = W.nx, ny = W.ny, nz = W.nz, wpx = W.px, wpy = W.py, wpz = W.pz;
+    for (std::size_t i = 0; i < n; ++i)
+      flag[i] = (x[i] - wpx) * nx + (y[i] - wpy) * ny + (z[i] - wpz) * nz < rad[i];
+  }
+  std::size_t nw = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    wc[nw] = static_cast<std::uint32_t>(i);
+    nw += flag[i];
+  }
+  return nw;
+}
+
 using FindContactsFn = std::size_t (*)(std::size_t, const std::uint32_t*, const std::uint32_t*, const double*,
                                        const double*, const double*, const double*,
                                        const std::array<double, 3>&, std::uint8_t*, std::uint32_t*,
@@ -204,6 +235,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   // Local particles only: a ghost's wall contact is its own rank's.
   const std::size_t nloc = s_.n_local;
   wall_contact_.resize(nloc);
+  if (pair_flag_.size() < nloc) pair_flag_.resize(nloc);
   prev_wall_contacts_.resize(cfg_.walls.size());
   std::uint32_t* __restrict wc = wall_contact_.data();
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
@@ -212,12 +244,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
     double* __restrict whx = whx_[w].data();
     double* __restrict why = why_[w].data();
     double* __restrict whz = whz_[w].data();
-    std::size_t nw = 0;
-    for (std::size_t i = 0; i < nloc; ++i) {
-      const double dist = (x[i] - wpx) * nx + (y[i] - wpy) * ny + (z[i] - wpz) * nz;
-      wc[nw] = static_cast<std::uint32_t>(i);
-      nw += dist < rad[i];
-    }
+    const std::size_t nw = find_wall_contacts(nloc, W, x, y, z, rad, pair_flag_.data(), wc);
     for (std::uint32_t i : prev_wall_contacts_[w]) {
       const double dist = (x[i] - wpx) * nx + (y[i] - wpy) * ny + (z[i] - wpz) * nz;
       if (dist >= rad[i]) whx[i] = why[i] = whz[i] = 0.0;
