@@ -2,7 +2,8 @@
 // d = 0.6 mm, Table III contacts, theta = 65 deg, dt = 20 us, 0.05 x 0.006 x 0.05 m, Stokes drag
 // F = -3 pi mu d v against still water. Inserts, settles 5000 steps untimed, times 20000 steps,
 // and prints ns per particle-step (the same measure as the LIGGGHTS script).
-// Usage: bench_dem [nsettle] [nrun]
+// Usage: bench_dem [nsettle] [nrun] [KEY=VALUE ...]   (case keys of dem_only.toml changed, e.g.
+//        particles.count=120000 domain.length_x=0.2 domain.height_z=0.1 for the full box)
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +17,7 @@ int main(int argc, char** argv) {
   const long nsettle = argc > 1 ? std::atol(argv[1]) : 5000;
   const long nrun = argc > 2 ? std::atol(argv[2]) : 20000;
   CaseParams p = parse_case_file(BOYCOTT_SOURCE_DIR "/studies/cases/dem_only.toml");
+  for (int a = 3; a < argc; ++a) apply_override(p, argv[a]);
   validate(p);
   auto dc = particles::DemConfig::from_case(p);
   dc.dry = true;  // as the dem_only scene runs it
