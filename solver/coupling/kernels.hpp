@@ -9,7 +9,9 @@
 // from the cell weights: face f, between cells f-1 and f, gets (w(f-1) + w(f))/2. That is exactly
 // the transpose of how the fluid solver forms alpha_f on a face (the mean of its two cells), so a
 // force computed from a face field with these weights cancels the fluid's own alpha-weighted term
-// to round-off (momentum test), and it reproduces linear fields exactly like trilinear sampling.
+// to round-off (momentum test). Away from the walls it reproduces linear fields exactly, like
+// trilinear sampling; near a wall the folded weights ignore the no-slip rule, so sampling with
+// them ("kernel") is not exact there (sampling.hpp has the wall-aware "trilinear").
 #include <cmath>
 #include <string>
 
