@@ -1,10 +1,11 @@
 #pragma once
-// The correlation curve <<w_p>>(theta) and r_acc(theta) as text and as an SVG in the layout of
-// Zeng et al. (2021) Fig. 14: settling velocity (left) and acceleration ratio (right) vs angle.
+// The correlation curve <<w_p>>(theta) and r_acc(theta) as text and as a plot (SVG, PDF or PNG) in the layout
+// of Zeng et al. (2021) Fig. 14: settling velocity (left) and acceleration ratio (right) vs angle.
 #include <string>
 #include <vector>
 
 #include "driver/paper_reference.hpp"
+#include "driver/plot_cairo.hpp"
 #include "driver/store.hpp"
 
 namespace boycott::driver {
@@ -15,8 +16,10 @@ CurveFormat parse_curve_format(const std::string& s);
 std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f);
 /// Both panels, one line per group with error bars (capped), each replica as a faint dot; with
 /// `paper`, the values Zeng et al. (2021) state (driver/paper_reference.hpp) as hollow diamonds.
-std::string curve_svg(const std::vector<CurvePoint>& pts, const std::string& title,
-                      const std::vector<PaperValue>* paper = nullptr);
+/// Drawn with Cairo as SVG, PDF or PNG (driver/plot_cairo.hpp).
+plot::Plot curve_plot(const std::vector<CurvePoint>& pts, const std::string& title,
+                      const std::vector<PaperValue>* paper = nullptr,
+                      plot::Format format = plot::Format::kSvg);
 
 std::string format_cases(const std::vector<CaseState>& cases);
 

@@ -201,7 +201,9 @@ int main(int argc, char** argv) {
   qcurve->add_option("--study", q_study, "study name")->required();
   qcurve->add_option("--group", q_group, "only this group");
   qcurve->add_option("--format", q_format, "table, csv or json")->capture_default_str();
-  qcurve->add_option("--plot", q_plot, "also draw the curves (SVG, like Fig. 14 of the paper)");
+  qcurve->add_option(
+      "--plot", q_plot,
+      "also draw the curves (like Fig. 14 of the paper): PDF for FILE.pdf, PNG for FILE.png, SVG otherwise");
   bool q_overlay_paper = false;
   qcurve->add_flag("--overlay-paper", q_overlay_paper,
                    "with --plot: also the values the paper states (studies/reference/zeng2021.csv)");
@@ -219,7 +221,9 @@ int main(int argc, char** argv) {
   qwork->add_option("--reference", q_reference, "group holding the reference runs, one per angle")
       ->capture_default_str();
   qwork->add_option("--format", q_format, "table, csv or json")->capture_default_str();
-  qwork->add_option("--plot", q_plot, "also draw |error| against wall time (SVG, log-log)");
+  qwork->add_option(
+      "--plot", q_plot,
+      "also draw |error| against wall time (log-log): PDF for FILE.pdf, PNG for FILE.png, SVG otherwise");
   auto* qcases = query_cmd->add_subcommand("cases", "list cases and their status");
   qcases->add_option("--db", q_db, "results database")->required();
   qcases->add_option("--study", q_study, "only this study");
@@ -271,7 +275,7 @@ int main(int argc, char** argv) {
     return run_guarded([&] {
       const auto fmt_kind = boycott::driver::parse_curve_format(q_format);
       if (q_overlay_paper && q_plot.empty())
-        throw boycott::InputError("--overlay-paper draws on the plot: give --plot FILE.svg too");
+        throw boycott::InputError("--overlay-paper draws on the plot: give --plot FILE.svg (or .pdf) too");
       auto db = open_for_query(q_db);
       const auto pts = boycott::driver::query_curve(db, q_study, q_group);
       if (pts.empty())
@@ -279,10 +283,12 @@ int main(int argc, char** argv) {
                                               q_group.empty() ? "" : " group '" + q_group + "'", q_db));
       std::fputs(boycott::driver::format_curve(pts, fmt_kind).c_str(), stdout);
       if (!q_plot.empty()) {
-        std::ofstream out(q_plot);
         const auto paper = boycott::driver::parse_paper_values(boycott::driver::paper_reference_csv());
-        out << boycott::driver::curve_svg(pts, fmt::format("study {}", q_study),
-                                          q_overlay_paper ? &paper : nullptr);
+        const auto plot = boycott::driver::curve_plot(pts, fmt::format("study {}", q_study),
+                                                      q_overlay_paper ? &paper : nullptr,
+                                                      boycott::driver::plot::format_of_path(q_plot));
+        std::ofstream out(q_plot, std::ios::binary);
+        out << plot.data;
         if (!out) throw std::runtime_error(fmt::format("cannot write '{}'", q_plot));
       }
       return 0;
@@ -306,9 +312,11 @@ int main(int argc, char** argv) {
                         q_reference, q_db));
       std::fputs(boycott::driver::format_work_precision(wp, fmt_kind).c_str(), stdout);
       if (!q_plot.empty()) {
-        std::ofstream out(q_plot);
-        out << boycott::driver::work_precision_svg(
-            wp, fmt::format("study {}: error against run time (reference group '{}')", q_study, q_reference));
+        const auto plot = boycott::driver::work_precision_plot(
+            wp, fmt::format("study {}: error against run time (reference group '{}')", q_study, q_reference),
+            boycott::driver::plot::format_of_path(q_plot));
+        std::ofstream out(q_plot, std::ios::binary);
+        out << plot.data;
         if (!out) throw std::runtime_error(fmt::format("cannot write '{}'", q_plot));
       }
       return 0;

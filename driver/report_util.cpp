@@ -56,37 +56,6 @@ const char* marker_kind(std::size_t i) {
   return kMarks[i % 4];
 }
 
-std::string marker(const char* kind, double x, double y, const char* color, bool hollow) {
-  const std::string k = kind;
-  const std::string paint = hollow ? fmt::format("fill='white' stroke='{}' stroke-width='1.5'", color)
-                                   : fmt::format("fill='{}'", color);
-  if (k == "circle") return fmt::format("<circle cx='{:.1f}' cy='{:.1f}' r='4' {}/>", x, y, paint);
-  if (k == "square")
-    return fmt::format("<rect x='{:.1f}' y='{:.1f}' width='8' height='8' {}/>", x - 4, y - 4, paint);
-  if (k == "diamond")
-    return fmt::format("<polygon points='{:.1f},{:.1f} {:.1f},{:.1f} {:.1f},{:.1f} {:.1f},{:.1f}' {}/>", x,
-                       y - 5, x + 5, y, x, y + 5, x - 5, y, paint);
-  return fmt::format("<polygon points='{:.1f},{:.1f} {:.1f},{:.1f} {:.1f},{:.1f}' {}/>", x, y - 5, x + 5,
-                     y + 4, x - 5, y + 4, paint);
-}
-
-std::string xml_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '<')
-      o += "&lt;";
-    else if (c == '>')
-      o += "&gt;";
-    else if (c == '&')
-      o += "&amp;";
-    else if (c == '\'')
-      o += "&apos;";
-    else
-      o += c;
-  }
-  return o;
-}
-
 std::string csv_field(const std::string& s) {
   if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
   std::string o = "\"";

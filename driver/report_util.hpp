@@ -1,6 +1,6 @@
 #pragma once
-// Small pieces shared by the query reports (curve, validation, work-precision): hand-written SVG
-// (no plotting dependency on a cluster node), CSV quoting and aligned text tables.
+// Small pieces shared by the query reports (curve, validation, work-precision): axis ticks and
+// series styles for the plots (drawn by driver/plot_cairo.hpp), CSV quoting and aligned text tables.
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,11 +19,6 @@ std::vector<double> log_ticks(double lo, double hi);
 /// Line colour and marker kind of the i-th series, cycling.
 const char* color(std::size_t i);
 const char* marker_kind(std::size_t i);
-/// An SVG marker centred on (x, y); hollow: white inside, coloured outline (used to flag points
-/// that are not where their value is, e.g. clamped to a log axis floor).
-std::string marker(const char* kind, double x, double y, const char* color, bool hollow = false);
-
-std::string xml_escape(const std::string& s);
 /// A CSV field, quoted when it holds a comma, quote or line break (e.g. domain.cells=[200, 6, 100]).
 std::string csv_field(const std::string& s);
 

@@ -231,8 +231,8 @@ std::string setting_label(const std::vector<SweptValue>& v) {
 
 }  // namespace
 
-std::string work_precision_svg(const WorkPrecision& wp, const std::string& title) {
-  using report::xml_escape;
+plot::Plot work_precision_plot(const WorkPrecision& wp, const std::string& title, plot::Format format) {
+  using plot::Anchor;
   constexpr double kFloor = kWorkPrecisionErrorFloor;
   std::vector<std::string> groups;
   std::vector<double> angles;
@@ -276,116 +276,91 @@ std::string work_precision_svg(const WorkPrecision& wp, const std::string& title
     return y0 + h - (std::log10(e) - std::log10(ylo)) / (std::log10(yhi) - std::log10(ylo)) * h;
   };
 
-  std::string s = fmt::format(
-      "<svg xmlns='http://www.w3.org/2000/svg' width='{0:.0f}' height='{1:.0f}' font-family='sans-serif' "
-      "font-size='13'>\n<rect width='{0:.0f}' height='{1:.0f}' fill='white'/>\n",
-      width, height);
-  s += fmt::format("<text x='{:.1f}' y='24' text-anchor='middle' font-size='15'>{}</text>\n",
-                   (90 + angles.size() * (w + gap) - gap) / 2 + 45, xml_escape(title));
-  for (std::size_t a = 0; a < angles.size(); ++a) {
-    const double angle = angles[a], x0 = 90 + a * (w + gap);
-    auto px = [&](double t) {
-      return x0 + (std::log10(t) - std::log10(xlo)) / (std::log10(xhi) - std::log10(xlo)) * w;
-    };
-    s += fmt::format(
-        "<clipPath id='frame{0}'><rect x='{1}' y='{2}' width='{3}' height='{4}'/></clipPath>\n"
-        "<rect class='panel' data-angle='{5:g}' x='{1}' y='{2}' width='{3}' height='{4}' fill='none' "
-        "stroke='black'/>\n<text x='{6:.1f}' y='{7:.1f}' text-anchor='middle'>θ = {5:g}°</text>\n",
-        a, x0, y0, w, h, angle, x0 + w / 2, y0 - 8);
-    for (double t : report::log_ticks(xlo, xhi))
-      s += fmt::format(
-          "<line x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' stroke='#ddd'/><text x='{0:.1f}' "
-          "y='{3:.1f}' text-anchor='middle'>{4:g}</text>\n",
-          px(t), y0, y0 + h, y0 + h + 18, t);
-    for (double e : report::log_ticks(ylo, yhi))
-      s += fmt::format(
-          "<line x1='{0:.1f}' y1='{1:.1f}' x2='{2:.1f}' y2='{1:.1f}' stroke='#ddd'/><text x='{3:.1f}' "
-          "y='{4:.1f}' text-anchor='end'>{5:g}</text>\n",
-          x0, py(e), x0 + w, x0 - 6, py(e) + 4, e);
-    s += fmt::format("<text x='{:.1f}' y='{:.1f}' text-anchor='middle'>wall time (s)</text>\n", x0 + w / 2,
-                     y0 + h + 40);
-    if (a == 0)
-      s += fmt::format(
-          "<text transform='translate({:.1f},{:.1f}) rotate(-90)' text-anchor='middle'>|⟨⟨w_p⟩⟩ / "
-          "⟨⟨w_p⟩⟩_ref − 1| (dimensionless)</text>\n",
-          x0 - 62, y0 + h / 2);
-    bool any_floor = false;
-    for (const auto& r : wp.rows)
-      if (r.angle_deg == angle && plotted(r) && std::abs(r.rel_error_w) < kFloor) any_floor = true;
-    if (any_floor)
-      s += fmt::format(
-          "<line class='floor' x1='{0:.1f}' y1='{1:.1f}' x2='{2:.1f}' y2='{1:.1f}' stroke='#999' "
-          "stroke-dasharray='2,3'/>\n",
-          x0, py(kFloor), x0 + w);
-    // The reference run's cost: how much cheaper each point is than the run it is measured against.
-    for (const auto& r : wp.references) {
-      if (r.angle_deg != angle || !r.wall_time_s || *r.wall_time_s <= 0) continue;
-      const double x = px(*r.wall_time_s);
-      s += fmt::format(
-          "<line class='reference' data-angle='{3:g}' x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' "
-          "stroke='#555' stroke-dasharray='6,4'/><text transform='translate({4:.1f},{5:.1f}) rotate(-90)' "
-          "font-size='11' fill='#555'>{6}</text>\n",
-          x, y0, y0 + h, r.angle_deg, x - 4, y0 + h - 6, xml_escape(wp.reference_group));
-    }
-    for (std::size_t g = 0; g < groups.size(); ++g) {
-      const char* color = report::color(g);
-      const char* kind = report::marker_kind(g);
-      std::vector<const WorkPrecisionRow*> mine;
-      for (const auto& r : wp.rows)
-        if (r.group == groups[g] && r.angle_deg == angle && plotted(r)) mine.push_back(&r);
-      if (mine.empty()) continue;
-      // Joined in the order of the varied setting, each point labelled with its value.
-      std::stable_sort(mine.begin(), mine.end(), [](const WorkPrecisionRow* p, const WorkPrecisionRow* q) {
-        return setting_before(p->setting, q->setting);
-      });
-      std::string line, bars, marks;
-      for (const auto* r : mine) {
-        const double e = std::abs(r->rel_error_w);
-        const bool at_floor = e < kFloor;
-        const double x = px(*r->wall_time_s), y = py(std::max(e, kFloor));
-        line += fmt::format("{:.1f},{:.1f} ", x, y);
-        if (r->rel_error_w_unc > 0) {
-          const double top = e + r->rel_error_w_unc, bottom = std::max(e - r->rel_error_w_unc, kFloor);
-          bars += fmt::format(
-              "<line x1='{0:.1f}' y1='{1:.1f}' x2='{0:.1f}' y2='{2:.1f}' stroke='{3}'/>"
-              "<line x1='{4:.1f}' y1='{2:.1f}' x2='{5:.1f}' y2='{2:.1f}' stroke='{3}'/>\n",
-              x, py(bottom), py(top), color, x - 4, x + 4);
-        }
-        marks += report::marker(kind, x, y, color, at_floor) + "\n";
-        const std::string label = setting_label(r->setting);
-        if (!label.empty())
-          marks +=
-              fmt::format("<text class='setting' x='{:.1f}' y='{:.1f}' font-size='10' fill='{}'>{}</text>\n",
-                          x + 6, y - 6, color, xml_escape(label));
+  return plot::render(width, height, format, [&](plot::Canvas& c) {
+    c.text((90 + angles.size() * (w + gap) - gap) / 2 + 45, 24, title, Anchor::kMiddle, 15);
+    for (std::size_t a = 0; a < angles.size(); ++a) {
+      const double angle = angles[a], x0 = 90 + a * (w + gap);
+      auto px = [&](double t) {
+        return x0 + (std::log10(t) - std::log10(xlo)) / (std::log10(xhi) - std::log10(xlo)) * w;
+      };
+      for (double t : report::log_ticks(xlo, xhi)) {
+        c.line(px(t), y0, px(t), y0 + h, "#ddd");
+        c.text(px(t), y0 + h + 18, fmt::format("{:g}", t), Anchor::kMiddle);
       }
-      s += fmt::format(
-          "<polyline class='group' data-group='{}' points='{}' fill='none' stroke='{}' "
-          "stroke-width='1.5'/>\n",
-          xml_escape(groups[g]), line, color);
-      if (!bars.empty())
-        s += fmt::format("<g class='errorbars' clip-path='url(#frame{})'>\n{}</g>\n", a, bars);
-      s += marks;
+      for (double e : report::log_ticks(ylo, yhi)) {
+        c.line(x0, py(e), x0 + w, py(e), "#ddd");
+        c.text(x0 - 6, py(e) + 4, fmt::format("{:g}", e), Anchor::kEnd);
+      }
+      c.stroke_rect(x0, y0, w, h, "#000", "panel");
+      c.text(x0 + w / 2, y0 - 8, fmt::format("θ = {:g}°", angle), Anchor::kMiddle);
+      c.text(x0 + w / 2, y0 + h + 40, "wall time (s)", Anchor::kMiddle);
+      if (a == 0)
+        c.text(x0 - 62, y0 + h / 2, "|⟨⟨w_p⟩⟩ / ⟨⟨w_p⟩⟩_ref − 1| (dimensionless)", Anchor::kMiddle, 13,
+               "#000", true);
+      bool any_floor = false;
+      for (const auto& r : wp.rows)
+        if (r.angle_deg == angle && plotted(r) && std::abs(r.rel_error_w) < kFloor) any_floor = true;
+      if (any_floor) c.line(x0, py(kFloor), x0 + w, py(kFloor), "#999", 1.0, {2, 3}, "floor");
+      // The reference run's cost: how much cheaper each point is than the run it is measured against.
+      for (const auto& r : wp.references) {
+        if (r.angle_deg != angle || !r.wall_time_s || *r.wall_time_s <= 0) continue;
+        const double x = px(*r.wall_time_s);
+        c.line(x, y0, x, y0 + h, "#555", 1.0, {6, 4}, "reference");
+        c.text(x - 4, y0 + h - 6, wp.reference_group, Anchor::kStart, 11, "#555", true);
+      }
+      for (std::size_t g = 0; g < groups.size(); ++g) {
+        const char* color = report::color(g);
+        const char* kind = report::marker_kind(g);
+        std::vector<const WorkPrecisionRow*> mine;
+        for (const auto& r : wp.rows)
+          if (r.group == groups[g] && r.angle_deg == angle && plotted(r)) mine.push_back(&r);
+        if (mine.empty()) continue;
+        // Joined in the order of the varied setting, each point labelled with its value.
+        std::stable_sort(mine.begin(), mine.end(), [](const WorkPrecisionRow* p, const WorkPrecisionRow* q) {
+          return setting_before(p->setting, q->setting);
+        });
+        auto at = [&](const WorkPrecisionRow* r) {
+          return std::pair{px(*r->wall_time_s), py(std::max(std::abs(r->rel_error_w), kFloor))};
+        };
+        std::vector<std::pair<double, double>> line;
+        for (const auto* r : mine) line.push_back(at(r));
+        c.polyline(line, color, 1.5, "group");
+        // Error bars are clipped to the panel's frame.
+        c.clip(x0, y0, w, h);
+        for (const auto* r : mine) {
+          if (r->rel_error_w_unc <= 0) continue;
+          const double e = std::abs(r->rel_error_w), x = at(r).first;
+          const double top = e + r->rel_error_w_unc, bottom = std::max(e - r->rel_error_w_unc, kFloor);
+          c.line(x, py(bottom), x, py(top), color, 1.0, {}, "errorbar");
+          c.line(x - 4, py(top), x + 4, py(top), color);
+        }
+        c.unclip();
+        for (const auto* r : mine) {
+          const auto [x, y] = at(r);
+          c.marker(kind, x, y, color, std::abs(r->rel_error_w) < kFloor);
+          const std::string label = setting_label(r->setting);
+          if (!label.empty()) c.text(x + 6, y - 6, label, Anchor::kStart, 10, color, false, "setting");
+        }
+      }
     }
-  }
 
-  // Legend, right of the panels.
-  const double lx = 90 + angles.size() * (w + gap) - gap + 20;
-  double ly = y0 + 10;
-  for (std::size_t g = 0; g < groups.size(); ++g, ly += 20)
-    s += fmt::format("{}<text x='{:.1f}' y='{:.1f}'>{}</text>\n",
-                     report::marker(report::marker_kind(g), lx + 8, ly, report::color(g)), lx + 20, ly + 4,
-                     xml_escape(groups[g]));
-  s += fmt::format(
-      "<line x1='{0:.1f}' y1='{1:.1f}' x2='{2:.1f}' y2='{1:.1f}' stroke='#555' stroke-dasharray='6,4'/>"
-      "<text x='{3:.1f}' y='{4:.1f}'>reference wall time</text>\n",
-      lx, ly, lx + 16, lx + 20, ly + 4);
-  ly += 20;
-  if (std::any_of(wp.rows.begin(), wp.rows.end(),
-                  [&](const WorkPrecisionRow& r) { return plotted(r) && std::abs(r.rel_error_w) < kFloor; }))
-    s += fmt::format("{}<text x='{:.1f}' y='{:.1f}'>|error| &lt; {:g}, drawn at {:g}</text>\n",
-                     report::marker("circle", lx + 8, ly, "#555", true), lx + 20, ly + 4, kFloor, kFloor);
-  s += "</svg>\n";
-  return s;
+    // Legend, right of the panels.
+    const double lx = 90 + angles.size() * (w + gap) - gap + 20;
+    double ly = y0 + 10;
+    for (std::size_t g = 0; g < groups.size(); ++g, ly += 20) {
+      c.marker(report::marker_kind(g), lx + 8, ly, report::color(g));
+      c.text(lx + 20, ly + 4, groups[g], Anchor::kStart, 13, "#000", false, "legend");
+    }
+    c.line(lx, ly, lx + 16, ly, "#555", 1.0, {6, 4});
+    c.text(lx + 20, ly + 4, "reference wall time");
+    ly += 20;
+    if (std::any_of(wp.rows.begin(), wp.rows.end(), [&](const WorkPrecisionRow& r) {
+          return plotted(r) && std::abs(r.rel_error_w) < kFloor;
+        })) {
+      c.marker("circle", lx + 8, ly, "#555", true);
+      c.text(lx + 20, ly + 4, fmt::format("|error| < {:g}, drawn at {:g}", kFloor, kFloor));
+    }
+  });
 }
 
 }  // namespace boycott::driver

@@ -10,6 +10,7 @@
 
 #include "driver/curve.hpp"
 #include "driver/database.hpp"
+#include "driver/plot_cairo.hpp"
 #include "driver/store.hpp"
 
 namespace boycott::driver {
@@ -57,7 +58,9 @@ std::string format_work_precision(const WorkPrecision& wp, CurveFormat f);
 inline constexpr double kWorkPrecisionErrorFloor = 1e-6;
 /// Log-log |rel_error_w| against wall time, one panel per angle: one colour and marker per group,
 /// its points joined in the order of the varied setting and labelled with its value, error bars
-/// clipped to the frame, the reference's wall time as a dashed vertical line.
-std::string work_precision_svg(const WorkPrecision& wp, const std::string& title);
+/// clipped to the frame, the reference's wall time as a dashed vertical line. Drawn with Cairo as
+/// SVG, PDF or PNG (driver/plot_cairo.hpp).
+plot::Plot work_precision_plot(const WorkPrecision& wp, const std::string& title,
+                               plot::Format format = plot::Format::kSvg);
 
 }  // namespace boycott::driver

@@ -172,13 +172,26 @@ TEST(StudyRun, RunsEveryCaseOnceAndQueryCurveMatchesTheCaseSummaries) {
   for (const auto& p : curve)
     EXPECT_NEAR(p["r_acc"].get<double>(), p["mean_settling_velocity_m_s"].get<double>() / w90[p["group"]],
                 1e-12);
+  // The plot as SVG (drawn by Cairo: strokes and glyphs as paths), of the curve's size.
   const auto svg = read(d.path / "c.svg");
-  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
-  // One polyline per group in each of the two panels.
-  std::size_t lines = 0;
-  for (auto pos = svg.find("<polyline"); pos != std::string::npos; pos = svg.find("<polyline", pos + 1))
-    ++lines;
-  EXPECT_EQ(lines, 4u);
+  const auto root = svg.find("<svg");
+  ASSERT_NE(root, std::string::npos) << svg.substr(0, 200);
+  const auto head = svg.substr(root, svg.find('>', root) - root);
+  EXPECT_NE(head.find("width=\"1000px\""), std::string::npos) << head;
+  EXPECT_NE(head.find("height=\"440px\""), std::string::npos) << head;
+  EXPECT_NE(svg.rfind("</svg>"), std::string::npos);
+  std::size_t paths = 0;
+  for (auto pos = svg.find("<path"); pos != std::string::npos; pos = svg.find("<path", pos + 1)) ++paths;
+  EXPECT_GT(paths, 20u);
+  // --plot FILE.pdf: the same drawing as PDF.
+  const auto qpdf = run({"query", "curve", "--db", db.string(), "--study", "small", "--plot",
+                         (d.path / "c.pdf").string(), "--overlay-paper"},
+                        d.path);
+  ASSERT_EQ(qpdf.rc, 0) << qpdf.err;
+  const auto pdf = read(d.path / "c.pdf");
+  EXPECT_EQ(pdf.rfind("%PDF-", 0), 0u);
+  EXPECT_GT(pdf.size(), 2000u);
+  EXPECT_NE(pdf.find("%%EOF"), std::string::npos);
 
   // A second run has nothing to do.
   const auto again = run(study_run(d.path / "s.toml", db), d.path);

@@ -7,10 +7,13 @@
 #include <filesystem>
 #include <map>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
+#include "driver/curve.hpp"
 #include "driver/database.hpp"
+#include "driver/plot_cairo.hpp"
 #include "driver/store.hpp"
 #include "driver/study.hpp"
 #include "driver/validation_query.hpp"
@@ -227,38 +230,102 @@ seed = [1, 2]
   for (const auto& id : ref_ids) EXPECT_NE(msg.find(id), std::string::npos) << msg;
 }
 
-TEST(WorkPrecision, SvgHasAPanelPerAngleALinePerGroupInEachAndFlagsZeroErrors) {
+// Occurrences of `needle` in `s`.
+std::size_t count_in(const std::string& s, const std::string& needle) {
+  std::size_t n = 0;
+  for (auto p = s.find(needle); p != std::string::npos; p = s.find(needle, p + 1)) ++n;
+  return n;
+}
+
+// A Cairo SVG document of the given size in CSS pixels, with strokes and text (glyphs) drawn.
+void expect_svg(const std::string& svg, int width, int height) {
+  const auto root = svg.find("<svg");
+  ASSERT_NE(root, std::string::npos) << svg.substr(0, 200);
+  EXPECT_EQ(svg.find_first_not_of(" \n"), svg.rfind("<?xml", 0) == 0 ? 0u : root);
+  const auto head = svg.substr(root, svg.find('>', root) - root);
+  EXPECT_NE(head.find("xmlns=\"http://www.w3.org/2000/svg\""), std::string::npos) << head;
+  EXPECT_NE(head.find(fmt::format("width=\"{}px\"", width)), std::string::npos) << head;
+  EXPECT_NE(head.find(fmt::format("height=\"{}px\"", height)), std::string::npos) << head;
+  EXPECT_EQ(svg.substr(svg.find_last_not_of(" \n") - 5, 6), "</svg>");
+  EXPECT_EQ(count_in(svg, "<"), count_in(svg, ">"));  // every tag closed
+  EXPECT_GT(count_in(svg, "<path"), 20u);             // lines, markers, glyph outlines
+  EXPECT_GT(count_in(svg, "<use"), 20u);              // the glyphs of the text, placed
+}
+
+TEST(WorkPrecision, PlotHasAPanelPerAngleALinePerGroupInEachAndFlagsZeroErrors) {
   TempDir d;
   bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
   const auto study = bd::expand_study_string(kWorkPrecisionStudy);
   bd::register_study(db, study);
   record(db, study, kRuns);
-  const auto svg = bd::work_precision_svg(bd::query_work_precision(db, "wp"), "wp & co");
-  auto count = [&](const std::string& needle) {
-    std::size_t n = 0;
-    for (auto p = svg.find(needle); p != std::string::npos; p = svg.find(needle, p + 1)) ++n;
-    return n;
-  };
-  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
-  EXPECT_EQ(svg.substr(svg.size() - 7), "</svg>\n");
-  EXPECT_EQ(count("<"), count(">"));        // every tag closed, text escaped
-  EXPECT_EQ(count("class='panel'"), 2u);    // one per angle
-  EXPECT_EQ(count("data-angle='65'"), 2u);  // its panel and its reference line
-  EXPECT_EQ(count("<polyline"), 4u);        // one per group in each panel
-  EXPECT_EQ(count("data-group='dt_dem'"), 2u);
-  EXPECT_EQ(count("data-group='cells'"), 2u);
-  EXPECT_EQ(count("class='reference'"), 2u);  // one per angle
-  // Error bars are clipped to their panel's frame.
-  EXPECT_EQ(count("<clipPath"), 2u);
-  EXPECT_EQ(count("clip-path='url(#frame"), count("class='errorbars'"));
+  const auto wp = bd::query_work_precision(db, "wp");
+  const auto plot = bd::work_precision_plot(wp, "wp & co");
+  expect_svg(plot.data, 90 + 2 * 440 + 170, 490);  // two angles
+  EXPECT_EQ(plot.count("panel"), 2);               // one per angle
+  EXPECT_TRUE(plot.has_text("θ = 65°"));
+  EXPECT_TRUE(plot.has_text("θ = 90°"));
+  EXPECT_EQ(plot.count("group"), 4);  // one line per group in each panel
+  EXPECT_EQ(plot.count("legend"), 2);
+  EXPECT_TRUE(plot.has_text("dt_dem"));
+  EXPECT_TRUE(plot.has_text("cells"));
+  EXPECT_EQ(plot.count("reference"), 2);  // one per angle
+  EXPECT_EQ(plot.count("errorbar"), 4);   // every point: both runs have an error
   // Each point is labelled with the value of its group's setting.
-  EXPECT_EQ(count("class='setting'"), 4u);
-  EXPECT_NE(svg.find(">4e-05</text>"), std::string::npos);
-  EXPECT_NE(svg.find("wp &amp; co"), std::string::npos);
-  EXPECT_NE(svg.find("wall time (s)"), std::string::npos);
-  // cells at 65 deg equals the reference: drawn hollow on the floor of the log axis.
-  EXPECT_EQ(count("class='floor'"), 1u);
-  EXPECT_NE(svg.find("fill='white' stroke="), std::string::npos);
+  EXPECT_EQ(plot.count("setting"), 4);
+  EXPECT_TRUE(plot.has_text("4e-05"));
+  EXPECT_TRUE(plot.has_text("wp & co"));
+  EXPECT_TRUE(plot.has_text("wall time (s)"));
+  // cells at 65 deg equals the reference: drawn hollow on the floor of the log axis (and keyed).
+  EXPECT_EQ(plot.count("floor"), 1);
+  EXPECT_EQ(plot.count("hollow marker"), 2);
+  EXPECT_EQ(plot.count("marker"), 5);  // the other three points, the groups' keys
+
+  // The same drawing as PDF.
+  const auto pdf = bd::work_precision_plot(wp, "wp & co", bd::plot::Format::kPdf);
+  EXPECT_EQ(pdf.data.rfind("%PDF-", 0), 0u);
+  EXPECT_GT(pdf.data.size(), 2000u);
+  EXPECT_NE(pdf.data.find("%%EOF"), std::string::npos);
+  EXPECT_EQ(pdf.drawn, plot.drawn);
+  EXPECT_EQ(pdf.texts, plot.texts);
+}
+
+TEST(CurvePlot, DrawsBothPanelsWithErrorBarsReplicasAndThePaperOverlayAsSvgPdfAndPng) {
+  std::vector<bd::CurvePoint> pts;
+  for (const double angle : {45.0, 90.0}) {
+    bd::CurvePoint p;
+    p.group = "Ga";
+    p.angle_deg = angle;
+    p.w_m_s = angle == 90.0 ? -0.02 : -0.03;
+    p.w_err_m_s = 0.001;
+    p.n_replicas = 3;
+    p.replica_w_m_s = {p.w_m_s - 0.001, p.w_m_s, p.w_m_s + 0.001};
+    p.r_acc = p.w_m_s / -0.02;
+    p.r_acc_err = 0.05;
+    pts.push_back(p);
+  }
+  const std::vector<bd::PaperValue> paper = {{"Ga", 60.0, "r_acc", 1.4, "Fig. 14"},
+                                             {"Ga", std::nullopt, "r_acc", 1.6, "text"}};
+  const auto plot = bd::curve_plot(pts, "study <s>", &paper);
+  expect_svg(plot.data, 1000, 440);
+  EXPECT_EQ(plot.count("panel"), 2);
+  EXPECT_EQ(plot.count("group"), 2);     // one line per series in each panel
+  EXPECT_EQ(plot.count("errorbar"), 4);  // each point in each panel
+  EXPECT_EQ(plot.count("replica"), 12);  // 3 replicas x 2 points x 2 panels
+  EXPECT_EQ(plot.count("paper"), 2);     // both r_acc values, on the right panel only
+  EXPECT_EQ(plot.count("legend"), 2);    // the series and the paper
+  EXPECT_TRUE(plot.has_text("study <s>"));
+  EXPECT_TRUE(plot.has_text("inclination angle θ (deg)"));
+  EXPECT_TRUE(plot.has_text("faint dots: replicas (seeds); error bars: their standard error of the mean"));
+
+  const auto pdf = bd::curve_plot(pts, "study <s>", &paper, bd::plot::format_of_path("c.PDF"));
+  EXPECT_EQ(pdf.data.rfind("%PDF-", 0), 0u);
+  EXPECT_GT(pdf.data.size(), 2000u);
+  EXPECT_EQ(pdf.drawn, plot.drawn);
+  const auto png = bd::curve_plot(pts, "study <s>", &paper, bd::plot::format_of_path("c.png"));
+  EXPECT_EQ(png.data.rfind("\x89PNG\r\n\x1a\n", 0), 0u);
+  EXPECT_GT(png.data.size(), 2000u);
+  EXPECT_EQ(bd::plot::format_of_path("c.svg"), bd::plot::Format::kSvg);
+  EXPECT_EQ(bd::plot::format_of_path("pdf"), bd::plot::Format::kSvg);
 }
 
 TEST(ValidationQuery, RowsListExactlyTheStoredErrorKeysWithTheirValues) {
