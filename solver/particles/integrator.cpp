@@ -14,18 +14,24 @@ namespace {
 /// read once and (M + h beta) is inverted once per particle; restrict-qualified parameters let
 /// GCC vectorise it. Predict: also write 2 v_new - v_old to p; Track: accumulate the drag
 /// impulse in J; Wet: read the fluid arrays (F_ext, u_f, m_add), which a dry kick leaves out.
-template <bool Predict, bool Track, bool Wet>
-void kick_loop(std::size_t n, double h, double gx, double gy, double gz, const double* __restrict m,
-               const double* __restrict ma, const double* __restrict b, const double* __restrict fx,
-               const double* __restrict fy, const double* __restrict fz, const double* __restrict ex,
-               const double* __restrict ey, const double* __restrict ez, const double* __restrict ux,
-               const double* __restrict uy, const double* __restrict uz, double* __restrict vx,
-               double* __restrict vy, double* __restrict vz, double* __restrict Jx, double* __restrict Jy,
-               double* __restrict Jz, double* __restrict px, double* __restrict py, double* __restrict pz) {
+/// Fused (between two steps of a sub-cycle): the closing half kick of a step, then the opening
+/// one of the next with its prediction, then its drift x += dt v, in one pass instead of three.
+/// Both kicks see the same forces, so the acceleration and (M + h beta)^-1 are formed once; each
+/// value is the same expression, in the same order, as in the separate passes: the results are
+/// bit for bit theirs.
+template <bool Predict, bool Track, bool Wet, bool Fused>
+void kick_loop(std::size_t n, double h, double dt, double gx, double gy, double gz,
+               const double* __restrict m, const double* __restrict ma, const double* __restrict b,
+               const double* __restrict fx, const double* __restrict fy, const double* __restrict fz,
+               const double* __restrict ex, const double* __restrict ey, const double* __restrict ez,
+               const double* __restrict ux, const double* __restrict uy, const double* __restrict uz,
+               double* __restrict vx, double* __restrict vy, double* __restrict vz, double* __restrict Jx,
+               double* __restrict Jy, double* __restrict Jz, double* __restrict px, double* __restrict py,
+               double* __restrict pz, double* __restrict x, double* __restrict y, double* __restrict z) {
+  static_assert(!Fused || Predict, "the fused pass opens a step: it predicts");
   for (std::size_t i = 0; i < n; ++i) {
     // Dry (!Wet): F_ext, u_f and m_add are zero and not read (DemConfig::dry).
     const double M = Wet ? m[i] + ma[i] : m[i], bi = b[i], inv_D = 1.0 / (M + h * bi);
-    const double v0x = vx[i], v0y = vy[i], v0z = vz[i];
     double ax = fx[i], ay = fy[i], az = fz[i];
     if constexpr (Wet) {
       ax += ex[i];
@@ -40,6 +46,20 @@ void kick_loop(std::size_t n, double h, double gx, double gy, double gz, const d
       ay += bi * uy[i];
       az += bi * uz[i];
     }
+    double v0x = vx[i], v0y = vy[i], v0z = vz[i];
+    double jx = 0.0, jy = 0.0, jz = 0.0;
+    if constexpr (Track) jx = Jx[i], jy = Jy[i], jz = Jz[i];
+    if constexpr (Fused) {
+      // The closing half kick of the step that ends here.
+      v0x = (M * v0x + h * ax) * inv_D;
+      v0y = (M * v0y + h * ay) * inv_D;
+      v0z = (M * v0z + h * az) * inv_D;
+      if constexpr (Track) {
+        jx += h * bi * (ux[i] - v0x);
+        jy += h * bi * (uy[i] - v0y);
+        jz += h * bi * (uz[i] - v0z);
+      }
+    }
     const double v1x = (M * v0x + h * ax) * inv_D;
     const double v1y = (M * v0y + h * ay) * inv_D;
     const double v1z = (M * v0z + h * az) * inv_D;
@@ -47,27 +67,37 @@ void kick_loop(std::size_t n, double h, double gx, double gy, double gz, const d
     vy[i] = v1y;
     vz[i] = v1z;
     if constexpr (Track) {
-      Jx[i] += h * bi * (ux[i] - v1x);
-      Jy[i] += h * bi * (uy[i] - v1y);
-      Jz[i] += h * bi * (uz[i] - v1z);
+      Jx[i] = jx + h * bi * (ux[i] - v1x);
+      Jy[i] = jy + h * bi * (uy[i] - v1y);
+      Jz[i] = jz + h * bi * (uz[i] - v1z);
     }
     if constexpr (Predict) {
       px[i] = 2.0 * v1x - v0x;
       py[i] = 2.0 * v1y - v0y;
       pz[i] = 2.0 * v1z - v0z;
     }
+    if constexpr (Fused) {
+      x[i] += dt * v1x;
+      y[i] += dt * v1y;
+      z[i] += dt * v1z;
+    }
   }
 }
 
-/// Spin half kick, w += h T / I, with the prediction as above.
-template <bool Predict>
+/// Spin half kick, w += h T / I, with the prediction as above; Fused: two of them.
+template <bool Predict, bool Fused>
 void kick_spin(std::size_t n, double h, const double* __restrict I, const double* __restrict tx,
                const double* __restrict ty, const double* __restrict tz, double* __restrict wx,
                double* __restrict wy, double* __restrict wz, double* __restrict px, double* __restrict py,
                double* __restrict pz) {
   for (std::size_t i = 0; i < n; ++i) {
     const double h_I = h / I[i];
-    const double w0x = wx[i], w0y = wy[i], w0z = wz[i];
+    double w0x = wx[i], w0y = wy[i], w0z = wz[i];
+    if constexpr (Fused) {
+      w0x = w0x + h_I * tx[i];
+      w0y = w0y + h_I * ty[i];
+      w0z = w0z + h_I * tz[i];
+    }
     const double w1x = w0x + h_I * tx[i], w1y = w0y + h_I * ty[i], w1z = w0z + h_I * tz[i];
     wx[i] = w1x;
     wy[i] = w1y;
@@ -80,112 +110,19 @@ void kick_spin(std::size_t n, double h, const double* __restrict I, const double
   }
 }
 
-/// Between two steps of one sub-cycle: the closing half kick of a step, the opening half kick of
-/// the next (with its prediction) and its drift, in one pass over the arrays instead of three.
-/// Both kicks see the same forces, so the acceleration and (M + h beta)^-1 are formed once; each
-/// value is the same expression, in the same order, as in kick_loop and drift: results are bit
-/// for bit those of the separate passes.
-template <bool Track, bool Wet>
-void kick_kick_drift_loop(std::size_t n, double h, double dt, double gx, double gy, double gz,
-                          const double* __restrict m, const double* __restrict ma, const double* __restrict b,
-                          const double* __restrict fx, const double* __restrict fy,
-                          const double* __restrict fz, const double* __restrict ex,
-                          const double* __restrict ey, const double* __restrict ez,
-                          const double* __restrict ux, const double* __restrict uy,
-                          const double* __restrict uz, double* __restrict vx, double* __restrict vy,
-                          double* __restrict vz, double* __restrict Jx, double* __restrict Jy,
-                          double* __restrict Jz, double* __restrict px, double* __restrict py,
-                          double* __restrict pz, double* __restrict x, double* __restrict y,
-                          double* __restrict z) {
-  for (std::size_t i = 0; i < n; ++i) {
-    const double M = Wet ? m[i] + ma[i] : m[i], bi = b[i], inv_D = 1.0 / (M + h * bi);
-    double ax = fx[i], ay = fy[i], az = fz[i];
-    if constexpr (Wet) {
-      ax += ex[i];
-      ay += ey[i];
-      az += ez[i];
-    }
-    ax += m[i] * gx;
-    ay += m[i] * gy;
-    az += m[i] * gz;
-    if constexpr (Wet) {
-      ax += bi * ux[i];
-      ay += bi * uy[i];
-      az += bi * uz[i];
-    }
-    const double v1x = (M * vx[i] + h * ax) * inv_D;
-    const double v1y = (M * vy[i] + h * ay) * inv_D;
-    const double v1z = (M * vz[i] + h * az) * inv_D;
-    const double v2x = (M * v1x + h * ax) * inv_D;
-    const double v2y = (M * v1y + h * ay) * inv_D;
-    const double v2z = (M * v1z + h * az) * inv_D;
-    vx[i] = v2x;
-    vy[i] = v2y;
-    vz[i] = v2z;
-    if constexpr (Track) {
-      double jx = Jx[i], jy = Jy[i], jz = Jz[i];
-      jx += h * bi * (ux[i] - v1x);
-      jy += h * bi * (uy[i] - v1y);
-      jz += h * bi * (uz[i] - v1z);
-      jx += h * bi * (ux[i] - v2x);
-      jy += h * bi * (uy[i] - v2y);
-      jz += h * bi * (uz[i] - v2z);
-      Jx[i] = jx;
-      Jy[i] = jy;
-      Jz[i] = jz;
-    }
-    px[i] = 2.0 * v2x - v1x;
-    py[i] = 2.0 * v2y - v1y;
-    pz[i] = 2.0 * v2z - v1z;
-    x[i] += dt * v2x;
-    y[i] += dt * v2y;
-    z[i] += dt * v2z;
-  }
-}
-
-/// The two spin half kicks of kick_kick_drift_loop.
-void kick_kick_spin(std::size_t n, double h, const double* __restrict I, const double* __restrict tx,
-                    const double* __restrict ty, const double* __restrict tz, double* __restrict wx,
-                    double* __restrict wy, double* __restrict wz, double* __restrict px,
-                    double* __restrict py, double* __restrict pz) {
-  for (std::size_t i = 0; i < n; ++i) {
-    const double h_I = h / I[i];
-    const double w1x = wx[i] + h_I * tx[i], w1y = wy[i] + h_I * ty[i], w1z = wz[i] + h_I * tz[i];
-    const double w2x = w1x + h_I * tx[i], w2y = w1y + h_I * ty[i], w2z = w1z + h_I * tz[i];
-    wx[i] = w2x;
-    wy[i] = w2y;
-    wz[i] = w2z;
-    px[i] = 2.0 * w2x - w1x;
-    py[i] = 2.0 * w2y - w1y;
-    pz[i] = 2.0 * w2z - w1z;
-  }
-}
-
-template <bool Track, bool Wet>
-void kick_kick_drift_all(std::size_t n, double h, double dt, const std::array<double, 3>& g, ParticleStore& s,
-                         std::vector<double>* pred) {
-  kick_kick_drift_loop<Track, Wet>(
-      n, h, dt, g[0], g[1], g[2], s.mass.data(), s.madd.data(), s.beta.data(), s.fx.data(), s.fy.data(),
-      s.fz.data(), s.ext_x.data(), s.ext_y.data(), s.ext_z.data(), s.ufx.data(), s.ufy.data(), s.ufz.data(),
-      s.vx.data(), s.vy.data(), s.vz.data(), s.drag_jx.data(), s.drag_jy.data(), s.drag_jz.data(),
-      pred[0].data(), pred[1].data(), pred[2].data(), s.x.data(), s.y.data(), s.z.data());
-  kick_kick_spin(n, h, s.inertia.data(), s.tx.data(), s.ty.data(), s.tz.data(), s.wx.data(), s.wy.data(),
-                 s.wz.data(), pred[3].data(), pred[4].data(), pred[5].data());
-}
-
-template <bool Predict, bool Track, bool Wet>
-void kick_all(std::size_t n, double h, const std::array<double, 3>& g, ParticleStore& s,
+template <bool Predict, bool Track, bool Wet, bool Fused = false>
+void kick_all(std::size_t n, double h, double dt, const std::array<double, 3>& g, ParticleStore& s,
               std::vector<double>* pred) {
   double* p[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
   if constexpr (Predict)
     for (int c = 0; c < 6; ++c) p[c] = pred[c].data();
-  kick_loop<Predict, Track, Wet>(n, h, g[0], g[1], g[2], s.mass.data(), s.madd.data(), s.beta.data(),
-                                 s.fx.data(), s.fy.data(), s.fz.data(), s.ext_x.data(), s.ext_y.data(),
-                                 s.ext_z.data(), s.ufx.data(), s.ufy.data(), s.ufz.data(), s.vx.data(),
-                                 s.vy.data(), s.vz.data(), s.drag_jx.data(), s.drag_jy.data(),
-                                 s.drag_jz.data(), p[0], p[1], p[2]);
-  kick_spin<Predict>(n, h, s.inertia.data(), s.tx.data(), s.ty.data(), s.tz.data(), s.wx.data(), s.wy.data(),
-                     s.wz.data(), p[3], p[4], p[5]);
+  kick_loop<Predict, Track, Wet, Fused>(
+      n, h, dt, g[0], g[1], g[2], s.mass.data(), s.madd.data(), s.beta.data(), s.fx.data(), s.fy.data(),
+      s.fz.data(), s.ext_x.data(), s.ext_y.data(), s.ext_z.data(), s.ufx.data(), s.ufy.data(), s.ufz.data(),
+      s.vx.data(), s.vy.data(), s.vz.data(), s.drag_jx.data(), s.drag_jy.data(), s.drag_jz.data(), p[0], p[1],
+      p[2], s.x.data(), s.y.data(), s.z.data());
+  kick_spin<Predict, Fused>(n, h, s.inertia.data(), s.tx.data(), s.ty.data(), s.tz.data(), s.wx.data(),
+                            s.wy.data(), s.wz.data(), p[3], p[4], p[5]);
 }
 }  // namespace
 
@@ -204,17 +141,17 @@ void DemSystem::kick(double h, bool predict) {
   const bool wet = !cfg_.dry || track;
   auto& g = cfg_.gravity_m_s2;
   if (predict && track)
-    kick_all<true, true, true>(n, h, g, s_, pred_);
+    kick_all<true, true, true>(n, h, 0.0, g, s_, pred_);
   else if (track)
-    kick_all<false, true, true>(n, h, g, s_, pred_);
+    kick_all<false, true, true>(n, h, 0.0, g, s_, pred_);
   else if (predict && wet)
-    kick_all<true, false, true>(n, h, g, s_, pred_);
+    kick_all<true, false, true>(n, h, 0.0, g, s_, pred_);
   else if (wet)
-    kick_all<false, false, true>(n, h, g, s_, pred_);
+    kick_all<false, false, true>(n, h, 0.0, g, s_, pred_);
   else if (predict)
-    kick_all<true, false, false>(n, h, g, s_, pred_);
+    kick_all<true, false, false>(n, h, 0.0, g, s_, pred_);
   else
-    kick_all<false, false, false>(n, h, g, s_, pred_);
+    kick_all<false, false, false>(n, h, 0.0, g, s_, pred_);
   if (predict) copy_ghost_predictions();
 }
 
@@ -232,11 +169,11 @@ void DemSystem::kick_kick_drift(double h) {
   const bool wet = !cfg_.dry || track;
   auto& g = cfg_.gravity_m_s2;
   if (track)
-    kick_kick_drift_all<true, true>(n, h, cfg_.dt_s, g, s_, pred_);
+    kick_all<true, true, true, true>(n, h, cfg_.dt_s, g, s_, pred_);
   else if (wet)
-    kick_kick_drift_all<false, true>(n, h, cfg_.dt_s, g, s_, pred_);
+    kick_all<true, false, true, true>(n, h, cfg_.dt_s, g, s_, pred_);
   else
-    kick_kick_drift_all<false, false>(n, h, cfg_.dt_s, g, s_, pred_);
+    kick_all<true, false, false, true>(n, h, cfg_.dt_s, g, s_, pred_);
   copy_ghost_predictions();
 }
 

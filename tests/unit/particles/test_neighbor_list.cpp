@@ -125,16 +125,19 @@ TEST(Insertion, NonOverlappingAndSeeded) {
   EXPECT_THROW(c.insert_random(2000, kR, kRho, {0, 0, 0}, {2e-3, 1.2e-3, 2.6e-3}, 1), std::exception);
 }
 
+/// A channel between walls at y = 0 and 3.6 mm under inclined gravity, with rolling friction.
+DemConfig channel_config() {
+  DemConfig c = gas_config(6e-3, 2e-5);
+  c.gravity_m_s2 = {0.0, -3.0, -8.0};
+  c.box.periodic = {true, false, true};
+  c.walls = {PlaneWall{0, 0, 0, 0, 1, 0}, PlaneWall{0, 3.6e-3, 0, 0, -1, 0}};
+  c.rolling_model = "constant_directional";
+  c.rolling_friction = 0.1;
+  return c;
+}
+
 TEST(DemState, ExportImportContinuesBitwise) {
-  auto make = [] {
-    DemConfig c = gas_config(6e-3, 2e-5);
-    c.gravity_m_s2 = {0.0, -3.0, -8.0};
-    c.box.periodic = {true, false, true};
-    c.walls = {PlaneWall{0, 0, 0, 0, 1, 0}, PlaneWall{0, 3.6e-3, 0, 0, -1, 0}};
-    c.rolling_model = "constant_directional";
-    c.rolling_friction = 0.1;
-    return c;
-  };
+  auto make = [] { return channel_config(); };
   DemSystem a(make());
   a.insert_random(300, kR, kRho, {0, 0, 0}, {6e-3, 3.6e-3, 7.8e-3}, 4);
   a.initialize();
@@ -156,12 +159,7 @@ TEST(DemSystem, FusedSubCycleEqualsSeparateStepsBitwise) {
   // a coupled sub-cycle (implicit drag, fluid force, added mass, drag impulse tracked) must
   // end where k calls of step() end, bit for bit, including the impulse owed to the fluid.
   auto make = [] {
-    DemConfig c = gas_config(6e-3, 2e-5);
-    c.gravity_m_s2 = {0.0, -3.0, -8.0};
-    c.box.periodic = {true, false, true};
-    c.walls = {PlaneWall{0, 0, 0, 0, 1, 0}, PlaneWall{0, 3.6e-3, 0, 0, -1, 0}};
-    c.rolling_model = "constant_directional";
-    c.rolling_friction = 0.1;
+    DemConfig c = channel_config();
     c.track_drag_impulse = true;
     DemSystem d(c);
     d.insert_random(300, kR, kRho, {0, 0, 0}, {6e-3, 3.6e-3, 7.8e-3}, 4);
