@@ -30,7 +30,15 @@ fi
 version=$("$cf" --version | grep -Eo 'version [0-9.]+' | head -1)
 
 if [ $# -gt 0 ]; then
-  files=("$@")  # relative to the caller's directory
+  # relative to the caller's directory; only C++ sources and headers (clang-format would also
+  # "format" a CMakeLists.txt or a script named here, and break it)
+  files=()
+  for f in "$@"; do
+    case "$f" in
+      *.cpp | *.hpp | *.h | *.cc) files+=("$f") ;;
+      *) echo "check_format: skipping $f (not a C++ file)" >&2 ;;
+    esac
+  done
 else
   cd "$root"
   mapfile -t files < <(find solver driver tests bench -type f \( -name '*.cpp' -o -name '*.hpp' \) |
