@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <regex>
 #include <stdexcept>
@@ -87,10 +88,23 @@ void write_index(const fs::path& dir, const GridSpec& g) {
   std::sort(files.begin(), files.end());
   std::string x = "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n";
   x += "<Grid Name=\"snapshots\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  std::vector<std::string> left_out;
   for (const auto& [idx, path] : files) {
     // A snapshot of the layout before particles/id (a run resumed across the change) is left out.
-    if (!CheckpointReader(path, CheckpointReader::Verify::kNo).has("particles/id")) continue;
+    if (!CheckpointReader(path, CheckpointReader::Verify::kNo).has("particles/id")) {
+      left_out.push_back(path.filename().string());
+      continue;
+    }
     x += index_entry(path, idx, g);
+  }
+  // Said once per run (the index is rewritten with every snapshot), not left for the user to find.
+  static bool told = false;
+  if (!left_out.empty() && !told) {
+    told = true;
+    std::fprintf(stderr,
+                 "note: %zu snapshot(s) of an older layout (no particles/id), first %s, are left out of %s; "
+                 "they stay readable with h5dump\n",
+                 left_out.size(), left_out.front().c_str(), (dir / "fields.xmf").c_str());
   }
   x += "</Grid>\n</Domain>\n</Xdmf>\n";
   write_file_atomic(dir / "fields.xmf", x);

@@ -18,6 +18,7 @@
 
 #include "core/case_params.hpp"
 #include "core/error.hpp"
+#include "io/checkpoint_file.hpp"
 #include "io/snapshot.hpp"
 #include "scenes/scene.hpp"
 
@@ -216,6 +217,41 @@ TEST(SnapshotFormat, WrittenSystemReadsBackInIdOrderWithVectorsAndStringNames) {
   EXPECT_NEAR(pos[2], 0.01 - 1e-6, 1e-15);  // id 0 wrapped to the top
   EXPECT_EQ(pos[3 * 2 + 1], 0.001);         // y (a wall-bounded axis) as it was
   EXPECT_EQ(time, std::vector<double>{1.0});
+}
+
+TEST(SnapshotFormat, OlderLayoutSnapshotIsLeftOutOfTheIndexWithANote) {
+  // A run resumed across the layout change holds snapshots without particles/id: the XDMF index
+  // cannot describe them, so they are left out, and the run says so instead of dropping them in
+  // silence.
+  GridSpec g;
+  g.n = {2, 2, 2};
+  g.length_m = {0.01, 0.006, 0.01};
+  g.periodic = {true, false, true};
+  io::SnapshotData d;
+  d.id = {0};
+  d.x = {0.001}, d.y = {0.001}, d.z = {0.001}, d.vx = {0}, d.vy = {0}, d.vz = {0};
+  d.wx = {0}, d.wy = {0}, d.wz = {0}, d.radius = {1e-4};
+  d.cell_fields.emplace_back("alpha_f", std::vector<double>(8, 1.0));
+  const fs::path dir = fs::temp_directory_path() / "boycott_snapshot_older_layout";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "snapshots");
+  {
+    // Complete and checksummed like every snapshot, but with positions and no particles/id.
+    io::CheckpointWriter w(dir / "snapshots" / "snap_00000.h5");
+    w.put("time", 0.1);
+    w.put_group("particles");
+    w.put_2d("particles/position", 1, 3, std::vector<double>{0.001, 0.001, 0.001});
+    w.commit();
+  }
+  d.time_s = 0.2;
+  testing::internal::CaptureStderr();
+  io::write_snapshot(dir, 1, d, g);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("older layout"), std::string::npos) << err;
+  EXPECT_NE(err.find("snap_00000.h5"), std::string::npos) << err;
+  const std::string xmf = slurp(dir / "snapshots" / "fields.xmf");
+  EXPECT_EQ(xmf.find("snap_00000.h5"), std::string::npos);
+  EXPECT_NE(xmf.find("snap_00001.h5"), std::string::npos);
 }
 
 TEST(SnapshotFormat, CoupledRunSnapshotsReadBackOnEveryRankCount) {
