@@ -100,7 +100,8 @@ print(json.dumps({"tag": sys.argv[2], "ranks": int(sys.argv[3]), "round": int(sy
                   "wall_s": float(sys.argv[5]), "interval_s": float(sys.argv[6]),
                   "particles": s["particle_count"], "dt_dem_s": s["dem_steps"] and
                   s["simulated_time_s"] / s["dem_steps"], "per_rank": s["ranks"]["per_rank"],
-                  "w_p": s.get("mean_settling_velocity_m_s")}))
+                  "w_p": s.get("mean_settling_velocity_m_s"),
+                  "rebuilds": s.get("neighbor_rebuilds_this_attempt")}))
 PY
       tail -1 "$results" | python3 -c "
 import json, sys
@@ -124,7 +125,8 @@ for r in rows:
         " ".join(f"{p['seconds'].get(k, 0.0):.1f}" for k in
                  ("fluid", "coupling_sample", "coupling_deposit", "dem_contacts", "neighbor_search",
                   "integration", "ghost_refresh", "waiting")) for p in r["per_rank"])
-    print(f"{r['tag']:9s} {r['ranks']:5d} {r['round']:5d} {r['wall_s'] / r['interval_s']:8.0f} {ns:20.1f}   {ph}")
+    rb = f"   DEM steps per list rebuild {steps / r['rebuilds']:.1f}" if r.get("rebuilds") else ""
+    print(f"{r['tag']:9s} {r['ranks']:5d} {r['round']:5d} {r['wall_s'] / r['interval_s']:8.0f} {ns:20.1f}   {ph}{rb}")
 for tag in sorted({r["tag"] for r in rows}):
     by = {}
     for r in rows:

@@ -244,6 +244,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   j["pressure_solver_fallbacks"] = run.pressure_fallbacks();
   j["unconverged_fluid_steps"] = run.unconverged_fluid_steps();
   j["dem_steps"] = run.dem().steps();
+  // Of this attempt only (the count restarts when a run resumes): with the DEM steps of the
+  // attempt it gives how often the neighbour list is rebuilt, which the cost depends on.
+  j["neighbor_rebuilds_this_attempt"] = run.dem().rebuilds();
   j["samples_averaged"] = wp_avg.count();
   j["resumed_from_checkpoint"] = resumed.has_value();
   j["pdf_outside_fraction"] = {{"y", pdf_y.total_ > 0 ? pdf_y.outside_ / pdf_y.total_ : 0.0},
