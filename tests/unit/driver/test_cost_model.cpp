@@ -1,0 +1,91 @@
+// The cost model of `study plan` on synthetic runs whose costs are known exactly: what the fit
+// recovers, which terms it drops, and the schedule of a study's wall time. The real-run check
+// (plan_study.sh) judges the model's form against the solver's measured CPU time; this one
+// judges the arithmetic, which a shared machine's timing noise cannot.
+#include <gtest/gtest.h>
+
+#include "driver/cost_model.hpp"
+
+namespace boycott::driver {
+namespace {
+
+MeasuredCost run(double particle_steps, double cell_steps, double core_s, const std::string& scene = "s") {
+  MeasuredCost m;
+  m.case_id = "c";
+  m.work.scene = scene;
+  m.work.particle_steps = particle_steps;
+  m.work.fluid_cell_steps = cell_steps;
+  m.core_s = core_s;
+  return m;
+}
+
+// Exactly linear costs: start 1.5 s, 200 ns per particle-step, 4 us per cell-step.
+double exact(double ps, double cs) {
+  return 1.5 + 200e-9 * ps + 4e-6 * cs;
+}
+
+TEST(CostModel, FitRecoversTheCoefficientsOfExactlyLinearCosts) {
+  std::vector<MeasuredCost> runs;
+  for (double ps : {1e7, 3e7, 8e7})
+    for (double cs : {2e5, 9e5}) runs.push_back(run(ps, cs, exact(ps, cs)));
+  const CostModel model(runs);
+  EXPECT_EQ(model.basis("s"), "fit to 6 runs");
+  CaseWork w{"s", 5e8, 4e6};  // far outside the fitted range: an error in a coefficient shows
+  EXPECT_NEAR(model.core_s(w), exact(5e8, 4e6), 1e-9 * exact(5e8, 4e6));
+  EXPECT_NEAR(model.core_s(CaseWork{"s", 0.0, 0.0}), 1.5, 1e-9);
+}
+
+TEST(CostModel, LeaveOneOutOfExactlyLinearCostsPredictsTheOneLeftOut) {
+  std::vector<MeasuredCost> runs;
+  for (double ps : {1e7, 3e7, 8e7})
+    for (double cs : {2e5, 9e5}) runs.push_back(run(ps, cs, exact(ps, cs)));
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    std::vector<MeasuredCost> others;
+    for (std::size_t j = 0; j < runs.size(); ++j)
+      if (j != k) others.push_back(runs[j]);
+    EXPECT_NEAR(CostModel(others).core_s(runs[k].work), runs[k].core_s, 1e-9 * runs[k].core_s) << k;
+  }
+}
+
+TEST(CostModel, ATermThatWouldBeNegativeIsDroppedAndTheRestRefitted) {
+  // Costs that fall with the cell-steps (-100 ns each): a negative coefficient is not a cost, so
+  // the fit keeps the start and particle terms only.
+  const auto cost = [](double ps, double cs) { return 1.0 + 1e-7 * ps - 1e-7 * cs; };
+  std::vector<MeasuredCost> runs = {run(1e7, 1e6, cost(1e7, 1e6)), run(2e7, 3e6, cost(2e7, 3e6)),
+                                    run(4e7, 2e6, cost(4e7, 2e6)), run(8e7, 5e5, cost(8e7, 5e5))};
+  const CostModel model(runs);
+  EXPECT_EQ(model.basis("s"), "fit to 4 runs");
+  EXPECT_NEAR(model.core_s(CaseWork{"s", 0.0, 1e9}), model.core_s(CaseWork{"s", 0.0, 0.0}), 1e-12);
+  EXPECT_GT(model.core_s(CaseWork{"s", 1e8, 0.0}), model.core_s(CaseWork{"s", 0.0, 0.0}));
+}
+
+TEST(CostModel, FewerThanThreeRunsScaleTheDefaultsByTheMeasuredRatio) {
+  const CaseWork w{"s", 1e8, 1e6};
+  const double by_default = CostModel({}).core_s(w);
+  EXPECT_EQ(CostModel({}).basis("s"), "default");
+  const CostModel twice({run(1e7, 1e5, 2.0 * CostModel({}).core_s(CaseWork{"s", 1e7, 1e5}))});
+  EXPECT_EQ(twice.basis("s"), "default scaled by 1 runs");
+  EXPECT_NEAR(twice.core_s(w), 2.0 * by_default, 1e-9 * by_default);
+}
+
+TEST(CostModel, ScenesAreFittedApart) {
+  std::vector<MeasuredCost> runs;
+  for (double ps : {1e7, 3e7, 8e7}) {
+    runs.push_back(run(ps, 0.0, 2.0 * exact(ps, 0.0), "a"));
+    runs.push_back(run(ps, 0.0, exact(ps, 0.0), "b"));
+  }
+  const CostModel model(runs);
+  const CaseWork a{"a", 5e7, 0.0}, b{"b", 5e7, 0.0};
+  EXPECT_NEAR(model.core_s(a), 2.0 * model.core_s(b), 1e-9 * model.core_s(a));
+}
+
+TEST(CostModel, StudyWallTimePlacesTheLongestCasesFirstOnTheSlotThatFreesFirst) {
+  // 6, 5, 4, 3 core-s on two single-core slots: {6, 3} and {5, 4} end at 9.
+  EXPECT_DOUBLE_EQ(study_wall_s({3.0, 4.0, 5.0, 6.0}, 2, 1), 9.0);
+  EXPECT_DOUBLE_EQ(study_wall_s({3.0, 4.0, 5.0, 6.0}, 1, 1), 18.0);
+  // Two ranks per case at efficiency 0.9: 18 core-s over 2 * 0.9 cores.
+  EXPECT_DOUBLE_EQ(study_wall_s({3.0, 4.0, 5.0, 6.0}, 1, 2), 18.0 / 1.8);
+}
+
+}  // namespace
+}  // namespace boycott::driver
