@@ -1,5 +1,6 @@
 #include "driver/run_tree.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <system_error>
@@ -37,7 +38,12 @@ fs::path names_root(const std::string& db_path) {
 fs::path case_name_path(const Study& study, const StudyCase& c) {
   fs::path p = fs::path(component_value(study.name)) / component_value(c.group);
   for (const auto& [key, value] : c.swept) p /= key + "=" + component_value(value);
-  if (c.replica > 0) p /= fmt::format("replica={}", c.replica);
+  // A point that has (or may grow) replicas is a folder of replica=<k> links, replica 0 included:
+  // a link for replica 0 at the point itself would stand where its replicas' folder must be.
+  const auto plan = study.replica_plans.find(c.group);
+  const bool replicated = c.replica > 0 || (plan != study.replica_plans.end() &&
+                                            std::max(plan->second.replicas, plan->second.max) > 1);
+  if (replicated) p /= fmt::format("replica={}", c.replica);
   return p;
 }
 
@@ -46,10 +52,10 @@ int update_run_tree(const Study& study, const std::string& db_path, const fs::pa
   const fs::path root = names_root(db_path);
   for (const auto& c : study.cases) {
     std::error_code ec;
-    fs::path leaf = root / case_name_path(study, c);
-    // A case with nothing varied is its group's only case: the group itself is the link.
-    if (c.swept.empty() && c.replica == 0)
-      leaf = root / component_value(study.name) / component_value(c.group);
+    // A case with nothing varied and no replicas is its group's only case: the group is the link.
+    const fs::path leaf = root / case_name_path(study, c);
+    // A tree written before the point had replicas holds a link where their folder goes now.
+    if (fs::is_symlink(leaf.parent_path(), ec)) fs::remove(leaf.parent_path(), ec);
     const fs::path target =
         fs::relative(fs::absolute(runs_root / c.id, ec), fs::absolute(leaf.parent_path(), ec), ec);
     if (ec) {

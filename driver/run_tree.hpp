@@ -1,6 +1,7 @@
 #pragma once
 // Readable names for the run folders: beside FILE.runs/<case_id>/, the tree FILE.names/<study>/
-// <group>/<key>=<value>/.../ (one component per varied key, then replica=<k> for replicas > 0)
+// <group>/<key>=<value>/.../ (one component per varied key, then replica=<k> where the group
+// runs replicas)
 // whose leaves are relative links to the case's run folder. Kept up to date by `study run` and
 // `study collect`; a convenience view: failing to write it never fails a study.
 #include <filesystem>
