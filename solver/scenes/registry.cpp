@@ -52,10 +52,12 @@ std::vector<std::string> registered_scenes() {
 namespace {
 
 /// What may be in a run folder before its first run: the driver's lock, case file and log, a
-/// Slurm task's attempt records, and checkpoints to start from (a folder prepared by hand).
+/// Slurm task's attempt records, checkpoints to start from (a folder prepared by hand), and the
+/// temporary of a params.json whose atomic write was cut short by a crash (incomplete by
+/// construction: the run writes params.json afresh over it).
 bool is_preparation_file(const std::string& name) {
   return name == ".lock" || name == "case.toml" || name == "solver.log" || name == "checkpoints" ||
-         name == "attempts" || name == "attempt.json";
+         name == "attempts" || name == "attempt.json" || name == "params.json.tmp";
 }
 
 /// Refuses an --out folder that is not this case's run folder (CheckpointError: exit 4): one that

@@ -128,6 +128,22 @@ TEST(RunFolder, WrittenBeforeAKeyWasAddedIsResumedButAnotherCaseIsRefused) {
   EXPECT_EQ(slurp(d / "summary.json"), before);
 }
 
+TEST(RunFolder, ParamsTemporaryLeftByACrashAtTheStartIsWrittenOver) {
+  // A crash during the first atomic write of params.json leaves params.json.tmp alone in the
+  // folder: the run starts there (it used to be refused as a folder of someone else's, exit 4).
+  const CaseParams p = small_case();
+  const fs::path d = fs::temp_directory_path() / "boycott_restart_paramstmp";
+  fs::remove_all(d);
+  fs::create_directories(d);
+  std::ofstream(d / "params.json.tmp") << "{\"scene\": \"inclined_sett";
+  ASSERT_EQ(run_in(p, d), kExitOk);
+  EXPECT_FALSE(fs::exists(d / "params.json.tmp"));
+  CaseParams resolved = p;
+  validate(resolved);
+  EXPECT_EQ(case_id(case_from_json(nlohmann::json::parse(slurp(d / "params.json")))), case_id(resolved));
+  EXPECT_EQ(summary(d)["status"], "completed");
+}
+
 TEST(BadCheckpoint, TruncatedFileIsRefusedAndLeftInPlace) {
   const CaseParams p = small_case();
   const fs::path d = fs::temp_directory_path() / "boycott_restart_trunc";
