@@ -42,7 +42,7 @@ CaseWork work_of(const StudyCase& c) {
 
 std::string swept_text(const StudyCase& c) {
   std::string s;
-  for (const auto& [k, v] : c.swept) s += (s.empty() ? "" : " ") + k + "=" + v;
+  for (const auto& [k, v] : c.swept) s += (s.empty() ? "" : " ") + k + "=" + readable_value(v);
   if (c.replica > 0) s += fmt::format("{}replica {}", s.empty() ? "" : " ", c.replica);
   return s.empty() ? "-" : s;
 }

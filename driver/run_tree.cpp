@@ -21,12 +21,7 @@ std::string component_value(std::string v) {
     if (ch == ' ' || ch == '[' || ch == ']') continue;
     out += (ch == '/' || ch == '\0') ? '_' : ch;
   }
-  // TOML text of a double may carry the binary expansion (0.029999999999999999): print it as the
-  // shortest text that reads back the same.
-  char* end = nullptr;
-  const double d = std::strtod(out.c_str(), &end);
-  if (end != out.c_str() && *end == '\0' && out.find_first_of(".eE") != std::string::npos)
-    out = fmt::format("{}", d);
+  out = readable_value(out);
   return out.empty() ? "_" : out;
 }
 }  // namespace
@@ -41,8 +36,8 @@ fs::path case_name_path(const Study& study, const StudyCase& c) {
   // A point that has (or may grow) replicas is a folder of replica=<k> links, replica 0 included:
   // a link for replica 0 at the point itself would stand where its replicas' folder must be.
   const auto plan = study.replica_plans.find(c.group);
-  const bool replicated = c.replica > 0 || (plan != study.replica_plans.end() &&
-                                            std::max(plan->second.replicas, plan->second.max) > 1);
+  // resolve_replicas guarantees max >= replicas.
+  const bool replicated = c.replica > 0 || (plan != study.replica_plans.end() && plan->second.max > 1);
   if (replicated) p /= fmt::format("replica={}", c.replica);
   return p;
 }

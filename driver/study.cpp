@@ -1,6 +1,7 @@
 #include "driver/study.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <set>
@@ -355,6 +356,14 @@ StudyCase replica_of(const StudyCase& replica0, int k) {
   validate(c.params);
   c.id = case_id(c.params);
   return c;
+}
+
+std::string readable_value(const std::string& toml_text) {
+  char* end = nullptr;
+  const double d = std::strtod(toml_text.c_str(), &end);
+  if (end != toml_text.c_str() && *end == '\0' && toml_text.find_first_of(".eE") != std::string::npos)
+    return fmt::format("{}", d);
+  return toml_text;
 }
 
 Study expand_study_file(const std::string& path) {

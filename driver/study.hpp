@@ -55,4 +55,9 @@ Study expand_study_file(const std::string& path);
 /// The case as a TOML case file (what `boycott case run` reads); parsing it gives the same id.
 std::string case_to_toml(const CaseParams& p);
 
+/// A swept value (TOML text) as people read it: a double's full binary expansion
+/// (0.80000000000000004) becomes the shortest text that reads back the same (0.8); anything else
+/// is returned as it is.
+std::string readable_value(const std::string& toml_text);
+
 }  // namespace boycott::driver

@@ -2,7 +2,7 @@
 # `study plan`: before any run it lists the cases as pending and creates no database; after the
 # study ran, each finished case's cost (its CPU time) predicted by the model fitted to the other
 # five (leave one out) is within 30 % of its measured cost in at least one of two identical
-# studies; bad --jobs exits 2; `study run` prints
+# studies; swept numbers are shown as written; bad --jobs exits 2; `study run` prints
 # the plan line before it starts and writes the tree of readable names beside the run folders.
 #   plan_study.sh BOYCOTT_BIN STUDY.toml
 set -euo pipefail
@@ -14,6 +14,8 @@ db=$work/plan.db
 grep -q '6 cases, 6 to run' "$work/plan0.txt" || { cat "$work/plan0.txt"; exit 1; }
 grep -q 'cost model inclined_settling: default' "$work/plan0.txt" || { cat "$work/plan0.txt"; exit 1; }
 [ ! -e "$db" ] || { echo "study plan created a database"; exit 1; }
+# Swept numbers as written, not as their binary expansion (0.029999999999999999).
+grep -q 'particles.volume_fraction=0.03 ' "$work/plan0.txt" || { cat "$work/plan0.txt"; exit 1; }
 if "$bin" study plan "$study" --jobs 0 > /dev/null 2>&1; then echo "--jobs 0 accepted"; exit 1; else rc=$?; fi
 [ "$rc" -eq 2 ] || { echo "--jobs 0 exited $rc, not 2"; exit 1; }
 # One case at a time, so that the measured costs are not two runs sharing the cores; a tiny run

@@ -341,3 +341,14 @@ TEST(StudyReplicas, ATargetStartsWithTwoReplicasUpToTenByDefault) {
   EXPECT_EQ(r.params.seed, s.cases[0].params.seed + 7);
   EXPECT_EQ(r.point_id, s.cases[0].id);
 }
+
+TEST(StudyExpansion, SweptDoublesReadAsTheShortestTextThatReadsBackTheSame) {
+  EXPECT_EQ(bd::readable_value("0.80000000000000004"), "0.8");
+  EXPECT_EQ(bd::readable_value("0.029999999999999999"), "0.03");
+  EXPECT_EQ(bd::readable_value("1.0000000000000001e-05"), "1e-05");
+  EXPECT_EQ(bd::readable_value("0.1234567890123"), "0.1234567890123");
+  // Integers, strings and arrays are left as they are.
+  EXPECT_EQ(bd::readable_value("65"), "65");
+  EXPECT_EQ(bd::readable_value("\"kernel\""), "\"kernel\"");
+  EXPECT_EQ(bd::readable_value("[20, 6, 40]"), "[20, 6, 40]");
+}
