@@ -14,6 +14,7 @@
 #include "core/constants.hpp"
 #include "core/error.hpp"
 #include "core/timers.hpp"
+#include "particles/displacement_bound.hpp"
 #include "particles/min_image.hpp"
 
 namespace boycott::particles {
@@ -41,6 +42,7 @@ DemConfig DemConfig::from_case(const CaseParams& p) {
   c.gravity_m_s2 = p.gravity_vector();
   c.dt_s = p.time.dt_dem_s;
   c.skin_m = p.numerics.neighbor_skin_m;
+  c.slab_excursion_m = 0.5 * c.skin_m;
   c.contact =
       LinearSpringDashpot(p.contact.stiffness_n_m, p.contact.restitution, p.contact.tangential_damping_ratio,
                           p.contact.friction, p.contact.clip_attractive_normal);
@@ -120,30 +122,16 @@ void DemSystem::force_rebuild() {
 }
 
 bool DemSystem::needs_rebuild() const {
-  // A pair's distance changes by at most |D_i - D_j| <= |D_i - c| + |D_j - c| for any common
-  // vector c, D the displacements since the last build. With c the mean displacement, a uniform
-  // drift of the whole packing (a settling bed in a periodic box) does not force rebuilds, and
-  // the list stays exact while every |D_i - c| < skin/2. Walls are not in the list: every
-  // particle is tested against every wall each step.
+  // Exact while every particle is within skin/2 of a common centre (displacement_bound.hpp).
+  // Walls are not in the list: every particle is tested against every wall each step.
   const std::size_t n = s_.size();
   if (n == 0) return false;
-  double cx = 0.0, cy = 0.0, cz = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    cx += s_.x[i] - ref_x_[i];
-    cy += s_.y[i] - ref_y_[i];
-    cz += s_.z[i] - ref_z_[i];
-  }
-  const double inv = 1.0 / static_cast<double>(n);
-  cx *= inv;
-  cy *= inv;
-  cz *= inv;
-  const double lim2 = 0.25 * cfg_.skin_m * cfg_.skin_m;
-  double worst = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double dx = s_.x[i] - ref_x_[i] - cx, dy = s_.y[i] - ref_y_[i] - cy, dz = s_.z[i] - ref_z_[i] - cz;
-    worst = std::max(worst, dx * dx + dy * dy + dz * dz);
-  }
-  return worst > lim2;
+  const DisplacementSpread sp = displacement_spread(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(),
+                                                    ref_y_.data(), ref_z_.data());
+  const auto c = displacement_centres(sp, static_cast<double>(n));
+  const auto w = largest_offsets2(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
+                                  ref_z_.data(), c[0], c[1]);
+  return std::min(w[0], w[1]) > 0.25 * cfg_.skin_m * cfg_.skin_m;
 }
 
 void DemSystem::rebuild() {

@@ -22,6 +22,11 @@ struct DemConfig {
   std::array<double, 3> gravity_m_s2 = {0.0, 0.0, 0.0};
   double dt_s = 2.0e-5;
   double skin_m = 0.3e-3;
+  /// Several ranks: how far (m) a particle may move along z past its slab before the next
+  /// rebuild moves it to its new rank. The pairs need no limit (the list's bound covers the
+  /// pairs across slab faces); this one keeps the particles with the rank of their slab, half
+  /// the skin by default (from_case), and a coupled run sets the reach of the fluid window.
+  double slab_excursion_m = 0.15e-3;
   LinearSpringDashpot contact;
   std::string rolling_model = "constant_directional";  ///< or "none"
   double rolling_friction = 0.1;

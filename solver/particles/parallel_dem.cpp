@@ -17,6 +17,7 @@
 
 #include "core/timers.hpp"
 #include "particles/dem_system.hpp"
+#include "particles/displacement_bound.hpp"
 
 namespace boycott::particles {
 
@@ -107,14 +108,28 @@ void DemSystem::set_cutoff_and_mass() {
 }
 
 bool DemSystem::needs_rebuild_parallel() const {
-  // Absolute displacements (the serial rule subtracts the mean drift): the slab faces do not
-  // move with the particles, so a uniformly drifting packing changes which pairs cross a face.
-  double worst = 0.0;
-  for (std::size_t i = 0; i < s_.n_local; ++i) {
-    const double dx = s_.x[i] - ref_x_[i], dy = s_.y[i] - ref_y_[i], dz = s_.z[i] - ref_z_[i];
-    worst = std::max(worst, dx * dx + dy * dy + dz * dz);
-  }
-  return global_max(dd_.comm, worst) > 0.25 * cfg_.skin_m * cfg_.skin_m;
+  // The pairs: as on one rank, every particle within skin/2 of a centre common to all ranks
+  // (displacement_bound.hpp). A ghost held here is a particle that was within the cutoff of this
+  // slab along z at the build, so a pair of a local particle and one that is not held was at
+  // least the cutoff apart then, and is covered by the same bound. The slabs: a local particle
+  // may leave its slab by at most cfg_.slab_excursion_m along z before it moves rank.
+  const std::size_t n = s_.n_local;
+  const DisplacementSpread sp = displacement_spread(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(),
+                                                    ref_y_.data(), ref_z_.data());
+  // One reduction for the bounding box (exact in any order), one ordered sum for the mean (the
+  // same bits on every rank, so that every rank takes the same decision).
+  double ext[6] = {sp.hi[0], sp.hi[1], sp.hi[2], -sp.lo[0], -sp.lo[1], -sp.lo[2]};
+  MPI_Allreduce(MPI_IN_PLACE, ext, 6, MPI_DOUBLE, MPI_MAX, dd_.comm);
+  const std::vector<double> sums =
+      ordered_sum(dd_.comm, std::vector<double>{sp.sum[0], sp.sum[1], sp.sum[2], static_cast<double>(n)});
+  DisplacementSpread all;
+  for (int c = 0; c < 3; ++c) all.sum[c] = sums[c], all.hi[c] = ext[c], all.lo[c] = -ext[3 + c];
+  if (std::max(all.hi[2], -all.lo[2]) > cfg_.slab_excursion_m) return true;
+  const auto c = displacement_centres(all, sums[3]);
+  auto w = largest_offsets2(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
+                            ref_z_.data(), c[0], c[1]);
+  MPI_Allreduce(MPI_IN_PLACE, w.data(), 2, MPI_DOUBLE, MPI_MAX, dd_.comm);
+  return std::min(w[0], w[1]) > 0.25 * cfg_.skin_m * cfg_.skin_m;
 }
 
 void DemSystem::drop_ghosts() {

@@ -90,6 +90,73 @@ TEST(NeighborList, HoldsEveryContactAfterManyRebuilds) {
   EXPECT_GT(dem.rebuilds(), 20);
 }
 
+namespace {
+/// Every overlapping pair of the store is in the current list (which may be an old one).
+void expect_every_contact_listed(const DemSystem& dem, int step) {
+  const auto& s = dem.particles();
+  const auto& nl = dem.neighbor_list();
+  std::set<std::pair<std::int64_t, std::int64_t>> listed;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    for (auto p = nl.offsets[i]; p < nl.offsets[i + 1]; ++p)
+      listed.insert({std::min(s.id[i], s.id[nl.neighbors[p]]), std::max(s.id[i], s.id[nl.neighbors[p]])});
+  for (const auto& pr : brute_force_pairs(s, dem.config().box, 2 * kR))
+    ASSERT_TRUE(listed.count(pr)) << "missing contact " << pr.first << "-" << pr.second << " at step "
+                                  << step;
+}
+}  // namespace
+
+TEST(NeighborList, RebuildsWhenTheDisplacementsSpreadByMoreThanTheSkin) {
+  // Rows of spheres that never touch, a third of them gliding along x at V, the rest at rest:
+  // the displacements span [0, V t], so about their bounding box's centre every particle is
+  // within V t / 2, and the list must be rebuilt once V t exceeds the skin: every
+  // floor(skin / (V dt)) + 1 = 22 steps. About the mean displacement (V t / 3) the farthest
+  // particle is 2 V t / 3 away: that rule would rebuild every 17 steps.
+  const double V = 0.7, dt = 2e-5, a = 4 * kR;
+  DemSystem dem(gas_config(6e-3, dt));
+  const auto& b = dem.config().box;
+  std::int64_t id = 0;
+  for (int iy = 0; iy < 3; ++iy)
+    for (int ix = 0; ix * a < b.len[0] - a; ++ix)
+      for (int iz = 0; iz * a < b.len[2] - a; ++iz)
+        dem.add_particle(id++, (ix + 0.5) * a, (iy + 0.5) * a, (iz + 0.5) * a, kR, kRho);
+  auto& s = dem.particles();
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.y[i] < a) s.vx[i] = V;  // the bottom row of three
+  dem.initialize();
+  const auto r0 = dem.rebuilds();
+  const int steps = 22 * 50;
+  for (int n = 0; n < steps; ++n) dem.step();
+  EXPECT_EQ(dem.contact_count(), 0);
+  EXPECT_EQ(dem.rebuilds() - r0, 50);
+}
+
+TEST(NeighborList, HoldsEveryContactInALayerSlidingOverABedAtRest) {
+  // A dense packing whose lower half slides fast along x and z over the upper half at rest (no
+  // gravity): the pairs across the shear plane come into contact between rebuilds.
+  DemSystem dem(gas_config(6e-3, 2e-5));
+  const auto& b = dem.config().box;
+  dem.insert_random(450, kR, kRho, {0, 0, 0}, {b.len[0], b.len[1], b.len[2]}, 9);
+  auto& s = dem.particles();
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> N(0.0, 0.05);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const bool sliding = s.y[i] < 0.5 * b.len[1];
+    s.vx[i] = (sliding ? 0.8 : 0.0) + N(rng);
+    s.vy[i] = N(rng);
+    s.vz[i] = (sliding ? -0.5 : 0.0) + N(rng);
+  }
+  dem.initialize();
+  std::int64_t most_contacts = 0;
+  for (int n = 0; n < 2000; ++n) {
+    dem.step();
+    most_contacts = std::max(most_contacts, dem.contact_count());
+    expect_every_contact_listed(dem, n);
+    if (HasFatalFailure()) return;
+  }
+  EXPECT_GT(most_contacts, 20);
+  EXPECT_GT(dem.rebuilds(), 20);
+}
+
 TEST(ContactHistory, SurvivesRebuildsAndPeriodicWrap) {
   // Two spheres pressed together and sheared across the periodic x face: forcing a list rebuild
   // (which re-sorts and wraps) at every step must not change the tangential force history.

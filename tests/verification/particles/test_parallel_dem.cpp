@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 #include <random>
 #include <vector>
@@ -165,6 +166,29 @@ TEST(ParallelDem, DiluteGasMatchesOneRank) {
   const double diff = max_position_difference(par, ser, L);
   std::printf("[ report ] dilute gas: %lld migrations, largest position difference %.3g m\n",
               static_cast<long long>(migrations), diff);
+  EXPECT_LT(diff, 1e-10);
+}
+
+// A dense layer sliding along z over particles at rest, across the slab faces, with no limit on
+// how far a particle may leave its slab between rebuilds: the list's bound alone must keep
+// every pair across a face (a ghost was within the cutoff of the slab at the build), so the
+// run is the one-rank run.
+TEST(ParallelDem, ALayerSlidingAcrossTheCutsBetweenRebuildsRunsAsOnOne) {
+  const double L = 16 * kD;
+  auto cfg = make_config(L, true, 0.5, 0.5, 0.1, 2e-5);
+  cfg.slab_excursion_m = std::numeric_limits<double>::infinity();
+  auto add = [&](DemSystem& dem) {
+    add_random(dem, 700, L, 21);
+    auto& s = dem.particles();
+    for (std::size_t i = 0; i < s.size(); ++i)
+      if (s.y[i] < 0.5 * L) s.vz[i] += 0.6;
+  };
+  std::int64_t migrations = 0;
+  const auto par = run(cfg, add, 2000, true, &migrations), ser = run(cfg, add, 2000, false);
+  const double diff = max_position_difference(par, ser, L);
+  std::printf("[ report ] sliding layer: %lld migrations, largest position difference %.3g m\n",
+              static_cast<long long>(migrations), diff);
+  EXPECT_GE(migrations, 50);
   EXPECT_LT(diff, 1e-10);
 }
 

@@ -1,0 +1,78 @@
+#pragma once
+// When the Verlet list must be rebuilt. A pair missing from the list was at least 2 r_max + skin
+// apart at the build, so it can touch only after its distance has shrunk by more than the skin.
+// The distance changes by at most |D_i - D_j| <= |D_i - c| + |D_j - c| for any vector c common
+// to all particles (D the displacements since the build), so the list stays exact while
+// max_i |D_i - c| <= skin / 2 for some c. The best c is the centre of the smallest ball around
+// the displacements; two cheap candidates are tested: the mean (a uniform drift of the whole
+// packing costs nothing) and the centre of the displacements' bounding box (a sliding layer over
+// a bed at rest: half the spread instead of most of it).
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <limits>
+
+namespace boycott::particles {
+
+/// Per component: the sum, the smallest and the largest displacement (m).
+struct DisplacementSpread {
+  std::array<double, 3> sum{0.0, 0.0, 0.0};
+  std::array<double, 3> lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::infinity()};
+  std::array<double, 3> hi{-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                           -std::numeric_limits<double>::infinity()};
+};
+
+/// The spread of D_i = p_i - ref_i over particles [0, n).
+inline DisplacementSpread displacement_spread(std::size_t n, const double* __restrict x,
+                                              const double* __restrict y, const double* __restrict z,
+                                              const double* __restrict rx, const double* __restrict ry,
+                                              const double* __restrict rz) {
+  DisplacementSpread s;
+  const double* p[3] = {x, y, z};
+  const double* r[3] = {rx, ry, rz};
+  for (int c = 0; c < 3; ++c) {
+    const double* __restrict a = p[c];
+    const double* __restrict b = r[c];
+    double sum = 0.0, lo = s.lo[c], hi = s.hi[c];
+    for (std::size_t i = 0; i < n; ++i) {
+      const double d = a[i] - b[i];
+      sum += d;
+      lo = d < lo ? d : lo;
+      hi = d > hi ? d : hi;
+    }
+    s.sum[c] = sum, s.lo[c] = lo, s.hi[c] = hi;
+  }
+  return s;
+}
+
+/// max_i |D_i - c|^2 (m^2) over particles [0, n) for two centres c (m): {about ca, about cb}.
+inline std::array<double, 2> largest_offsets2(std::size_t n, const double* __restrict x,
+                                              const double* __restrict y, const double* __restrict z,
+                                              const double* __restrict rx, const double* __restrict ry,
+                                              const double* __restrict rz, const std::array<double, 3>& ca,
+                                              const std::array<double, 3>& cb) {
+  double wa = 0.0, wb = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double dx = x[i] - rx[i], dy = y[i] - ry[i], dz = z[i] - rz[i];
+    const double ax = dx - ca[0], ay = dy - ca[1], az = dz - ca[2];
+    const double bx = dx - cb[0], by = dy - cb[1], bz = dz - cb[2];
+    const double a2 = ax * ax + ay * ay + az * az, b2 = bx * bx + by * by + bz * bz;
+    wa = a2 > wa ? a2 : wa;
+    wb = b2 > wb ? b2 : wb;
+  }
+  return {wa, wb};
+}
+
+/// The two centres tested: the mean displacement of `count` particles and the bounding box's
+/// centre (m).
+inline std::array<std::array<double, 3>, 2> displacement_centres(const DisplacementSpread& s, double count) {
+  std::array<std::array<double, 3>, 2> c{};
+  for (int k = 0; k < 3; ++k) {
+    c[0][k] = count > 0.0 ? s.sum[k] / count : 0.0;
+    c[1][k] = s.lo[k] <= s.hi[k] ? 0.5 * (s.lo[k] + s.hi[k]) : 0.0;
+  }
+  return c;
+}
+
+}  // namespace boycott::particles
