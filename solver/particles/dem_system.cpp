@@ -128,6 +128,7 @@ bool DemSystem::needs_rebuild() const {
   if (n == 0) return false;
   const DisplacementSpread sp = displacement_spread(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(),
                                                     ref_y_.data(), ref_z_.data());
+  if (box_within_half_skin(sp, cfg_.skin_m)) return false;
   const auto c = displacement_centres(sp, static_cast<double>(n));
   const auto w = largest_offsets2(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
                                   ref_z_.data(), c[0], c[1]);

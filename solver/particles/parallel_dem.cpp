@@ -125,6 +125,7 @@ bool DemSystem::needs_rebuild_parallel() const {
   DisplacementSpread all;
   for (int c = 0; c < 3; ++c) all.sum[c] = sums[c], all.hi[c] = ext[c], all.lo[c] = -ext[3 + c];
   if (std::max(all.hi[2], -all.lo[2]) > cfg_.slab_excursion_m) return true;
+  if (box_within_half_skin(all, cfg_.skin_m)) return false;
   const auto c = displacement_centres(all, sums[3]);
   auto w = largest_offsets2(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
                             ref_z_.data(), c[0], c[1]);
