@@ -93,14 +93,18 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
   // candidates.
   std::size_t count = 0;
   neighbors.resize(std::max<std::size_t>(neighbors.capacity(), 8 * rows + 64));
-  // Stored cell by cell (bin_and_order, and a restart at the reference positions), a cell's
-  // members are a contiguous, increasing index range: then the half list (j > i) needs nothing
-  // from lower cells and only the tail of the own cell, which halves the distance tests. The
-  // pairs kept and their order are the same as with the full scan.
-  // Ghost copies (rows < n) are stored after the local particles, not by cell.
-  bool by_cell = rows == n;
-  for (std::size_t i = 0; i < n && by_cell; ++i)
-    by_cell = cell_items_[i] == i && (i == 0 || cell_of_[i - 1] <= cell_of_[i]);
+  // With the rows [0, rows) stored cell by cell (bin_and_order; a restart at the reference
+  // positions), each cell's items are its rows, a contiguous increasing index range, then its
+  // ghost copies (indices >= rows, appended after the rows; the binning keeps index order within
+  // a cell). The half list (j > i) then needs only the ghosts of a lower cell and what follows i
+  // in its own cell, which halves the distance tests. The pairs kept and their order are those
+  // of the full scan.
+  bool by_cell = true;
+  for (std::size_t i = 1; i < rows && by_cell; ++i) by_cell = cell_of_[i - 1] <= cell_of_[i];
+  if (by_cell) {
+    rows_in_cell_.assign(cell_start_.size() - 1, 0);
+    for (std::size_t i = 0; i < rows; ++i) ++rows_in_cell_[static_cast<std::size_t>(cell_of_[i])];
+  }
   // The geometry as locals: through the BoxGeometry reference (which the list's own stores
   // might alias) the compiler would divide by each length again for every distance test.
   const double P0 = g.period(0), P1 = g.period(1), P2 = g.period(2);
@@ -128,9 +132,7 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
           for (int ox : offs[0]) {
             const int kx = wrap[0][static_cast<std::size_t>(cx + 1 + ox)];
             if (kx < 0) continue;
-            const int nb = kx + nc_[0] * (ky + nc_[1] * kz);
-            if (by_cell && nb < c) continue;
-            nb_cells[n_nb++] = nb;
+            nb_cells[n_nb++] = kx + nc_[0] * (ky + nc_[1] * kz);
           }
         }
       }
@@ -143,7 +145,8 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
     for (int b = 0; b < n_nb; ++b) {
       const int nb = nb_cells[b];
       std::uint32_t q0 = cell_start_[nb];
-      if (by_cell && nb == c) q0 = static_cast<std::uint32_t>(i + 1);
+      if (by_cell && nb < c) q0 += rows_in_cell_[static_cast<std::size_t>(nb)];
+      if (by_cell && nb == c) q0 += static_cast<std::uint32_t>(i - cell_items_[q0]) + 1;
       const std::uint32_t q1 = cell_start_[nb + 1];
       for (std::uint32_t q = q0; q < q1; ++q) {
         const std::uint32_t j = cell_items_[q];

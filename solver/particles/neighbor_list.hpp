@@ -44,6 +44,7 @@ class NeighborList {
   std::array<int, 3> nc_{};
   std::vector<int> cell_of_;
   std::vector<std::uint32_t> cell_start_, cell_items_;
+  std::vector<std::uint32_t> rows_in_cell_;  ///< per cell, its items that are rows (build_binned)
 };
 
 }  // namespace boycott::particles

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <set>
@@ -59,6 +60,51 @@ TEST(NeighborList, MatchesBruteForceAcrossPeriodicBoundaries) {
       }
     EXPECT_EQ(got.size(), nl.pair_count()) << "a pair is listed twice";
     EXPECT_EQ(got, brute_force_pairs(s, b, cut));
+  }
+}
+
+TEST(NeighborList, RowsStoredByCellWithGhostsAppendedGiveEveryPairOnce) {
+  // As on a rank of a parallel run: the rows sorted cell by cell, then copies of other particles
+  // appended as ghosts (partners only). Every pair with a row and a later index within the
+  // cutoff is listed once, in the row of its lower index, whatever the cells of the ghosts.
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    DemSystem dem(gas_config(6e-3, 2e-5));
+    const auto& b = dem.config().box;
+    dem.insert_random(500, kR, kRho, {0, 0, 0}, {b.len[0], b.len[1], b.len[2]}, seed);
+    ParticleStore s = dem.particles();
+    const double cut = 2 * kR + 0.3e-3;
+    NeighborList nl;
+    const auto order = nl.bin_and_order(s, b, cut);
+    s.permute(order);
+    // 300 of the sorted particles stay rows, in their order; the others become ghosts, appended
+    // in reverse order (out of cell order).
+    ParticleStore rows_then_ghosts = s;
+    const std::size_t rows = 300;
+    std::vector<std::size_t> reorder, ghosts;
+    for (std::size_t k = 0; k < s.size(); ++k)
+      (k % 3 != 1 && reorder.size() < rows ? reorder : ghosts).push_back(k);
+    reorder.insert(reorder.end(), ghosts.rbegin(), ghosts.rend());
+    ASSERT_EQ(reorder.size(), s.size());
+    rows_then_ghosts.permute(reorder);
+    nl.build(rows_then_ghosts, b, cut, rows);
+    const auto& t = rows_then_ghosts;
+    std::set<std::pair<std::int64_t, std::int64_t>> got, want;
+    for (std::size_t i = 0; i < t.size(); ++i)
+      for (auto p = nl.offsets[i]; p < nl.offsets[i + 1]; ++p) {
+        ASSERT_LT(i, rows);
+        ASSERT_GT(nl.neighbors[p], i);
+        got.insert({t.id[i], t.id[nl.neighbors[p]]});
+      }
+    EXPECT_EQ(got.size(), nl.pair_count()) << "a pair is listed twice";
+    for (const auto& pr : brute_force_pairs(t, b, cut)) {
+      std::size_t a = 0, c = 0;
+      for (std::size_t k = 0; k < t.size(); ++k) {
+        if (t.id[k] == pr.first) a = k;
+        if (t.id[k] == pr.second) c = k;
+      }
+      if (std::min(a, c) < rows) want.insert({t.id[std::min(a, c)], t.id[std::max(a, c)]});
+    }
+    EXPECT_EQ(got, want);
   }
 }
 
