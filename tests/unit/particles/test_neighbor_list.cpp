@@ -40,6 +40,19 @@ std::set<std::pair<std::int64_t, std::int64_t>> brute_force_pairs(const Particle
     }
   return out;
 }
+
+/// Every overlapping pair of the store is in the current list (which may be an old one).
+void expect_every_contact_listed(const DemSystem& dem, int step) {
+  const auto& s = dem.particles();
+  const auto& nl = dem.neighbor_list();
+  std::set<std::pair<std::int64_t, std::int64_t>> listed;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    for (auto p = nl.offsets[i]; p < nl.offsets[i + 1]; ++p)
+      listed.insert({std::min(s.id[i], s.id[nl.neighbors[p]]), std::max(s.id[i], s.id[nl.neighbors[p]])});
+  for (const auto& pr : brute_force_pairs(s, dem.config().box, 2 * kR))
+    ASSERT_TRUE(listed.count(pr)) << "missing contact " << pr.first << "-" << pr.second << " at step "
+                                  << step;
+}
 }  // namespace
 
 TEST(NeighborList, MatchesBruteForceAcrossPeriodicBoundaries) {
@@ -125,31 +138,11 @@ TEST(NeighborList, HoldsEveryContactAfterManyRebuilds) {
   for (int n = 0; n < 3000; ++n) {
     dem.step();
     if (n % 50 != 0) continue;
-    const auto& nl = dem.neighbor_list();
-    std::set<std::pair<std::int64_t, std::int64_t>> listed;
-    for (std::size_t i = 0; i < s.size(); ++i)
-      for (auto p = nl.offsets[i]; p < nl.offsets[i + 1]; ++p)
-        listed.insert({std::min(s.id[i], s.id[nl.neighbors[p]]), std::max(s.id[i], s.id[nl.neighbors[p]])});
-    for (const auto& pr : brute_force_pairs(s, b, 2 * kR))
-      ASSERT_TRUE(listed.count(pr)) << "missing contact at step " << n;
+    expect_every_contact_listed(dem, n);
+    if (HasFatalFailure()) return;
   }
   EXPECT_GT(dem.rebuilds(), 20);
 }
-
-namespace {
-/// Every overlapping pair of the store is in the current list (which may be an old one).
-void expect_every_contact_listed(const DemSystem& dem, int step) {
-  const auto& s = dem.particles();
-  const auto& nl = dem.neighbor_list();
-  std::set<std::pair<std::int64_t, std::int64_t>> listed;
-  for (std::size_t i = 0; i < s.size(); ++i)
-    for (auto p = nl.offsets[i]; p < nl.offsets[i + 1]; ++p)
-      listed.insert({std::min(s.id[i], s.id[nl.neighbors[p]]), std::max(s.id[i], s.id[nl.neighbors[p]])});
-  for (const auto& pr : brute_force_pairs(s, dem.config().box, 2 * kR))
-    ASSERT_TRUE(listed.count(pr)) << "missing contact " << pr.first << "-" << pr.second << " at step "
-                                  << step;
-}
-}  // namespace
 
 TEST(NeighborList, RebuildsWhenTheDisplacementsSpreadByMoreThanTheSkin) {
   // Rows of spheres that never touch, a third of them gliding along x at V, the rest at rest:
