@@ -4,7 +4,8 @@
 // developing flow from rest, then the timed steps. Prints ms per step, SIMPLE iterations and
 // Krylov iterations per step. Run under mpirun for several ranks (bench/cfd_steps.sh).
 //   usage: boycott_bench_cfd [timed_steps=50] [warmup_steps=50] [PETSc options]
-// -piso [-piso_correctors N] runs PISO instead of SIMPLE (numerics.pressure_velocity_coupling).
+// -piso [-piso_correctors N] runs PISO instead of SIMPLE (numerics.pressure_velocity_coupling);
+// -simple_correctors N sets SIMPLE's pressure corrections per iteration (numerics.simple_correctors).
 #include <mpi.h>
 
 #include <algorithm>
@@ -104,6 +105,9 @@ int main(int argc, char** argv) {
   PetscInt correctors = s.piso_correctors;
   PetscOptionsGetInt(nullptr, nullptr, "-piso_correctors", &correctors, nullptr);
   s.piso_correctors = static_cast<int>(correctors);
+  PetscInt simple_correctors = s.simple_correctors;
+  PetscOptionsGetInt(nullptr, nullptr, "-simple_correctors", &simple_correctors, nullptr);
+  s.simple_correctors = static_cast<int>(simple_correctors);
   const double alpha_p = 120000 * M_PI / 6.0 * std::pow(kDiameter, 3) / (0.2 * 0.006 * 0.1);
   s.target_mean_flux_z_m_s = -alpha_p * kSettling;  // zero slurry flux, Eq. 25
   FluidSolver f(s);
@@ -155,7 +159,8 @@ int main(int argc, char** argv) {
   const double dt_end = f.stable_dt(), flux_end = f.mean_flux_z(), wmax_end = f.max_abs_velocity(2);
   if (rank == 0) {
     std::printf("cfd_steps: mesh 200x6x100, %d rank(s), %d warm-up + %d timed steps, dt %.3g s, %s\n", size,
-                warmup, timed, dt_end, s.piso ? fmt_piso(s.piso_correctors).c_str() : "SIMPLE");
+                warmup, timed, dt_end,
+                s.piso ? fmt_piso(s.piso_correctors).c_str() : s.coupling_name().c_str());
     std::sort(step_times.begin(), step_times.end());
     std::printf("  ms per CFD step        %.2f (median %.2f; CPU ms of rank 0 %.2f)\n", 1e3 * step_s / timed,
                 1e3 * step_times[step_times.size() / 2], 1e3 * cpu_s / timed);

@@ -110,6 +110,7 @@ void visit_keys(P& p, V&& v) {
   v("numerics.pressure_relaxation", p.numerics.pressure_relaxation, open_range(0.0, 1.0, true, false));
   v("numerics.pressure_velocity_coupling", p.numerics.pressure_velocity_coupling, choice({"simple", "piso"}));
   v("numerics.piso_correctors", p.numerics.piso_correctors, range(1, 100));
+  v("numerics.simple_correctors", p.numerics.simple_correctors, range(1, 100));
   v("numerics.cfl_max", p.numerics.cfl_max, open_range(0.0, 1.0, true, false));
   v("numerics.neighbor_skin", p.numerics.neighbor_skin_m, positive("m"));
   v("numerics.void_fraction_kernel", p.numerics.void_fraction_kernel, choice(kernel_names()));

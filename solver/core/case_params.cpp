@@ -54,7 +54,8 @@ struct LateKey {
   const char* key;
   const char* old_behaviour;  ///< the value as JSON text
 };
-constexpr std::array<LateKey, 1> kLateKeys{{{"numerics.sampling", "\"kernel\""}}};
+constexpr std::array<LateKey, 2> kLateKeys{
+    {{"numerics.sampling", "\"kernel\""}, {"numerics.simple_correctors", "1"}}};
 }  // namespace
 
 std::string case_id(const CaseParams& p) {

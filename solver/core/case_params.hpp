@@ -100,6 +100,11 @@ struct NumericsParams {
   /// difference from SIMPLE is reported in the README).
   std::string pressure_velocity_coupling = "simple";
   std::int64_t piso_correctors = 2;
+  /// Pressure corrections per SIMPLE iteration. Beyond the first, each moves the velocity by a
+  /// sweep of the momentum equations at the corrected pressure and corrects again (the PISO
+  /// corrector inside the iteration): the converged step meets the same simple_tolerance, in
+  /// fewer iterations where convection is strong (docs/model.md).
+  std::int64_t simple_correctors = 1;
   double cfl_max = 0.5;
   double neighbor_skin_m = 0.3e-3;
   std::string void_fraction_kernel = "trilinear_smoothed";

@@ -53,6 +53,7 @@ constexpr std::array kDocs = {
     KeyDoc{"numerics.pressure_relaxation", "-", "under-relaxation of pressure (SIMPLE only)"},
     KeyDoc{"numerics.pressure_velocity_coupling", "", "simple (the paper's) or piso"},
     KeyDoc{"numerics.piso_correctors", "-", "pressure corrections per PISO step"},
+    KeyDoc{"numerics.simple_correctors", "-", "pressure corrections per SIMPLE iteration"},
     KeyDoc{"numerics.cfl_max", "-", "largest Courant number; lowers dt_cfd when exceeded"},
     KeyDoc{"numerics.neighbor_skin", "m", "Verlet skin of the contact neighbour lists"},
     KeyDoc{"numerics.void_fraction_kernel", "", "deposition kernel of particle volume and forces"},

@@ -69,8 +69,8 @@ std::vector<SceneSpec> make_specs() {
                "fluid alone: mean and centreline velocity against plane Poiseuille",
                {"fluid.", "domain.", "time.dt_cfd", "time.end", "flow.", "numerics.simple_max_iterations",
                 "numerics.simple_tolerance", "numerics.velocity_relaxation", "numerics.pressure_relaxation",
-                "numerics.pressure_velocity_coupling", "numerics.piso_correctors", "numerics.cfl_max",
-                "output.timeseries_every"},
+                "numerics.pressure_velocity_coupling", "numerics.piso_correctors",
+                "numerics.simple_correctors", "numerics.cfl_max", "output.timeseries_every"},
                {{"fluid.subgrid_model", "\"none\""}},
                false,
                0.0});

@@ -21,6 +21,7 @@ FluidSettings FluidSettings::from_case(const CaseParams& p) {
   s.dt_max_s = p.time.dt_cfd_s;
   s.piso = p.numerics.pressure_velocity_coupling == "piso";
   s.piso_correctors = static_cast<int>(p.numerics.piso_correctors);
+  s.simple_correctors = static_cast<int>(p.numerics.simple_correctors);
   return s;
 }
 

@@ -37,12 +37,15 @@ struct FluidSettings {
   /// piso_correctors pressure corrections per step, no convergence test.
   bool piso = false;
   int piso_correctors = 2;
+  /// Pressure corrections per SIMPLE iteration (numerics.simple_correctors).
+  int simple_correctors = 1;
   /// Builds the settings of a case: grid, fluid, numerics, `[flow]` forcing.
   static FluidSettings from_case(const CaseParams& p);
   /// Pressure-velocity coupling in words ("SIMPLEC", "SIMPLE" or "PISO, 2 correctors").
   std::string coupling_name() const {
     if (piso) return "PISO, " + std::to_string(piso_correctors) + " correctors";
-    return simplec ? "SIMPLEC" : "SIMPLE";
+    const std::string name = simplec ? "SIMPLEC" : "SIMPLE";
+    return simple_correctors > 1 ? name + ", " + std::to_string(simple_correctors) + " correctors" : name;
   }
 };
 

@@ -172,6 +172,8 @@ class FluidSolver {
   void assemble_momentum_t(double dt, double c0, double c1, double c2, bool first_iteration,
                            StencilOperator& A);
   void step_simple(double dt, const double c[3], StepReport& rep);
+  /// Creates each component's operator and right-hand side, kept for corrector sweeps.
+  void keep_momentum_operators();
   void step_piso(double dt, const double c[3], StepReport& rep);
   /// U_[cc] = A^-1 rhs_ (from U_[cc]).
   void solve_momentum(int cc, const StencilOperator& A, StepReport& rep);
@@ -197,8 +199,8 @@ class FluidSolver {
   std::unique_ptr<HaloExchange> halo_;    // ghost fills of da_'s local vectors
   std::unique_ptr<StencilOperator> opA_;  // momentum operator (one component at a time)
   std::unique_ptr<StencilOperator> opP_;  // pressure-correction operator
-  // PISO: each component's operator and right-hand side, kept for the corrector sweeps, and the
-  // pressure they were assembled with
+  // PISO and SIMPLE with several correctors: each component's operator and right-hand side, kept
+  // for the corrector sweeps, and the pressure they were assembled with
   std::unique_ptr<StencilOperator> opm_[3];
   Vec bm_[3]{}, P_asm_ = nullptr;
   // AIJ copies of the operators, made only for preconditioners that need the entries

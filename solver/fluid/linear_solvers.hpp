@@ -19,9 +19,9 @@ struct SpectralPcShell;
 /// every application (the solve in progress sets it). `-momentum_pc_type` replaces the shell.
 KSP create_momentum_ksp(MPI_Comm comm, Vec* inv_diag);
 
-/// The pressure KSP: with `spectral` its PCSHELL, otherwise the multigrid of
-/// create_pressure_amg_ksp under the prefix "pressure_".
-KSP create_pressure_ksp(MPI_Comm comm, SpectralPcShell* spectral);
+/// The pressure KSP: with `spectral` its PCSHELL (FGMRES to `spectral_rtol`), otherwise the
+/// multigrid of create_pressure_amg_ksp under the prefix "pressure_".
+KSP create_pressure_ksp(MPI_Comm comm, SpectralPcShell* spectral, double spectral_rtol);
 
 /// GMRES (relative tolerance 1e-2) with BoomerAMG, tuned for 3-D Laplacians, under `prefix`;
 /// GAMG where PETSc was built without hypre. BoomerAMG on every rank count: its set-up is
