@@ -110,7 +110,8 @@ void FluidSolver::create_layout() {
   for (Vec* v : {&P_, &nut_, &rhs_, &sol_, &R_, &pc_}) gv(v);
   for (Vec* v : {&Pl_, &nutl_, &pcl_, &dep_solid_, &nuel_}) lv(v);
 
-  ksp_m_ = create_momentum_ksp(comm_, &jacobi_inv_diag_);
+  ksp_m_ = create_momentum_ksp(comm_, &jacobi_inv_diag_, inexact_inner_solves());
+  BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-momentum_ksp_atol", &user_momentum_atol_));
   // The spectral preconditioner unless the user names another (-pressure_pc_type).
   if (!user_pc) spectral_pc_ = std::make_unique<SpectralPcShell>(dam_, g);
   // With the spectral preconditioner a tighter solve than the multigrid's is cheap (about one
@@ -118,8 +119,7 @@ void FluidSolver::create_layout() {
   // (5.8 -> 5.0 per step on the fluid bench at 1e-3 against 1e-2; 1e-4: 5.0); with two it does
   // not (4.0 at both on the bench, 7.6 at both in the developed full-size case, where 1e-2 takes
   // 26 % fewer pressure Krylov iterations). PISO is not iterated: 1e-3.
-  const bool two_step_correction = !s_.piso && s_.simple_correctors > 1;
-  ksp_p_ = create_pressure_ksp(comm_, spectral_pc_.get(), two_step_correction ? 1e-2 : 1e-3);
+  ksp_p_ = create_pressure_ksp(comm_, spectral_pc_.get(), inexact_inner_solves() ? 1e-2 : 1e-3);
   BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-pressure_ksp_atol", &user_pressure_atol_));
   // Periodic x, z and walls (or periodicity) in y: pure Neumann, the constant is the null space.
   BC_PETSC(MatNullSpaceCreate(comm_, PETSC_TRUE, 0, nullptr, &null_));

@@ -174,6 +174,9 @@ class FluidSolver {
   void step_simple(double dt, const double c[3], StepReport& rep);
   /// Creates each component's operator and right-hand side, kept for corrector sweeps.
   void keep_momentum_operators();
+  /// SIMPLE with several correctors solves its inner systems to a fixed reduction per iteration
+  /// (simple_piso.cpp); one corrector and PISO keep the tolerances they always had.
+  bool inexact_inner_solves() const { return !s_.piso && s_.simple_correctors > 1; }
   void step_piso(double dt, const double c[3], StepReport& rep);
   /// U_[cc] = A^-1 rhs_ (from U_[cc]).
   void solve_momentum(int cc, const StencilOperator& A, StepReport& rep);
@@ -217,6 +220,7 @@ class FluidSolver {
   // a user's -pressure_ksp_atol replaces it.
   double pressure_abs_tol_ = 0.0;
   PetscBool user_pressure_atol_ = PETSC_FALSE;
+  PetscBool user_momentum_atol_ = PETSC_FALSE;
   MatNullSpace null_ = nullptr;
 
   // global vectors

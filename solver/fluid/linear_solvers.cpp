@@ -47,6 +47,8 @@ PetscErrorCode apply_inverse_diagonal(PC p, Vec x, Vec y) {
   return 0;
 }
 
+}  // namespace
+
 void set_abs_tol(KSP ksp, double abs_tol) {
   if (abs_tol < 0.0) return;
   PetscReal rtol, atol, dtol;
@@ -55,14 +57,13 @@ void set_abs_tol(KSP ksp, double abs_tol) {
   BC_PETSC(KSPSetTolerances(ksp, rtol, abs_tol, dtol, maxits));
 }
 
-}  // namespace
-
-KSP create_momentum_ksp(MPI_Comm comm, Vec* inv_diag) {
+KSP create_momentum_ksp(MPI_Comm comm, Vec* inv_diag, bool relative_to_initial) {
   KSP ksp;
   BC_PETSC(KSPCreate(comm, &ksp));
   BC_PETSC(KSPSetOptionsPrefix(ksp, "momentum_"));
   BC_PETSC(KSPSetType(ksp, KSPBCGS));
-  BC_PETSC(KSPSetTolerances(ksp, 1e-8, 1e-50, PETSC_DEFAULT, 1000));
+  BC_PETSC(KSPSetTolerances(ksp, relative_to_initial ? 1e-2 : 1e-8, 1e-50, PETSC_DEFAULT, 1000));
+  if (relative_to_initial) BC_PETSC(KSPConvergedDefaultSetUIRNorm(ksp));
   BC_PETSC(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE));
   // Point Jacobi: the BDF2 term makes the momentum rows strongly diagonally dominant (one or
   // two BiCGStab iterations either way), and block Jacobi/ILU refactored the matrix for every

@@ -17,7 +17,12 @@ struct SpectralPcShell;
 
 /// The momentum KSP; its point-Jacobi shell reads the reciprocal diagonal from *inv_diag at
 /// every application (the solve in progress sets it). `-momentum_pc_type` replaces the shell.
-KSP create_momentum_ksp(MPI_Comm comm, Vec* inv_diag);
+/// Its relative tolerance is 1e-8 of |b|, or with `relative_to_initial` 1e-2 of the initial
+/// residual (the caller then sets an absolute floor per solve with set_abs_tol).
+KSP create_momentum_ksp(MPI_Comm comm, Vec* inv_diag, bool relative_to_initial);
+
+/// Sets the absolute tolerance of `ksp`, keeping its other tolerances; nothing when abs_tol < 0.
+void set_abs_tol(KSP ksp, double abs_tol);
 
 /// The pressure KSP: with `spectral` its PCSHELL (FGMRES to `spectral_rtol`), otherwise the
 /// multigrid of create_pressure_amg_ksp under the prefix "pressure_".

@@ -64,9 +64,10 @@ void deposit(FluidSolver& f, double t, double lz) {
   f.end_deposition();
 }
 
-std::vector<std::vector<double>> run(MPI_Comm comm, bool piso, int nz) {
+std::vector<std::vector<double>> run(MPI_Comm comm, bool piso, int nz, int simple_correctors) {
   FluidSettings s = case_settings(nz);
   s.piso = piso;
+  s.simple_correctors = simple_correctors;
   FluidSolver f(s, comm);
   int size;
   MPI_Comm_size(comm, &size);
@@ -85,12 +86,12 @@ std::vector<std::vector<double>> run(MPI_Comm comm, bool piso, int nz) {
   return out;
 }
 
-void compare_ranks(bool piso, int nz = 8) {
+void compare_ranks(bool piso, int nz = 8, int simple_correctors = 1) {
   int size;
   MPI_Comm_size(PETSC_COMM_WORLD, &size);
-  const auto par = run(PETSC_COMM_WORLD, piso, nz);
-  const auto ser = run(PETSC_COMM_SELF, piso, nz);
-  std::printf("ranks %d, %s\n", size, piso ? "PISO" : "SIMPLE");
+  const auto par = run(PETSC_COMM_WORLD, piso, nz, simple_correctors);
+  const auto ser = run(PETSC_COMM_SELF, piso, nz, simple_correctors);
+  std::printf("ranks %d, %s, %d SIMPLE correctors\n", size, piso ? "PISO" : "SIMPLE", simple_correctors);
   const char* names[6] = {"u", "v", "w", "p", "nu_t", "G"};
   for (int c = 0; c < 6; ++c) {
     double diff = 0.0, ref = 0.0;
@@ -109,6 +110,10 @@ TEST(ParallelFluid, OneAndTwoRanksGiveTheSameField) {
 
 TEST(ParallelFluid, OneAndTwoRanksGiveTheSameFieldWithPiso) {
   compare_ranks(true);
+}
+
+TEST(ParallelFluid, OneAndTwoRanksGiveTheSameFieldWithTwoSimpleCorrectors) {
+  compare_ranks(false, 8, 2);
 }
 
 TEST(ParallelFluid, OneAndTwoRanksGiveTheSameFieldWhereTheSlabsDoNotFit) {

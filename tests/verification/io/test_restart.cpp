@@ -102,6 +102,14 @@ TEST(RestartIdentity, StoppedHalfwayAndResumedEqualsTheUninterruptedRunBitwiseWi
   expect_resume_is_bitwise(p, "_piso");
 }
 
+TEST(RestartIdentity, StoppedHalfwayAndResumedEqualsTheUninterruptedRunBitwiseWithTwoSimpleCorrectors) {
+  // The corrector sweeps read operators assembled within the same iteration: nothing of them
+  // outlives a step, so the checkpoint's state is still all a resumed run needs.
+  CaseParams p = small_case();
+  apply_override(p, "numerics.simple_correctors=2");
+  expect_resume_is_bitwise(p, "_simple2");
+}
+
 TEST(RunFolder, WrittenBeforeAKeyWasAddedIsResumedButAnotherCaseIsRefused) {
   // A folder from an older binary: its params.json lacks the keys added since. It is the same
   // case (case_id() hashes late keys only when set), so the run resumes from its checkpoint.
