@@ -2,6 +2,7 @@
 // plane and a 3-D channel with walls, convection and pressure ("wavy channel").
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "fluid/fluid_solver.hpp"
@@ -61,6 +62,27 @@ inline void perturb_wavy_channel(FluidSolver& f) {
   f.set_velocity(2, [](double x, double y, double z) {
     return y * (1 - y) * (1.0 - 0.2 * std::cos(M_PI * x) * std::sin(M_PI * z));
   });
+}
+
+/// The flux controller's check: the flow of `s` (the wavy channel) pushed against a target mean
+/// flux of 0.05 m/s by an opposing body force, over a non-uniform alpha_f, 40 steps of 0.05 s.
+struct FluxHold {
+  double worst_relative_error = 0.0;  ///< max over the steps of |mean(a w) / target - 1|
+  bool all_converged = true;
+};
+inline FluxHold hold_flux_against_opposing_body_force(FluidSettings s) {
+  s.body_acceleration_m_s2 = {0.0, 0.0, -1.0};  // opposes the target: G must reverse it
+  s.target_mean_flux_z_m_s = 0.05;
+  s.dt_max_s = 0.05;
+  FluidSolver f(s);
+  f.set_fluid_fraction(
+      [](double x, double, double z) { return 0.8 + 0.1 * std::sin(M_PI * x) * std::cos(M_PI * z); });
+  FluxHold h;
+  for (int n = 0; n < 40; ++n) {
+    h.all_converged = f.step(0.05).converged && h.all_converged;
+    h.worst_relative_error = std::max(h.worst_relative_error, std::abs(f.mean_flux_z() / 0.05 - 1.0));
+  }
+  return h;
 }
 
 }  // namespace boycott::fluid::testing
