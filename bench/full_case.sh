@@ -3,7 +3,7 @@
 # settings) timed over an interval of the developed flow, on 1 and 2 MPI ranks.
 #
 #   bench/full_case.sh [--build DIR] [--previous DIR] [--from T] [--interval S] [--rounds R]
-#                      [--ranks "1 2"] [--cache DIR] [--set KEY=VALUE ...]
+#                      [--ranks "1 2"] [--cache DIR] [--warmup DIR] [--set KEY=VALUE ...]
 #
 # --build DIR     the build to measure (default build); its driver/boycott is the binary.
 # --previous DIR  a second build (an older binary) timed over the same interval, interleaved
@@ -17,6 +17,10 @@
 #                 folder per binary's SHA-256: a checkpoint written by another binary is never
 #                 reused. The first run of a binary writes it (2 ranks, tens of minutes at full
 #                 size; an interrupted warm-up resumes).
+# --warmup DIR    start every binary from this run folder's checkpoint at T instead of its own
+#                 (a run of the same case that reached T, such as a warm-up in the cache): when
+#                 a change moves round-off, the two warm-ups are two realisations of the flow
+#                 and their costs differ with them; from one checkpoint the ratio is the code's.
 # --set KEY=VALUE a case key changed for every run (another angle, a smaller box for a quick
 #                 look); the warm-up folder's name holds them, so each variant has its own.
 #
@@ -27,7 +31,7 @@ set -euo pipefail
 shopt -s inherit_errexit
 root=$(cd "$(dirname "$0")/.." && pwd)
 extra=()
-build=build previous="" from=1.0 interval=0.3 rounds=1 ranks="1 2"
+build=build previous="" from=1.0 interval=0.3 rounds=1 ranks="1 2" shared_warmup=""
 cache=${XDG_CACHE_HOME:-$HOME/.cache}/boycott-bench
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -38,8 +42,9 @@ while [ $# -gt 0 ]; do
     --rounds) rounds=$2; shift 2 ;;
     --ranks) ranks=$2; shift 2 ;;
     --cache) cache=$2; shift 2 ;;
+    --warmup) shared_warmup=$2; shift 2 ;;
     --set) extra+=(--set "$2"); shift 2 ;;
-    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,29p' "$0"; exit 0 ;;
     *) echo "full_case.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -79,7 +84,11 @@ new=$(binary_of "$build")
 bins=("$new")
 [ -n "$previous" ] && bins+=("$(binary_of "$previous")")
 declare -A warm
-for b in "${bins[@]}"; do warm[$b]=$(warmup_of "$b"); done
+if [ -n "$shared_warmup" ]; then
+  [ -d "$shared_warmup/checkpoints" ] || { echo "full_case.sh: no checkpoints in '$shared_warmup'" >&2; exit 2; }
+  shared_warmup=$(cd "$shared_warmup" && pwd)
+fi
+for b in "${bins[@]}"; do warm[$b]=${shared_warmup:-$(warmup_of "$b")}; done
 
 results="$work/results.jsonl"
 for r in $(seq 1 "$rounds"); do
