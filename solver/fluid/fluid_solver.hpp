@@ -221,6 +221,8 @@ class FluidSolver {
   double pressure_abs_tol_ = 0.0;
   PetscBool user_pressure_atol_ = PETSC_FALSE;
   PetscBool user_momentum_atol_ = PETSC_FALSE;
+  // whether the momentum floor is taken in the Jacobi-scaled norm: -1 until the first solve
+  int momentum_floor_jacobi_ = -1;
   MatNullSpace null_ = nullptr;
 
   // global vectors
