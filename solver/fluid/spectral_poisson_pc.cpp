@@ -3,6 +3,7 @@
 #include <fftw3-mpi.h>
 #include <fftw3.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -186,77 +187,145 @@ std::vector<int> DistributedSpectralPoisson::z_slab_counts(int nx, int ny, int n
 }
 
 DistributedSpectralPoisson::DistributedSpectralPoisson(int nx, int ny, int nz, bool periodic_y, MPI_Comm comm)
-    : nx_(nx), ny_(ny), nz_(nz), nkx_(nx / 2 + 1) {
+    : nx_(nx), ny_(ny), nz_(nz), nkx_(nx / 2 + 1), comm_(comm) {
   if (nx < 1 || ny < 1 || nz < 1) throw std::invalid_argument("DistributedSpectralPoisson: empty grid");
-  init_fftw_mpi();
   make_bases(nx, ny, nz, periodic_y, qy_, sy_, sx_, sz_);
-  const ptrdiff_t nc[2] = {nz, nkx_};  // complex extents for the r2c local sizes
-  ptrdiff_t n0, s0, n1, s1;
-  const ptrdiff_t alloc = fftw_mpi_local_size_many_transposed(
-      2, nc, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, comm, &n0, &s0, &n1, &s1);
-  z0_ = static_cast<int>(s0), nz_local_ = static_cast<int>(n0);
-  kx0_ = static_cast<int>(s1), nkx_local_ = static_cast<int>(n1);
-  real_ = fftw_alloc_real(2 * static_cast<std::size_t>(alloc > 0 ? alloc : 1));
-  auto* spec = fftw_alloc_complex(static_cast<std::size_t>(alloc > 0 ? alloc : 1));
-  spec_ = spec;
-  eig_.resize(static_cast<std::size_t>(ny) * 2 * nz);
-  rows_.resize(static_cast<std::size_t>(ny) * 2 * nz);
-  const ptrdiff_t nr[2] = {nz, nx};
-  fwd_ = fftw_mpi_plan_many_dft_r2c(2, nr, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, real_, spec,
-                                    comm, FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_OUT);
-  bwd_ = fftw_mpi_plan_many_dft_c2r(2, nr, ny, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, spec, real_,
-                                    comm, FFTW_ESTIMATE | FFTW_MPI_TRANSPOSED_IN);
-  if (!fwd_ || !bwd_) throw std::runtime_error("DistributedSpectralPoisson: FFTW MPI plan failed");
+  int size = 1, rank = 0;
+  MPI_Comm_size(comm, &size);
+  MPI_Comm_rank(comm, &rank);
+  // z-planes: FFTW's slabs (the fluid grid's layout); kx: near-equal blocks.
+  const std::vector<int> zc = z_slab_counts(nx, ny, nz, comm);
+  std::vector<int> zs(size), kc(size), ks(size);
+  for (int r = 0, z = 0, k = 0; r < size; ++r) {
+    zs[r] = z, z += zc[r];
+    kc[r] = nkx_ / size + (r < nkx_ % size ? 1 : 0);
+    ks[r] = k, k += kc[r];
+  }
+  z0_ = zs[rank], nz_local_ = zc[rank], kx0_ = ks[rank], nkx_local_ = kc[rank];
+  // Message sizes in doubles: a slab's [k][m][kx block] to each rank, whole [kz][m][kx] back.
+  send_count_.resize(size), send_first_.resize(size), recv_count_.resize(size), recv_first_.resize(size);
+  for (int q = 0, a = 0, b = 0; q < size; ++q) {
+    send_count_[q] = 2 * nz_local_ * ny * kc[q], send_first_[q] = a, a += send_count_[q];
+    recv_count_[q] = 2 * zc[q] * ny * nkx_local_, recv_first_[q] = b, b += recv_count_[q];
+  }
+  block_first_ = ks, block_count_ = kc;
+  const std::size_t rows = static_cast<std::size_t>(nz_local_) * ny;   // x rows of this slab
+  const std::size_t cols = static_cast<std::size_t>(ny) * nkx_local_;  // z columns of this kx block
+  real_ = fftw_alloc_real(std::max<std::size_t>(1, rows * nx));
+  spec_ = fftw_alloc_complex(std::max<std::size_t>(1, rows * nkx_));
+  eig_.resize(rows * 2 * nkx_);
+  packed_.resize(rows * 2 * nkx_);
+  zcols_ = fftw_alloc_complex(std::max<std::size_t>(1, cols * nz));
+  auto* spec = static_cast<fftw_complex*>(spec_);
+  auto* zc_ = static_cast<fftw_complex*>(zcols_);
+  // FFTW_ESTIMATE (as the serial preconditioner): deterministic plans, so runs repeat bit for bit.
+  const int n_x[1] = {nx}, n_z[1] = {nz};
+  if (rows > 0) {
+    fwd_x_ = fftw_plan_many_dft_r2c(1, n_x, (int)rows, real_, nullptr, 1, nx, spec, nullptr, 1, nkx_,
+                                    FFTW_ESTIMATE);
+    bwd_x_ = fftw_plan_many_dft_c2r(1, n_x, (int)rows, spec, nullptr, 1, nkx_, real_, nullptr, 1, nx,
+                                    FFTW_ESTIMATE);
+    if (!fwd_x_ || !bwd_x_) throw std::runtime_error("DistributedSpectralPoisson: FFTW plan failed");
+  }
+  if (cols > 0) {
+    // [kz][m][kx]: column (m, kx) has stride cols, neighbouring columns are adjacent (FFTW
+    // vectorises across them), and each rank's slab arrives as one contiguous block.
+    fwd_z_ = fftw_plan_many_dft(1, n_z, (int)cols, zc_, nullptr, (int)cols, 1, zc_, nullptr, (int)cols, 1,
+                                FFTW_FORWARD, FFTW_ESTIMATE);
+    bwd_z_ = fftw_plan_many_dft(1, n_z, (int)cols, zc_, nullptr, (int)cols, 1, zc_, nullptr, (int)cols, 1,
+                                FFTW_BACKWARD, FFTW_ESTIMATE);
+    if (!fwd_z_ || !bwd_z_) throw std::runtime_error("DistributedSpectralPoisson: FFTW plan failed");
+  }
 }
 
 DistributedSpectralPoisson::~DistributedSpectralPoisson() {
-  if (fwd_) fftw_destroy_plan(static_cast<fftw_plan>(fwd_));
-  if (bwd_) fftw_destroy_plan(static_cast<fftw_plan>(bwd_));
+  for (void* p : {fwd_x_, bwd_x_, fwd_z_, bwd_z_})
+    if (p) fftw_destroy_plan(static_cast<fftw_plan>(p));
   fftw_free(real_);
   fftw_free(spec_);
+  fftw_free(zcols_);
 }
 
-void DistributedSpectralPoisson::apply(const double* r, double* z) {
-  const std::size_t nxp = 2 * static_cast<std::size_t>(nkx_);  // padded x extent of the real array
-  // slab [k][j][i] -> real_[(k nxp + i) ny + j]
-  for (int k = 0; k < nz_local_; ++k)
-    for (int j = 0; j < ny_; ++j) {
-      const double* src = r + static_cast<std::size_t>(nx_) * (j + static_cast<std::size_t>(ny_) * k);
-      double* dst = real_ + static_cast<std::size_t>(k) * nxp * ny_ + j;
-      for (int i = 0; i < nx_; ++i) dst[static_cast<std::size_t>(i) * ny_] = src[i];
+namespace {
+/// To (forward) or from the y eigenbasis, per z-plane of ny rows of n2 doubles: out row m =
+/// sum_j qy[j][m] in row j (forward), out row j = sum_m qy[j][m] in row m (back). Along the
+/// rows, contiguous, vectorised.
+void y_basis(const std::vector<double>& qy, int ny, const double* in, double* out, std::size_t n2,
+             bool forward) {
+  for (int a = 0; a < ny; ++a) {
+    double* __restrict o = out + static_cast<std::size_t>(a) * n2;
+    for (std::size_t q = 0; q < n2; ++q) o[q] = 0.0;
+    for (int b = 0; b < ny; ++b) {
+      const double w =
+          forward ? qy[static_cast<std::size_t>(b) * ny + a] : qy[static_cast<std::size_t>(a) * ny + b];
+      const double* __restrict r = in + static_cast<std::size_t>(b) * n2;
+#pragma GCC ivdep
+      for (std::size_t q = 0; q < n2; ++q) o[q] += w * r[q];
     }
-  fftw_execute(static_cast<fftw_plan>(fwd_));
-  // FFTW's transposed output holds, per local kx, nz columns of ny (y innermost): move each kx
-  // block to ny rows over kz, so that the y solve runs along contiguous rows as in the serial
-  // preconditioner (same arithmetic, same order), and back.
-  auto* sp = reinterpret_cast<double*>(spec_);
-  const double scale = 1.0 / (static_cast<double>(nx_) * nz_);
-  const double tiny = 1e-12 * (c_[0] + c_[1] + c_[2]);
-  const std::size_t n2 = 2 * static_cast<std::size_t>(nz_);
-  double* __restrict rows = rows_.data();
-  for (int a = 0; a < nkx_local_; ++a) {
-    const int kx = kx0_ + a;
-    double* block = sp + static_cast<std::size_t>(a) * n2 * ny_;  // [kz][j] complex
-    for (int kz = 0; kz < nz_; ++kz)
-      for (int j = 0; j < ny_; ++j) {
-        rows[j * n2 + 2 * kz] = block[(static_cast<std::size_t>(kz) * ny_ + j) * 2];
-        rows[j * n2 + 2 * kz + 1] = block[(static_cast<std::size_t>(kz) * ny_ + j) * 2 + 1];
-      }
-    solve_y_rows(qy_, sy_, rows, n2, static_cast<int>(n2), c_[2], sz_.data(), c_[0] * sx_[kx], c_[1], scale,
-                 tiny, eig_.data());
-    for (int kz = 0; kz < nz_; ++kz)
-      for (int j = 0; j < ny_; ++j) {
-        block[(static_cast<std::size_t>(kz) * ny_ + j) * 2] = rows[j * n2 + 2 * kz];
-        block[(static_cast<std::size_t>(kz) * ny_ + j) * 2 + 1] = rows[j * n2 + 2 * kz + 1];
-      }
   }
-  fftw_execute(static_cast<fftw_plan>(bwd_));
-  for (int k = 0; k < nz_local_; ++k)
-    for (int j = 0; j < ny_; ++j) {
-      double* dst = z + static_cast<std::size_t>(nx_) * (j + static_cast<std::size_t>(ny_) * k);
-      const double* src = real_ + static_cast<std::size_t>(k) * nxp * ny_ + j;
-      for (int i = 0; i < nx_; ++i) dst[i] = src[static_cast<std::size_t>(i) * ny_];
-    }
+}
+}  // namespace
+
+void DistributedSpectralPoisson::apply(const double* r, double* z) {
+  // The transform is separable: x by FFT on each rank's own rows, y by the eigenvectors on the
+  // same rows, then one all-to-all gives each rank whole z columns of its kx block for the z FFT
+  // and the division by the eigenvalue, and a second one brings them back. Half the data of a
+  // 2-D transform crosses ranks, once each way, in two messages per pair of ranks.
+  const int size = static_cast<int>(send_count_.size());
+  const std::size_t rows = static_cast<std::size_t>(nz_local_) * ny_, nx = static_cast<std::size_t>(nx_);
+  const std::size_t n2 = 2 * static_cast<std::size_t>(nkx_), plane = static_cast<std::size_t>(ny_) * n2;
+  auto* spec = static_cast<double*>(spec_);
+  double* __restrict eig = eig_.data();
+  double* __restrict packed = packed_.data();
+  auto* zc = static_cast<double*>(zcols_);
+  if (rows > 0) {
+    std::memcpy(real_, r, sizeof(double) * rows * nx);
+    fftw_execute(static_cast<fftw_plan>(fwd_x_));
+  }
+  for (int k = 0; k < nz_local_; ++k) y_basis(qy_, ny_, spec + k * plane, eig + k * plane, n2, true);
+  // To rank q: [k][m][its kx block].
+  double* out = packed;
+  for (int q = 0; q < size; ++q) {
+    const std::size_t len = 2 * static_cast<std::size_t>(block_count_[q]);
+    for (std::size_t row = 0; row < rows; ++row, out += len)
+      std::memcpy(out, eig + row * n2 + 2 * static_cast<std::size_t>(block_first_[q]), sizeof(double) * len);
+  }
+  MPI_Alltoallv(packed, send_count_.data(), send_first_.data(), MPI_DOUBLE, zc, recv_count_.data(),
+                recv_first_.data(), MPI_DOUBLE, comm_);
+  const std::size_t cols = static_cast<std::size_t>(ny_) * nkx_local_;
+  if (cols > 0) {
+    fftw_execute(static_cast<fftw_plan>(fwd_z_));
+    const double scale = 1.0 / (static_cast<double>(nx_) * nz_);
+    const double tiny = 1e-12 * (c_[0] + c_[1] + c_[2]);
+    for (int kz = 0; kz < nz_; ++kz)
+      for (int m = 0; m < ny_; ++m) {
+        double* __restrict row = zc + 2 * ((static_cast<std::size_t>(kz) * ny_ + m) * nkx_local_);
+        const double kb = c_[2] * sz_[kz];
+        const bool unused = sy_[m] < 0.0;
+#pragma GCC ivdep
+        for (int a = 0; a < nkx_local_; ++a) {
+          // The serial preconditioner's eigenvalue, rounded the same way.
+          const double lam = std::fma(c_[1], sy_[m], std::fma(c_[0], sx_[kx0_ + a], kb));
+          const double f = (unused || lam <= tiny) ? 0.0 : scale / lam;
+          row[2 * a] *= f;
+          row[2 * a + 1] *= f;
+        }
+      }
+    fftw_execute(static_cast<fftw_plan>(bwd_z_));
+  }
+  MPI_Alltoallv(zc, recv_count_.data(), recv_first_.data(), MPI_DOUBLE, packed, send_count_.data(),
+                send_first_.data(), MPI_DOUBLE, comm_);
+  const double* in = packed;
+  for (int q = 0; q < size; ++q) {
+    const std::size_t len = 2 * static_cast<std::size_t>(block_count_[q]);
+    for (std::size_t row = 0; row < rows; ++row, in += len)
+      std::memcpy(eig + row * n2 + 2 * static_cast<std::size_t>(block_first_[q]), in, sizeof(double) * len);
+  }
+  for (int k = 0; k < nz_local_; ++k) y_basis(qy_, ny_, eig + k * plane, spec + k * plane, n2, false);
+  if (rows > 0) {
+    fftw_execute(static_cast<fftw_plan>(bwd_x_));
+    std::memcpy(z, real_, sizeof(double) * rows * nx);
+  }
 }
 
 }  // namespace boycott::fluid

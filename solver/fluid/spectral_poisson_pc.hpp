@@ -44,10 +44,12 @@ class SpectralPoissonPreconditioner {
   void* bwd_ = nullptr;
 };
 
-/// The same preconditioner on several ranks, with FFTW's MPI transforms instead of every rank
-/// transforming the gathered vector (which made one application ~1.5x slower on 2 ranks than on
-/// one). Each rank holds a slab of whole z-planes, k in [z_begin, z_begin + z_count), in natural
-/// order i + nx (j + ny (k - z_begin)); FFTW chooses the slabs (collective constructor).
+/// The same preconditioner on several ranks. Each rank holds a slab of whole z-planes, k in
+/// [z_begin, z_begin + z_count), in natural order i + nx (j + ny (k - z_begin)); the slabs are
+/// FFTW's MPI slabs (z_slab_counts), the layout of the fluid grid. An application transforms x
+/// and y on the slab, exchanges once with every rank (all-to-all) for whole z columns of a block
+/// of x wavenumbers, and back; FFTW's own MPI 2-D transform of the same data, y interleaved, was
+/// ~1.5x slower on 2 ranks and barely faster than one rank's serial transform.
 class DistributedSpectralPoisson {
  public:
   DistributedSpectralPoisson(int nx, int ny, int nz, bool periodic_y, MPI_Comm comm);
@@ -67,15 +69,21 @@ class DistributedSpectralPoisson {
 
  private:
   int nx_, ny_, nz_, nkx_;
+  MPI_Comm comm_;
   int z0_ = 0, nz_local_ = 0, kx0_ = 0, nkx_local_ = 0;
   std::array<double, 3> c_{1.0, 1.0, 1.0};
   std::vector<double> qy_, sy_, sx_, sz_;
-  double* real_ = nullptr;    ///< [z local][2 nkx][ny] (FFTW MPI layout, y innermost)
-  void* spec_ = nullptr;      ///< transposed: [kx local][nz][ny] complex
-  std::vector<double> eig_;   ///< one kx block in the y eigenbasis: ny x (re, im) x nz
-  std::vector<double> rows_;  ///< that block moved to ny rows over kz
-  void* fwd_ = nullptr;
-  void* bwd_ = nullptr;
+  std::vector<int> block_first_, block_count_;                          ///< each rank's kx block
+  std::vector<int> send_count_, send_first_, recv_count_, recv_first_;  ///< all-to-all, in doubles
+  double* real_ = nullptr;      ///< the slab's x rows, [k][j][i] (fftw_malloc)
+  void* spec_ = nullptr;        ///< their transforms, [k][j][kx] complex
+  std::vector<double> eig_;     ///< in the y eigenbasis, [k][m][kx] complex
+  std::vector<double> packed_;  ///< eig_ by destination rank: [rank][k][m][kx in its block]
+  void* zcols_ = nullptr;       ///< this rank's kx block over all z, [kz][m][kx] complex
+  void* fwd_x_ = nullptr;       ///< fftw_plans
+  void* bwd_x_ = nullptr;
+  void* fwd_z_ = nullptr;
+  void* bwd_z_ = nullptr;
 };
 
 }  // namespace boycott::fluid

@@ -1,6 +1,6 @@
-// DistributedSpectralPoisson (FFTW's MPI transforms on z-slabs) gives what the serial
+// DistributedSpectralPoisson (x and y on z-slabs, z after an all-to-all) gives what the serial
 // SpectralPoissonPreconditioner gives on the whole vector, to round-off, for walls or periodicity
-// in y and odd sizes. Run under `mpirun -n 2` (also correct on one rank).
+// in y and odd sizes. Run under `mpirun -n 2` or `-n 3` (also correct on one rank).
 #include <gtest/gtest.h>
 #include <mpi.h>
 
