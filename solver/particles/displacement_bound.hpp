@@ -23,26 +23,29 @@ struct DisplacementSpread {
                            -std::numeric_limits<double>::infinity()};
 };
 
-/// The spread of D_i = p_i - ref_i over particles [0, n).
+/// The spread of D_i = p_i - ref_i over particles [0, n). The three components in one pass: each
+/// sum is still added in particle order (the same bits as three passes), but the three chains of
+/// dependent additions overlap instead of running one after the other.
 inline DisplacementSpread displacement_spread(std::size_t n, const double* __restrict x,
                                               const double* __restrict y, const double* __restrict z,
                                               const double* __restrict rx, const double* __restrict ry,
                                               const double* __restrict rz) {
   DisplacementSpread s;
-  const double* p[3] = {x, y, z};
-  const double* r[3] = {rx, ry, rz};
-  for (int c = 0; c < 3; ++c) {
-    const double* __restrict a = p[c];
-    const double* __restrict b = r[c];
-    double sum = 0.0, lo = s.lo[c], hi = s.hi[c];
-    for (std::size_t i = 0; i < n; ++i) {
-      const double d = a[i] - b[i];
-      sum += d;
-      lo = d < lo ? d : lo;
-      hi = d > hi ? d : hi;
-    }
-    s.sum[c] = sum, s.lo[c] = lo, s.hi[c] = hi;
+  double sx = 0.0, sy = 0.0, sz = 0.0;
+  double lx = s.lo[0], ly = s.lo[1], lz = s.lo[2], hx = s.hi[0], hy = s.hi[1], hz = s.hi[2];
+  for (std::size_t i = 0; i < n; ++i) {
+    const double dx = x[i] - rx[i], dy = y[i] - ry[i], dz = z[i] - rz[i];
+    sx += dx;
+    sy += dy;
+    sz += dz;
+    lx = dx < lx ? dx : lx;
+    ly = dy < ly ? dy : ly;
+    lz = dz < lz ? dz : lz;
+    hx = dx > hx ? dx : hx;
+    hy = dy > hy ? dy : hy;
+    hz = dz > hz ? dz : hz;
   }
+  s.sum = {sx, sy, sz}, s.lo = {lx, ly, lz}, s.hi = {hx, hy, hz};
   return s;
 }
 
