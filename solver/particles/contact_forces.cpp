@@ -146,16 +146,21 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   // Pass 2a: each contact's force and torques, written per contact. Contacts touch distinct
   // list slots (their histories do not alias) and nothing is accumulated per particle here, so
   // the loop has no dependence between iterations and vectorises over contacts (gathers).
-  contact_out_.resize(9 * np);
+  // Pass 2b adds them to the particles. Both run on one block of contacts at a time, so the
+  // per-contact results stay in L1 instead of a round trip of 9 doubles per contact through
+  // memory (the dense bed of the full-size case has a few hundred thousand contacts); the
+  // additions keep contact order, so the sums are the same bits as with one pass over all.
+  constexpr std::size_t kBlock = 256;
+  contact_out_.resize(9 * kBlock);
   double* __restrict oFx = contact_out_.data();
-  double* __restrict oFy = oFx + np;
-  double* __restrict oFz = oFy + np;
-  double* __restrict oTix = oFz + np;
-  double* __restrict oTiy = oTix + np;
-  double* __restrict oTiz = oTiy + np;
-  double* __restrict oTjx = oTiz + np;
-  double* __restrict oTjy = oTjx + np;
-  double* __restrict oTjz = oTjy + np;
+  double* __restrict oFy = oFx + kBlock;
+  double* __restrict oFz = oFy + kBlock;
+  double* __restrict oTix = oFz + kBlock;
+  double* __restrict oTiy = oTix + kBlock;
+  double* __restrict oTiz = oTiy + kBlock;
+  double* __restrict oTjx = oTiz + kBlock;
+  double* __restrict oTjy = oTjx + kBlock;
+  double* __restrict oTjz = oTjy + kBlock;
   double* __restrict hist = h_.data();
   const double iLx = 1.0 / Lx, iLy = 1.0 / Ly, iLz = 1.0 / Lz;
   // The period of each direction, 0 where it is not periodic (min_image then leaves d as it is):
@@ -164,9 +169,9 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   const double damping_factor = cm.damping_factor;
   // Equal masses (the usual case) and mixed ones are separate loops: a select between them would
   // turn the mass loads into masked gathers, which do not vectorise.
-  auto contact_loop = [&](auto uniform_masses) {
+  auto contact_loop = [&](auto uniform_masses, std::size_t k0, std::size_t k1) {
 #pragma GCC ivdep
-    for (std::size_t k = 0; k < nc; ++k) {
+    for (std::size_t k = k0; k < k1; ++k) {
       const std::uint32_t i = ci[k], p = cp[k], j = nb[p];
       const double ri = rad[i], rj = rad[j], mi = mass[i], mj = mass[j];
       double dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
@@ -189,9 +194,9 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       double ftx, fty, ftz;
       const double fn = spring_dashpot(cm, dt, nx, ny, nz, rsum - r, vrx, vry, vrz, gn, hist[3 * p],
                                        hist[3 * p + 1], hist[3 * p + 2], ftx, fty, ftz);
-      oFx[k] = fn * nx + ftx;
-      oFy[k] = fn * ny + fty;
-      oFz[k] = fn * nz + ftz;
+      oFx[k - k0] = fn * nx + ftx;
+      oFy[k - k0] = fn * ny + fty;
+      oFz[k - k0] = fn * nz + ftz;
       // Torque -R n x F_t on both spheres (the arm of j is +R_j n, its force -F_t).
       const double mx = ny * ftz - nz * fty, my = nz * ftx - nx * ftz, mz = nx * fty - ny * ftx;
       double rtx = 0.0, rty = 0.0, rtz = 0.0;
@@ -200,33 +205,37 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
                            ri / inertia[i], rj / inertia[j], inv_dt, rolling.mu_r * std::abs(fn), rtx, rty,
                            rtz);
       }
-      oTix[k] = -ri * mx - ri * rtx;
-      oTiy[k] = -ri * my - ri * rty;
-      oTiz[k] = -ri * mz - ri * rtz;
-      oTjx[k] = -rj * mx + rj * rtx;
-      oTjy[k] = -rj * my + rj * rty;
-      oTjz[k] = -rj * mz + rj * rtz;
+      oTix[k - k0] = -ri * mx - ri * rtx;
+      oTiy[k - k0] = -ri * my - ri * rty;
+      oTiz[k - k0] = -ri * mz - ri * rtz;
+      oTjx[k - k0] = -rj * mx + rj * rtx;
+      oTjy[k - k0] = -rj * my + rj * rty;
+      oTjz[k - k0] = -rj * mz + rj * rtz;
     }
   };
-  if (uniform)
-    contact_loop(std::true_type{});
-  else
-    contact_loop(std::false_type{});
-  // Pass 2b: add them to the particles, in contact order.
-  for (std::size_t k = 0; k < nc; ++k) {
-    const std::uint32_t i = ci[k], j = nb[cp[k]];
-    fx[i] += oFx[k];
-    fy[i] += oFy[k];
-    fz[i] += oFz[k];
-    fx[j] -= oFx[k];
-    fy[j] -= oFy[k];
-    fz[j] -= oFz[k];
-    tx[i] += oTix[k];
-    ty[i] += oTiy[k];
-    tz[i] += oTiz[k];
-    tx[j] += oTjx[k];
-    ty[j] += oTjy[k];
-    tz[j] += oTjz[k];
+  for (std::size_t k0 = 0; k0 < nc; k0 += kBlock) {
+    const std::size_t k1 = std::min(nc, k0 + kBlock);
+    if (uniform)
+      contact_loop(std::true_type{}, k0, k1);
+    else
+      contact_loop(std::false_type{}, k0, k1);
+    // Pass 2b: add them to the particles, in contact order.
+    for (std::size_t k = k0; k < k1; ++k) {
+      const std::uint32_t i = ci[k], j = nb[cp[k]];
+      const std::size_t b = k - k0;
+      fx[i] += oFx[b];
+      fy[i] += oFy[b];
+      fz[i] += oFz[b];
+      fx[j] -= oFx[b];
+      fy[j] -= oFy[b];
+      fz[j] -= oFz[b];
+      tx[i] += oTix[b];
+      ty[i] += oTiy[b];
+      tz[i] += oTiz[b];
+      tx[j] += oTjx[b];
+      ty[j] += oTjy[b];
+      tz[j] += oTjz[b];
+    }
   }
 
   // Walls: a sphere of infinite mass at rest; history per particle and wall. As for pairs: find
