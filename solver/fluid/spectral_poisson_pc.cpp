@@ -55,47 +55,41 @@ void make_bases(int nx, int ny, int nz, bool periodic_y, std::vector<double>& qy
   for (int k = 0; k < nz; ++k) sz[k] = 2.0 - 2.0 * std::cos(kTwoPi * k / nz);
 }
 
-/// The y part of the inverse on ny rows of n2 doubles (complex values, re and im interleaved; row
-/// j at rows + j * stride): to the y eigenbasis, times scale / lambda, back, where
-/// lambda = ca sa[p] + kb + cy sy[m] for complex entry p (the x or z part varying along the row,
-/// the other one constant). The zero eigenvalue
-/// (the constant, the null space of the pure-Neumann/periodic system) and unused modes give 0.
-/// The loops run along the rows (contiguous) and vectorise; each value is summed over j and m in
-/// index order. eig: scratch of ny * n2.
-void solve_y_rows(const std::vector<double>& qy, const std::vector<double>& sy, double* rows,
-                  std::size_t stride, int n2, double ca, const double* sa, double kb, double cy, double scale,
-                  double tiny, double* __restrict eig) {
-  const int ny = static_cast<int>(sy.size());
-  for (int m = 0; m < ny; ++m) {
-    double* __restrict e = eig + static_cast<std::size_t>(m) * n2;
-    for (int q = 0; q < n2; ++q) e[q] = 0.0;
-    for (int j = 0; j < ny; ++j) {
-      const double w = qy[static_cast<std::size_t>(j) * ny + m];
-      const double* __restrict row = rows + j * stride;
+/// To (forward) or from the y eigenbasis: ny rows of n2 doubles (complex values, re and im
+/// interleaved; row j of `in` at in + j * in_stride) to ny rows of `out` (at out_stride):
+/// out row m = sum_j qy[j][m] in row j (forward), out row j = sum_m qy[j][m] in row m (back).
+/// The loops run along the rows (contiguous) and vectorise; each value is summed in index order.
+void y_basis(const std::vector<double>& qy, int ny, const double* in, std::size_t in_stride, double* out,
+             std::size_t out_stride, std::size_t n2, bool forward) {
+  for (int a = 0; a < ny; ++a) {
+    double* __restrict o = out + a * out_stride;
+    for (std::size_t q = 0; q < n2; ++q) o[q] = 0.0;
+    for (int b = 0; b < ny; ++b) {
+      const double w =
+          forward ? qy[static_cast<std::size_t>(b) * ny + a] : qy[static_cast<std::size_t>(a) * ny + b];
+      const double* __restrict r = in + b * in_stride;
 #pragma GCC ivdep
-      for (int q = 0; q < n2; ++q) e[q] += w * row[q];
-    }
-    const bool unused = sy[m] < 0.0;
-#pragma GCC ivdep
-    for (int p = 0; p < n2 / 2; ++p) {
-      // Explicit fused multiply-adds: what GCC made of this sum before the kernel was shared
-      // (contracted, with cy sy[m] kept in the loop). Here it would hoist cy sy[m] and round it
-      // separately, and one rank's results would change in the last bit.
-      const double lam = std::fma(cy, sy[m], std::fma(ca, sa[p], kb));
-      const double f = (unused || lam <= tiny) ? 0.0 : scale / lam;
-      e[2 * p] *= f;
-      e[2 * p + 1] *= f;
+      for (std::size_t q = 0; q < n2; ++q) o[q] += w * r[q];
     }
   }
-  for (int j = 0; j < ny; ++j) {
-    double* __restrict row = rows + j * stride;
-    for (int q = 0; q < n2; ++q) row[q] = 0.0;
-    for (int m = 0; m < ny; ++m) {
-      const double w = qy[static_cast<std::size_t>(j) * ny + m];
-      const double* __restrict e = eig + static_cast<std::size_t>(m) * n2;
+}
+
+/// Multiplies count complex entries (x wavenumbers kx .. kx + count - 1, sx from kx) of y mode m
+/// and z wavenumber kz by scale / lambda, lambda = c_x sx[kx] + c_z sz[kz] + c_y sy[m]; the zero
+/// eigenvalue (the constant, the null space of the pure-Neumann/periodic system) and unused modes
+/// (sy < 0) give 0. kb = c_z sz[kz].
+void divide_by_eigenvalue(double* __restrict row, int count, const std::array<double, 3>& c,
+                          const double* __restrict sx, double kb, double sym, double scale, double tiny) {
+  const bool unused = sym < 0.0;
 #pragma GCC ivdep
-      for (int q = 0; q < n2; ++q) row[q] += w * e[q];
-    }
+  for (int p = 0; p < count; ++p) {
+    // Explicit fused multiply-adds: what GCC made of this sum before the kernel was shared
+    // (contracted, with c_y sy[m] kept in the loop). Here it would hoist c_y sy[m] and round it
+    // separately, and one rank's results would change in the last bit.
+    const double lam = std::fma(c[1], sym, std::fma(c[0], sx[p], kb));
+    const double f = (unused || lam <= tiny) ? 0.0 : scale / lam;
+    row[2 * p] *= f;
+    row[2 * p + 1] *= f;
   }
 }
 
@@ -147,9 +141,13 @@ void SpectralPoissonPreconditioner::apply(const double* r, double* z) {
   const double scale = 1.0 / (static_cast<double>(nx_) * nz_);
   const double tiny = 1e-12 * (c_[0] + c_[1] + c_[2]);
   auto* sp = reinterpret_cast<double*>(spec);
+  const std::size_t n2 = 2 * static_cast<std::size_t>(nkx_);
   for (int kz = 0; kz < nz_; ++kz) {
-    solve_y_rows(qy_, sy_, sp + 2 * static_cast<std::size_t>(kz) * nkx_, 2 * cplane, 2 * nkx_, c_[0],
-                 sx_.data(), c_[2] * sz_[kz], c_[1], scale, tiny, eig_.data());
+    double* rows = sp + 2 * static_cast<std::size_t>(kz) * nkx_;  // ny rows, 2 cplane apart
+    y_basis(qy_, ny_, rows, 2 * cplane, eig_.data(), n2, n2, true);
+    for (int m = 0; m < ny_; ++m)
+      divide_by_eigenvalue(eig_.data() + m * n2, nkx_, c_, sx_.data(), c_[2] * sz_[kz], sy_[m], scale, tiny);
+    y_basis(qy_, ny_, eig_.data(), n2, rows, 2 * cplane, n2, false);
   }
   fftw_execute(static_cast<fftw_plan>(bwd_));
   for (int k = 0; k < nz_; ++k)
@@ -217,7 +215,7 @@ DistributedSpectralPoisson::DistributedSpectralPoisson(int nx, int ny, int nz, b
   packed_.resize(rows * 2 * nkx_);
   zcols_ = fftw_alloc_complex(std::max<std::size_t>(1, cols * nz));
   auto* spec = static_cast<fftw_complex*>(spec_);
-  auto* zc_ = static_cast<fftw_complex*>(zcols_);
+  auto* zcol = static_cast<fftw_complex*>(zcols_);
   // FFTW_ESTIMATE (as the serial preconditioner): deterministic plans, so runs repeat bit for bit.
   const int n_x[1] = {nx}, n_z[1] = {nz};
   if (rows > 0) {
@@ -230,9 +228,9 @@ DistributedSpectralPoisson::DistributedSpectralPoisson(int nx, int ny, int nz, b
   if (cols > 0) {
     // [kz][m][kx]: column (m, kx) has stride cols, neighbouring columns are adjacent (FFTW
     // vectorises across them), and each rank's slab arrives as one contiguous block.
-    fwd_z_ = fftw_plan_many_dft(1, n_z, (int)cols, zc_, nullptr, (int)cols, 1, zc_, nullptr, (int)cols, 1,
+    fwd_z_ = fftw_plan_many_dft(1, n_z, (int)cols, zcol, nullptr, (int)cols, 1, zcol, nullptr, (int)cols, 1,
                                 FFTW_FORWARD, FFTW_ESTIMATE);
-    bwd_z_ = fftw_plan_many_dft(1, n_z, (int)cols, zc_, nullptr, (int)cols, 1, zc_, nullptr, (int)cols, 1,
+    bwd_z_ = fftw_plan_many_dft(1, n_z, (int)cols, zcol, nullptr, (int)cols, 1, zcol, nullptr, (int)cols, 1,
                                 FFTW_BACKWARD, FFTW_ESTIMATE);
     if (!fwd_z_ || !bwd_z_) throw std::runtime_error("DistributedSpectralPoisson: FFTW plan failed");
   }
@@ -245,26 +243,6 @@ DistributedSpectralPoisson::~DistributedSpectralPoisson() {
   fftw_free(spec_);
   fftw_free(zcols_);
 }
-
-namespace {
-/// To (forward) or from the y eigenbasis, per z-plane of ny rows of n2 doubles: out row m =
-/// sum_j qy[j][m] in row j (forward), out row j = sum_m qy[j][m] in row m (back). Along the
-/// rows, contiguous, vectorised.
-void y_basis(const std::vector<double>& qy, int ny, const double* in, double* out, std::size_t n2,
-             bool forward) {
-  for (int a = 0; a < ny; ++a) {
-    double* __restrict o = out + static_cast<std::size_t>(a) * n2;
-    for (std::size_t q = 0; q < n2; ++q) o[q] = 0.0;
-    for (int b = 0; b < ny; ++b) {
-      const double w =
-          forward ? qy[static_cast<std::size_t>(b) * ny + a] : qy[static_cast<std::size_t>(a) * ny + b];
-      const double* __restrict r = in + static_cast<std::size_t>(b) * n2;
-#pragma GCC ivdep
-      for (std::size_t q = 0; q < n2; ++q) o[q] += w * r[q];
-    }
-  }
-}
-}  // namespace
 
 void DistributedSpectralPoisson::apply(const double* r, double* z) {
   // The transform is separable: x by FFT on each rank's own rows, y by the eigenvectors on the
@@ -282,7 +260,7 @@ void DistributedSpectralPoisson::apply(const double* r, double* z) {
     std::memcpy(real_, r, sizeof(double) * rows * nx);
     fftw_execute(static_cast<fftw_plan>(fwd_x_));
   }
-  for (int k = 0; k < nz_local_; ++k) y_basis(qy_, ny_, spec + k * plane, eig + k * plane, n2, true);
+  for (int k = 0; k < nz_local_; ++k) y_basis(qy_, ny_, spec + k * plane, n2, eig + k * plane, n2, n2, true);
   // To rank q: [k][m][its kx block].
   double* out = packed;
   for (int q = 0; q < size; ++q) {
@@ -298,19 +276,9 @@ void DistributedSpectralPoisson::apply(const double* r, double* z) {
     const double scale = 1.0 / (static_cast<double>(nx_) * nz_);
     const double tiny = 1e-12 * (c_[0] + c_[1] + c_[2]);
     for (int kz = 0; kz < nz_; ++kz)
-      for (int m = 0; m < ny_; ++m) {
-        double* __restrict row = zc + 2 * ((static_cast<std::size_t>(kz) * ny_ + m) * nkx_local_);
-        const double kb = c_[2] * sz_[kz];
-        const bool unused = sy_[m] < 0.0;
-#pragma GCC ivdep
-        for (int a = 0; a < nkx_local_; ++a) {
-          // The serial preconditioner's eigenvalue, rounded the same way.
-          const double lam = std::fma(c_[1], sy_[m], std::fma(c_[0], sx_[kx0_ + a], kb));
-          const double f = (unused || lam <= tiny) ? 0.0 : scale / lam;
-          row[2 * a] *= f;
-          row[2 * a + 1] *= f;
-        }
-      }
+      for (int m = 0; m < ny_; ++m)
+        divide_by_eigenvalue(zc + 2 * ((static_cast<std::size_t>(kz) * ny_ + m) * nkx_local_), nkx_local_, c_,
+                             sx_.data() + kx0_, c_[2] * sz_[kz], sy_[m], scale, tiny);
     fftw_execute(static_cast<fftw_plan>(bwd_z_));
   }
   MPI_Alltoallv(zc, recv_count_.data(), recv_first_.data(), MPI_DOUBLE, packed, send_count_.data(),
@@ -321,7 +289,7 @@ void DistributedSpectralPoisson::apply(const double* r, double* z) {
     for (std::size_t row = 0; row < rows; ++row, in += len)
       std::memcpy(eig + row * n2 + 2 * static_cast<std::size_t>(block_first_[q]), in, sizeof(double) * len);
   }
-  for (int k = 0; k < nz_local_; ++k) y_basis(qy_, ny_, eig + k * plane, spec + k * plane, n2, false);
+  for (int k = 0; k < nz_local_; ++k) y_basis(qy_, ny_, eig + k * plane, n2, spec + k * plane, n2, n2, false);
   if (rows > 0) {
     fftw_execute(static_cast<fftw_plan>(bwd_x_));
     std::memcpy(z, real_, sizeof(double) * rows * nx);

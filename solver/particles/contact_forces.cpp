@@ -148,8 +148,8 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   // the loop has no dependence between iterations and vectorises over contacts (gathers).
   // Pass 2b adds them to the particles. Both run on one block of contacts at a time, so the
   // per-contact results stay in L1 instead of a round trip of 9 doubles per contact through
-  // memory (the dense bed of the full-size case has a few hundred thousand contacts); the
-  // additions keep contact order, so the sums are the same bits as with one pass over all.
+  // memory; the additions keep contact order, so the sums are the same bits as with one pass
+  // over all contacts.
   constexpr std::size_t kBlock = 256;
   contact_out_.resize(9 * kBlock);
   double* __restrict oFx = contact_out_.data();

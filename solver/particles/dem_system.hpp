@@ -199,7 +199,8 @@ class DemSystem {
   // overlap test's result per slot (scratch).
   std::vector<std::uint32_t> pair_i_;
   std::vector<std::uint8_t> pair_flag_;
-  // Per contact of this evaluation: force on i (N), torques on i and on j (N m), 9 blocks.
+  // Per contact of the current block of contacts (contact_forces.cpp): force on i (N), torques on
+  // i and on j (N m), 9 arrays of the block size.
   std::vector<double> contact_out_;
   // Per wall, per particle: tangential displacement, m.
   std::vector<std::vector<double>> whx_, why_, whz_;
