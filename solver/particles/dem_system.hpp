@@ -92,8 +92,10 @@ class DemSystem {
   void step();
   /// `count` velocity-Verlet steps of dt, as many calls of step() would make them (bit for bit),
   /// with the closing half kick of each step, the opening one of the next and its drift fused
-  /// into one pass over the particle arrays.
-  void advance(int count);
+  /// into one pass over the particle arrays. With `vz_sums` (count values), vz_sums[k] is the
+  /// sum of the local particles' v_z (m/s) at the end of step k, added in storage order: the
+  /// same bits as summing particles().vz after the k-th of as many step() calls.
+  void advance(int count, double* vz_sums = nullptr);
   /// Rebuilds the neighbour list now (re-sorts and wraps; forces and histories are kept).
   void force_rebuild();
 
@@ -148,8 +150,9 @@ class DemSystem {
   void kick(double h, bool predict);
   void drift();
   /// The closing half kick h of a step, the next step's opening one with its prediction, and its
-  /// drift: kick(h, false); kick(h, true); drift() in one pass.
-  void kick_kick_drift(double h);
+  /// drift: kick(h, false); kick(h, true); drift() in one pass. With `vz_sum`, also the sum of
+  /// v_z after the closing kick (see advance).
+  void kick_kick_drift(double h, double* vz_sum = nullptr);
   void copy_ghost_predictions();
   /// After the drift: the list rebuilt or the ghosts refreshed, then the forces.
   void advance_to_forces();
@@ -186,6 +189,7 @@ class DemSystem {
   NeighborList nl_;
   double cutoff_m_ = 0.0;
   double uniform_mass_kg_ = 0.0;
+  std::vector<double> vz_end_;   ///< v_z (m/s) after a fused pass's closing kick (advance's sums)
   std::vector<double> pred_[6];  ///< v, w (m/s, rad/s) seen by the forces: predicted to the force time
   std::vector<double> ref_x_, ref_y_, ref_z_;
   // Tangential spring displacement per list pair (seen from the lower-index particle i), m;

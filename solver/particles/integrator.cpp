@@ -18,8 +18,8 @@ namespace {
 /// one of the next with its prediction, then its drift x += dt v, in one pass instead of three.
 /// Both kicks see the same forces, so the acceleration and (M + h beta)^-1 are formed once; each
 /// value is the same expression, in the same order, as in the separate passes: the results are
-/// bit for bit theirs.
-template <bool Predict, bool Track, bool Wet, bool Fused>
+/// bit for bit theirs. Record (fused only): v_z after the closing kick to rz.
+template <bool Predict, bool Track, bool Wet, bool Fused, bool Record = false>
 void kick_loop(std::size_t n, double h, double dt, double gx, double gy, double gz,
                const double* __restrict m, const double* __restrict ma, const double* __restrict b,
                const double* __restrict fx, const double* __restrict fy, const double* __restrict fz,
@@ -27,8 +27,10 @@ void kick_loop(std::size_t n, double h, double dt, double gx, double gy, double 
                const double* __restrict ux, const double* __restrict uy, const double* __restrict uz,
                double* __restrict vx, double* __restrict vy, double* __restrict vz, double* __restrict Jx,
                double* __restrict Jy, double* __restrict Jz, double* __restrict px, double* __restrict py,
-               double* __restrict pz, double* __restrict x, double* __restrict y, double* __restrict z) {
+               double* __restrict pz, double* __restrict x, double* __restrict y, double* __restrict z,
+               double* __restrict rz) {
   static_assert(!Fused || Predict, "the fused pass opens a step: it predicts");
+  static_assert(!Record || Fused, "only a fused pass has the end of a step inside it");
   for (std::size_t i = 0; i < n; ++i) {
     // Dry (!Wet): F_ext, u_f and m_add are zero and not read (DemConfig::dry).
     const double M = Wet ? m[i] + ma[i] : m[i], bi = b[i], inv_D = 1.0 / (M + h * bi);
@@ -54,6 +56,7 @@ void kick_loop(std::size_t n, double h, double dt, double gx, double gy, double 
       v0x = (M * v0x + h * ax) * inv_D;
       v0y = (M * v0y + h * ay) * inv_D;
       v0z = (M * v0z + h * az) * inv_D;
+      if constexpr (Record) rz[i] = v0z;
       if constexpr (Track) {
         jx += h * bi * (ux[i] - v0x);
         jy += h * bi * (uy[i] - v0y);
@@ -110,17 +113,17 @@ void kick_spin(std::size_t n, double h, const double* __restrict I, const double
   }
 }
 
-template <bool Predict, bool Track, bool Wet, bool Fused = false>
+template <bool Predict, bool Track, bool Wet, bool Fused = false, bool Record = false>
 void kick_all(std::size_t n, double h, double dt, const std::array<double, 3>& g, ParticleStore& s,
-              std::vector<double>* pred) {
+              std::vector<double>* pred, double* rz = nullptr) {
   double* p[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
   if constexpr (Predict)
     for (int c = 0; c < 6; ++c) p[c] = pred[c].data();
-  kick_loop<Predict, Track, Wet, Fused>(
+  kick_loop<Predict, Track, Wet, Fused, Record>(
       n, h, dt, g[0], g[1], g[2], s.mass.data(), s.madd.data(), s.beta.data(), s.fx.data(), s.fy.data(),
       s.fz.data(), s.ext_x.data(), s.ext_y.data(), s.ext_z.data(), s.ufx.data(), s.ufy.data(), s.ufz.data(),
       s.vx.data(), s.vy.data(), s.vz.data(), s.drag_jx.data(), s.drag_jy.data(), s.drag_jz.data(), p[0], p[1],
-      p[2], s.x.data(), s.y.data(), s.z.data());
+      p[2], s.x.data(), s.y.data(), s.z.data(), rz);
   kick_spin<Predict, Fused>(n, h, s.inertia.data(), s.tx.data(), s.ty.data(), s.tz.data(), s.wx.data(),
                             s.wy.data(), s.wz.data(), p[3], p[4], p[5]);
 }
@@ -162,18 +165,34 @@ void DemSystem::copy_ghost_predictions() {
     for (std::size_t i = s_.n_local; i < s_.size(); ++i) pred_[c][i] = (*cur[c])[i];
 }
 
-void DemSystem::kick_kick_drift(double h) {
+void DemSystem::kick_kick_drift(double h, double* vz_sum) {
   const std::size_t n = s_.n_local;
   for (int c = 0; c < 6; ++c) pred_[c].resize(s_.size());
   const bool track = cfg_.track_drag_impulse;
   const bool wet = !cfg_.dry || track;
   auto& g = cfg_.gravity_m_s2;
-  if (track)
-    kick_all<true, true, true, true>(n, h, cfg_.dt_s, g, s_, pred_);
-  else if (wet)
-    kick_all<true, false, true, true>(n, h, cfg_.dt_s, g, s_, pred_);
-  else
-    kick_all<true, false, false, true>(n, h, cfg_.dt_s, g, s_, pred_);
+  const double dt = cfg_.dt_s;
+  if (vz_sum) {
+    // v_z at the end of the step exists only inside the pass: it is written out and summed after
+    // (a sum inside the loop would keep it from vectorising).
+    vz_end_.resize(n);
+    double* rz = vz_end_.data();
+    if (track)
+      kick_all<true, true, true, true, true>(n, h, dt, g, s_, pred_, rz);
+    else if (wet)
+      kick_all<true, false, true, true, true>(n, h, dt, g, s_, pred_, rz);
+    else
+      kick_all<true, false, false, true, true>(n, h, dt, g, s_, pred_, rz);
+    double sum = 0.0;
+    for (std::size_t i = 0; i < n; ++i) sum += rz[i];
+    *vz_sum = sum;
+  } else if (track) {
+    kick_all<true, true, true, true>(n, h, dt, g, s_, pred_);
+  } else if (wet) {
+    kick_all<true, false, true, true>(n, h, dt, g, s_, pred_);
+  } else {
+    kick_all<true, false, false, true>(n, h, dt, g, s_, pred_);
+  }
   copy_ghost_predictions();
 }
 
@@ -201,7 +220,7 @@ void DemSystem::step() {
   advance(1);
 }
 
-void DemSystem::advance(int count) {
+void DemSystem::advance(int count, double* vz_sums) {
   if (!initialized_) initialize();
   for (int k = 0; k < count; ++k) {
     auto t0 = std::chrono::steady_clock::now();
@@ -209,13 +228,19 @@ void DemSystem::advance(int count) {
       kick(0.5 * cfg_.dt_s, true);
       drift();
     } else {
-      kick_kick_drift(0.5 * cfg_.dt_s);
+      // the closing kick in this pass ends step k - 1
+      kick_kick_drift(0.5 * cfg_.dt_s, vz_sums ? vz_sums + (k - 1) : nullptr);
     }
     seconds_integrate += seconds_since(t0);
     advance_to_forces();
     if (k == count - 1) {
       t0 = std::chrono::steady_clock::now();
       kick(0.5 * cfg_.dt_s, false);
+      if (vz_sums) {
+        double sum = 0.0;
+        for (std::size_t i = 0; i < s_.n_local; ++i) sum += s_.vz[i];
+        vz_sums[k] = sum;
+      }
       seconds_integrate += seconds_since(t0);
     }
     time_ += cfg_.dt_s;
