@@ -9,6 +9,7 @@
 #include "core/timers.hpp"
 #include "particles/contact_kernels.hpp"
 #include "particles/dem_system.hpp"
+#include "particles/flag_compress.hpp"
 #include "particles/min_image.hpp"
 
 namespace boycott::particles {
@@ -16,7 +17,7 @@ namespace boycott::particles {
 namespace {
 /// First pass of the force loop: appends (i, list slot) of each overlapping list pair to ci, cp
 /// and returns their number. The test runs over the flat pair arrays (pair_i, nb) so that it
-/// vectorises (gathers) into a byte per pair; the append is a second, branch-free scalar pass.
+/// vectorises (gathers) into a byte per pair; the append is a second pass (flag_compress.hpp).
 /// The periodic directions are template flags so that the loop body has no branch at all.
 template <bool PX, bool PY, bool PZ>
 std::size_t find_contacts(std::size_t np, const std::uint32_t* __restrict pair_i,
@@ -36,13 +37,7 @@ std::size_t find_contacts(std::size_t np, const std::uint32_t* __restrict pair_i
     const double rsum = rad[i] + rad[j];
     flag[p] = dx * dx + dy * dy + dz * dz < rsum * rsum;
   }
-  std::size_t nc = 0;
-  for (std::size_t p = 0; p < np; ++p) {
-    ci[nc] = pair_i[p];
-    cp[nc] = static_cast<std::uint32_t>(p);
-    nc += flag[p];
-  }
-  return nc;
+  return compress_flagged(np, flag, pair_i, ci, cp);
 }
 
 /// The particles [0, n) closer to wall W than their radius, appended to wc; returns their number.
@@ -68,12 +63,7 @@ std::size_t find_wall_contacts(std::size_t n, const PlaneWall& W, const double* 
     for (std::size_t i = 0; i < n; ++i)
       flag[i] = (x[i] - wpx) * nx + (y[i] - wpy) * ny + (z[i] - wpz) * nz < rad[i];
   }
-  std::size_t nw = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    wc[nw] = static_cast<std::uint32_t>(i);
-    nw += flag[i];
-  }
-  return nw;
+  return compress_flagged(n, flag, nullptr, nullptr, wc);
 }
 
 using FindContactsFn = std::size_t (*)(std::size_t, const std::uint32_t*, const std::uint32_t*, const double*,
