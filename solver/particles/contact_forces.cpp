@@ -79,12 +79,12 @@ constexpr FindContactsFn kFindContacts[8] = {
 
 template <class Rolling>
 void DemSystem::compute_forces_impl(const Rolling& rolling) {
-  std::fill(s_.fx.begin(), s_.fx.end(), 0.0);
-  std::fill(s_.fy.begin(), s_.fy.end(), 0.0);
-  std::fill(s_.fz.begin(), s_.fz.end(), 0.0);
-  std::fill(s_.tx.begin(), s_.tx.end(), 0.0);
-  std::fill(s_.ty.begin(), s_.ty.end(), 0.0);
-  std::fill(s_.tz.begin(), s_.tz.end(), 0.0);
+  // A fused kick has zeroed the local particles' forces and torques (kick_kick_drift); the ghost
+  // copies' are zeroed here.
+  const std::size_t zero_from = local_forces_zeroed_ ? s_.n_local : 0;
+  local_forces_zeroed_ = false;
+  for (auto* a : {&s_.fx, &s_.fy, &s_.fz, &s_.tx, &s_.ty, &s_.tz})
+    std::fill(a->begin() + static_cast<std::ptrdiff_t>(zero_from), a->end(), 0.0);
   const LinearSpringDashpot& cm = cfg_.contact;
   const double kn = cm.kn_n_m, dt = cfg_.dt_s;
   const double Lx = cfg_.box.len[0], Ly = cfg_.box.len[1], Lz = cfg_.box.len[2];

@@ -219,6 +219,9 @@ class DemSystem {
   double time_ = 0.0;
   std::int64_t steps_ = 0, rebuilds_ = 0, contacts_ = 0;
   bool initialized_ = false;
+  /// The local particles' forces and torques are zero (a fused kick spent them); the next
+  /// compute_forces zeroes only the ghost copies'.
+  bool local_forces_zeroed_ = false;
 };
 
 }  // namespace boycott::particles

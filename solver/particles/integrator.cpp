@@ -22,7 +22,7 @@ namespace {
 template <bool Predict, bool Track, bool Wet, bool Fused, bool Record = false>
 void kick_loop(std::size_t n, double h, double dt, double gx, double gy, double gz,
                const double* __restrict m, const double* __restrict ma, const double* __restrict b,
-               const double* __restrict fx, const double* __restrict fy, const double* __restrict fz,
+               double* __restrict fx, double* __restrict fy, double* __restrict fz,
                const double* __restrict ex, const double* __restrict ey, const double* __restrict ez,
                const double* __restrict ux, const double* __restrict uy, const double* __restrict uz,
                double* __restrict vx, double* __restrict vy, double* __restrict vz, double* __restrict Jx,
@@ -83,16 +83,21 @@ void kick_loop(std::size_t n, double h, double dt, double gx, double gy, double 
       x[i] += dt * v1x;
       y[i] += dt * v1y;
       z[i] += dt * v1z;
+      // The forces are spent: zero them for the coming contact loop while their lines are here
+      // (a separate pass would stream them from memory once more).
+      fx[i] = 0.0;
+      fy[i] = 0.0;
+      fz[i] = 0.0;
     }
   }
 }
 
-/// Spin half kick, w += h T / I, with the prediction as above; Fused: two of them.
+/// Spin half kick, w += h T / I, with the prediction as above; Fused: two of them, and the
+/// torques zeroed as the forces are.
 template <bool Predict, bool Fused>
-void kick_spin(std::size_t n, double h, const double* __restrict I, const double* __restrict tx,
-               const double* __restrict ty, const double* __restrict tz, double* __restrict wx,
-               double* __restrict wy, double* __restrict wz, double* __restrict px, double* __restrict py,
-               double* __restrict pz) {
+void kick_spin(std::size_t n, double h, const double* __restrict I, double* __restrict tx,
+               double* __restrict ty, double* __restrict tz, double* __restrict wx, double* __restrict wy,
+               double* __restrict wz, double* __restrict px, double* __restrict py, double* __restrict pz) {
   for (std::size_t i = 0; i < n; ++i) {
     const double h_I = h / I[i];
     double w0x = wx[i], w0y = wy[i], w0z = wz[i];
@@ -109,6 +114,11 @@ void kick_spin(std::size_t n, double h, const double* __restrict I, const double
       px[i] = 2.0 * w1x - w0x;
       py[i] = 2.0 * w1y - w0y;
       pz[i] = 2.0 * w1z - w0z;
+    }
+    if constexpr (Fused) {
+      tx[i] = 0.0;
+      ty[i] = 0.0;
+      tz[i] = 0.0;
     }
   }
 }
@@ -193,6 +203,7 @@ void DemSystem::kick_kick_drift(double h, double* vz_sum) {
   } else {
     kick_all<true, false, false, true>(n, h, dt, g, s_, pred_);
   }
+  local_forces_zeroed_ = true;
   copy_ghost_predictions();
 }
 
