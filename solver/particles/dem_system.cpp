@@ -126,9 +126,11 @@ bool DemSystem::needs_rebuild() const {
   // Walls are not in the list: every particle is tested against every wall each step.
   const std::size_t n = s_.size();
   if (n == 0) return false;
-  const DisplacementSpread sp = displacement_spread(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(),
-                                                    ref_y_.data(), ref_z_.data());
+  DisplacementSpread sp =
+      displacement_box(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(), ref_z_.data());
   if (box_within_half_skin(sp, cfg_.skin_m)) return false;
+  sp.sum = displacement_sums(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
+                             ref_z_.data());
   const auto c = displacement_centres(sp, static_cast<double>(n));
   const auto w = largest_offsets2(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
                                   ref_z_.data(), c[0], c[1]);

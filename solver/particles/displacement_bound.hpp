@@ -23,21 +23,17 @@ struct DisplacementSpread {
                            -std::numeric_limits<double>::infinity()};
 };
 
-/// The spread of D_i = p_i - ref_i over particles [0, n). The three components in one pass: each
-/// sum is still added in particle order (the same bits as three passes), but the three chains of
-/// dependent additions overlap instead of running one after the other.
-inline DisplacementSpread displacement_spread(std::size_t n, const double* __restrict x,
-                                              const double* __restrict y, const double* __restrict z,
-                                              const double* __restrict rx, const double* __restrict ry,
-                                              const double* __restrict rz) {
+/// The bounding box of D_i = p_i - ref_i over particles [0, n) (lo, hi; sum left at zero). The
+/// box alone usually settles the test (box_within_half_skin); the ordered sums, and on several
+/// ranks their collective, are needed only where it does not.
+inline DisplacementSpread displacement_box(std::size_t n, const double* __restrict x,
+                                           const double* __restrict y, const double* __restrict z,
+                                           const double* __restrict rx, const double* __restrict ry,
+                                           const double* __restrict rz) {
   DisplacementSpread s;
-  double sx = 0.0, sy = 0.0, sz = 0.0;
   double lx = s.lo[0], ly = s.lo[1], lz = s.lo[2], hx = s.hi[0], hy = s.hi[1], hz = s.hi[2];
   for (std::size_t i = 0; i < n; ++i) {
     const double dx = x[i] - rx[i], dy = y[i] - ry[i], dz = z[i] - rz[i];
-    sx += dx;
-    sy += dy;
-    sz += dz;
     lx = dx < lx ? dx : lx;
     ly = dy < ly ? dy : ly;
     lz = dz < lz ? dz : lz;
@@ -45,8 +41,24 @@ inline DisplacementSpread displacement_spread(std::size_t n, const double* __res
     hy = dy > hy ? dy : hy;
     hz = dz > hz ? dz : hz;
   }
-  s.sum = {sx, sy, sz}, s.lo = {lx, ly, lz}, s.hi = {hx, hy, hz};
+  s.lo = {lx, ly, lz}, s.hi = {hx, hy, hz};
   return s;
+}
+
+/// The sums of D_i over particles [0, n) (m), each added in particle order (the mean centre's
+/// bits do not depend on the vector width). The three components in one pass: their chains of
+/// dependent additions overlap.
+inline std::array<double, 3> displacement_sums(std::size_t n, const double* __restrict x,
+                                               const double* __restrict y, const double* __restrict z,
+                                               const double* __restrict rx, const double* __restrict ry,
+                                               const double* __restrict rz) {
+  double sx = 0.0, sy = 0.0, sz = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sx += x[i] - rx[i];
+    sy += y[i] - ry[i];
+    sz += z[i] - rz[i];
+  }
+  return {sx, sy, sz};
 }
 
 /// max_i |D_i - c|^2 (m^2) over particles [0, n) for two centres c (m): {about ca, about cb}.

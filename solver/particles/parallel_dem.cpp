@@ -114,18 +114,22 @@ bool DemSystem::needs_rebuild_parallel() const {
   // least the cutoff apart then, and is covered by the same bound. The slabs: a local particle
   // may leave its slab by at most cfg_.slab_excursion_m along z before it moves rank.
   const std::size_t n = s_.n_local;
-  const DisplacementSpread sp = displacement_spread(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(),
-                                                    ref_y_.data(), ref_z_.data());
-  // One reduction for the bounding box (exact in any order), one ordered sum for the mean (the
-  // same bits on every rank, so that every rank takes the same decision).
+  const DisplacementSpread sp =
+      displacement_box(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(), ref_z_.data());
+  // One reduction for the bounding box (exact in any order); where the box does not settle it,
+  // one ordered sum for the mean (the same bits on every rank, so that every rank takes the same
+  // decision).
   double ext[6] = {sp.hi[0], sp.hi[1], sp.hi[2], -sp.lo[0], -sp.lo[1], -sp.lo[2]};
   MPI_Allreduce(MPI_IN_PLACE, ext, 6, MPI_DOUBLE, MPI_MAX, dd_.comm);
-  const std::vector<double> sums =
-      ordered_sum(dd_.comm, std::vector<double>{sp.sum[0], sp.sum[1], sp.sum[2], static_cast<double>(n)});
   DisplacementSpread all;
-  for (int c = 0; c < 3; ++c) all.sum[c] = sums[c], all.hi[c] = ext[c], all.lo[c] = -ext[3 + c];
+  for (int c = 0; c < 3; ++c) all.hi[c] = ext[c], all.lo[c] = -ext[3 + c];
   if (std::max(all.hi[2], -all.lo[2]) > cfg_.slab_excursion_m) return true;
   if (box_within_half_skin(all, cfg_.skin_m)) return false;
+  const auto local = displacement_sums(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
+                                       ref_z_.data());
+  const std::vector<double> sums =
+      ordered_sum(dd_.comm, std::vector<double>{local[0], local[1], local[2], static_cast<double>(n)});
+  for (int c = 0; c < 3; ++c) all.sum[c] = sums[c];
   const auto c = displacement_centres(all, sums[3]);
   auto w = largest_offsets2(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
                             ref_z_.data(), c[0], c[1]);
