@@ -126,8 +126,10 @@ bool DemSystem::needs_rebuild() const {
   // Walls are not in the list: every particle is tested against every wall each step.
   const std::size_t n = s_.size();
   if (n == 0) return false;
-  DisplacementSpread sp =
-      displacement_box(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(), ref_z_.data());
+  DisplacementSpread sp = drift_box_fresh_ && n == s_.n_local
+                              ? drift_box_
+                              : displacement_box(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(),
+                                                 ref_y_.data(), ref_z_.data());
   if (box_within_half_skin(sp, cfg_.skin_m)) return false;
   sp.sum = displacement_sums(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
                              ref_z_.data());

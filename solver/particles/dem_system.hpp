@@ -9,6 +9,7 @@
 
 #include "core/case_params.hpp"
 #include "particles/contact_models.hpp"
+#include "particles/displacement_bound.hpp"
 #include "particles/neighbor_list.hpp"
 #include "particles/particle_store.hpp"
 #include "particles/slab_decomposition.hpp"
@@ -222,6 +223,10 @@ class DemSystem {
   /// The local particles' forces and torques are zero (a fused kick spent them); the next
   /// compute_forces zeroes only the ghost copies'.
   bool local_forces_zeroed_ = false;
+  /// The displacement box of the local particles as the last fused kick drifted them, for the
+  /// rebuild test that follows it (fresh until that test has read it).
+  DisplacementSpread drift_box_;
+  bool drift_box_fresh_ = false;
 };
 
 }  // namespace boycott::particles

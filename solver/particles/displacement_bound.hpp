@@ -23,6 +23,62 @@ struct DisplacementSpread {
                            -std::numeric_limits<double>::infinity()};
 };
 
+/// The running bounding box of displacements D_i = p_i - ref_i (m), kept in eight lanes that are
+/// merged by result(): GCC does not vectorise a floating-point min/max reduction by itself (it
+/// would need -ffast-math) but does the lanes' loop. Min and max do not round, so the box is the
+/// one pass's in any order (a -0 against a +0 aside, which neither the box's extent nor its
+/// centre sees). Particles may be added in ranges (the fused kick adds each block it drifts).
+class DisplacementBox {
+ public:
+  static constexpr std::size_t kLanes = 8;
+  DisplacementBox() {
+    for (std::size_t l = 0; l < kLanes; ++l)
+      lx_[l] = ly_[l] = lz_[l] = std::numeric_limits<double>::infinity(),
+      hx_[l] = hy_[l] = hz_[l] = -std::numeric_limits<double>::infinity();
+  }
+  /// Adds particles [b, e).
+  void add(std::size_t b, std::size_t e, const double* __restrict x, const double* __restrict y,
+           const double* __restrict z, const double* __restrict rx, const double* __restrict ry,
+           const double* __restrict rz) {
+    // The lanes as locals while the loop runs (through `this` they would be stored back each
+    // iteration).
+    double lx[kLanes], ly[kLanes], lz[kLanes], hx[kLanes], hy[kLanes], hz[kLanes];
+    for (std::size_t l = 0; l < kLanes; ++l)
+      lx[l] = lx_[l], ly[l] = ly_[l], lz[l] = lz_[l], hx[l] = hx_[l], hy[l] = hy_[l], hz[l] = hz_[l];
+    auto lane = [&](std::size_t l, double dx, double dy, double dz) {
+      lx[l] = dx < lx[l] ? dx : lx[l];
+      ly[l] = dy < ly[l] ? dy : ly[l];
+      lz[l] = dz < lz[l] ? dz : lz[l];
+      hx[l] = dx > hx[l] ? dx : hx[l];
+      hy[l] = dy > hy[l] ? dy : hy[l];
+      hz[l] = dz > hz[l] ? dz : hz[l];
+    };
+    std::size_t i = b;
+    for (; i + kLanes <= e; i += kLanes)
+      for (std::size_t l = 0; l < kLanes; ++l)
+        lane(l, x[i + l] - rx[i + l], y[i + l] - ry[i + l], z[i + l] - rz[i + l]);
+    for (std::size_t l = 0; i < e; ++i, ++l) lane(l, x[i] - rx[i], y[i] - ry[i], z[i] - rz[i]);
+    for (std::size_t l = 0; l < kLanes; ++l)
+      lx_[l] = lx[l], ly_[l] = ly[l], lz_[l] = lz[l], hx_[l] = hx[l], hy_[l] = hy[l], hz_[l] = hz[l];
+  }
+  /// lo and hi (sum left at zero).
+  DisplacementSpread result() const {
+    DisplacementSpread s;
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      s.lo[0] = lx_[l] < s.lo[0] ? lx_[l] : s.lo[0];
+      s.lo[1] = ly_[l] < s.lo[1] ? ly_[l] : s.lo[1];
+      s.lo[2] = lz_[l] < s.lo[2] ? lz_[l] : s.lo[2];
+      s.hi[0] = hx_[l] > s.hi[0] ? hx_[l] : s.hi[0];
+      s.hi[1] = hy_[l] > s.hi[1] ? hy_[l] : s.hi[1];
+      s.hi[2] = hz_[l] > s.hi[2] ? hz_[l] : s.hi[2];
+    }
+    return s;
+  }
+
+ private:
+  double lx_[kLanes], ly_[kLanes], lz_[kLanes], hx_[kLanes], hy_[kLanes], hz_[kLanes];
+};
+
 /// The bounding box of D_i = p_i - ref_i over particles [0, n) (lo, hi; sum left at zero). The
 /// box alone usually settles the test (box_within_half_skin); the ordered sums, and on several
 /// ranks their collective, are needed only where it does not.
@@ -30,19 +86,9 @@ inline DisplacementSpread displacement_box(std::size_t n, const double* __restri
                                            const double* __restrict y, const double* __restrict z,
                                            const double* __restrict rx, const double* __restrict ry,
                                            const double* __restrict rz) {
-  DisplacementSpread s;
-  double lx = s.lo[0], ly = s.lo[1], lz = s.lo[2], hx = s.hi[0], hy = s.hi[1], hz = s.hi[2];
-  for (std::size_t i = 0; i < n; ++i) {
-    const double dx = x[i] - rx[i], dy = y[i] - ry[i], dz = z[i] - rz[i];
-    lx = dx < lx ? dx : lx;
-    ly = dy < ly ? dy : ly;
-    lz = dz < lz ? dz : lz;
-    hx = dx > hx ? dx : hx;
-    hy = dy > hy ? dy : hy;
-    hz = dz > hz ? dz : hz;
-  }
-  s.lo = {lx, ly, lz}, s.hi = {hx, hy, hz};
-  return s;
+  DisplacementBox b;
+  b.add(0, n, x, y, z, rx, ry, rz);
+  return b.result();
 }
 
 /// The sums of D_i over particles [0, n) (m), each added in particle order (the mean centre's

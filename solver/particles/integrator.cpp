@@ -1,11 +1,13 @@
 // Velocity Verlet (paper Eqs. 4-6) with the coupling hook: drag implicit in the half kicks,
 // added mass in the mass matrix, and the predicted velocities the contact forces see.
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <vector>
 
 #include "core/timers.hpp"
 #include "particles/dem_system.hpp"
+#include "particles/displacement_bound.hpp"
 
 namespace boycott::particles {
 
@@ -20,7 +22,7 @@ namespace {
 /// value is the same expression, in the same order, as in the separate passes: the results are
 /// bit for bit theirs. Record (fused only): v_z after the closing kick to rz.
 template <bool Predict, bool Track, bool Wet, bool Fused, bool Record = false>
-void kick_loop(std::size_t n, double h, double dt, double gx, double gy, double gz,
+void kick_loop(std::size_t i0, std::size_t n, double h, double dt, double gx, double gy, double gz,
                const double* __restrict m, const double* __restrict ma, const double* __restrict b,
                double* __restrict fx, double* __restrict fy, double* __restrict fz,
                const double* __restrict ex, const double* __restrict ey, const double* __restrict ez,
@@ -31,7 +33,7 @@ void kick_loop(std::size_t n, double h, double dt, double gx, double gy, double 
                double* __restrict rz) {
   static_assert(!Fused || Predict, "the fused pass opens a step: it predicts");
   static_assert(!Record || Fused, "only a fused pass has the end of a step inside it");
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = i0; i < n; ++i) {
     // Dry (!Wet): F_ext, u_f and m_add are zero and not read (DemConfig::dry).
     const double M = Wet ? m[i] + ma[i] : m[i], bi = b[i], inv_D = 1.0 / (M + h * bi);
     double ax = fx[i], ay = fy[i], az = fz[i];
@@ -125,15 +127,35 @@ void kick_spin(std::size_t n, double h, const double* __restrict I, double* __re
 
 template <bool Predict, bool Track, bool Wet, bool Fused = false, bool Record = false>
 void kick_all(std::size_t n, double h, double dt, const std::array<double, 3>& g, ParticleStore& s,
-              std::vector<double>* pred, double* rz = nullptr) {
+              std::vector<double>* pred, double* rz = nullptr, DisplacementBox* box = nullptr,
+              const double* const* ref = nullptr) {
   double* p[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
   if constexpr (Predict)
     for (int c = 0; c < 6; ++c) p[c] = pred[c].data();
-  kick_loop<Predict, Track, Wet, Fused, Record>(
-      n, h, dt, g[0], g[1], g[2], s.mass.data(), s.madd.data(), s.beta.data(), s.fx.data(), s.fy.data(),
-      s.fz.data(), s.ext_x.data(), s.ext_y.data(), s.ext_z.data(), s.ufx.data(), s.ufy.data(), s.ufz.data(),
-      s.vx.data(), s.vy.data(), s.vz.data(), s.drag_jx.data(), s.drag_jy.data(), s.drag_jz.data(), p[0], p[1],
-      p[2], s.x.data(), s.y.data(), s.z.data(), rz);
+  auto run = [&](std::size_t i0, std::size_t i1) {
+    kick_loop<Predict, Track, Wet, Fused, Record>(
+        i0, i1, h, dt, g[0], g[1], g[2], s.mass.data(), s.madd.data(), s.beta.data(), s.fx.data(),
+        s.fy.data(), s.fz.data(), s.ext_x.data(), s.ext_y.data(), s.ext_z.data(), s.ufx.data(), s.ufy.data(),
+        s.ufz.data(), s.vx.data(), s.vy.data(), s.vz.data(), s.drag_jx.data(), s.drag_jy.data(),
+        s.drag_jz.data(), p[0], p[1], p[2], s.x.data(), s.y.data(), s.z.data(), rz);
+  };
+  if constexpr (Fused) {
+    // The drifted positions' displacement box for the rebuild test, block by block while the
+    // block's positions are in L1: the test then reads only the reference positions from memory
+    // instead of those and the positions again.
+    if (box) {
+      constexpr std::size_t kBlock = 512;
+      for (std::size_t b = 0; b < n; b += kBlock) {
+        const std::size_t e = std::min(n, b + kBlock);
+        run(b, e);
+        box->add(b, e, s.x.data(), s.y.data(), s.z.data(), ref[0], ref[1], ref[2]);
+      }
+    } else {
+      run(0, n);
+    }
+  } else {
+    run(0, n);
+  }
   kick_spin<Predict, Fused>(n, h, s.inertia.data(), s.tx.data(), s.ty.data(), s.tz.data(), s.wx.data(),
                             s.wy.data(), s.wz.data(), p[3], p[4], p[5]);
 }
@@ -182,27 +204,32 @@ void DemSystem::kick_kick_drift(double h, double* vz_sum) {
   const bool wet = !cfg_.dry || track;
   auto& g = cfg_.gravity_m_s2;
   const double dt = cfg_.dt_s;
+  DisplacementBox box;
+  const double* ref[3] = {ref_x_.data(), ref_y_.data(), ref_z_.data()};
+  double* rz = nullptr;
   if (vz_sum) {
     // v_z at the end of the step exists only inside the pass: it is written out and summed after
     // (a sum inside the loop would keep it from vectorising).
     vz_end_.resize(n);
-    double* rz = vz_end_.data();
+    rz = vz_end_.data();
     if (track)
-      kick_all<true, true, true, true, true>(n, h, dt, g, s_, pred_, rz);
+      kick_all<true, true, true, true, true>(n, h, dt, g, s_, pred_, rz, &box, ref);
     else if (wet)
-      kick_all<true, false, true, true, true>(n, h, dt, g, s_, pred_, rz);
+      kick_all<true, false, true, true, true>(n, h, dt, g, s_, pred_, rz, &box, ref);
     else
-      kick_all<true, false, false, true, true>(n, h, dt, g, s_, pred_, rz);
+      kick_all<true, false, false, true, true>(n, h, dt, g, s_, pred_, rz, &box, ref);
     double sum = 0.0;
     for (std::size_t i = 0; i < n; ++i) sum += rz[i];
     *vz_sum = sum;
   } else if (track) {
-    kick_all<true, true, true, true>(n, h, dt, g, s_, pred_);
+    kick_all<true, true, true, true>(n, h, dt, g, s_, pred_, nullptr, &box, ref);
   } else if (wet) {
-    kick_all<true, false, true, true>(n, h, dt, g, s_, pred_);
+    kick_all<true, false, true, true>(n, h, dt, g, s_, pred_, nullptr, &box, ref);
   } else {
-    kick_all<true, false, false, true>(n, h, dt, g, s_, pred_);
+    kick_all<true, false, false, true>(n, h, dt, g, s_, pred_, nullptr, &box, ref);
   }
+  drift_box_ = box.result();
+  drift_box_fresh_ = true;
   local_forces_zeroed_ = true;
   copy_ghost_predictions();
 }
@@ -261,15 +288,17 @@ void DemSystem::advance(int count, double* vz_sums) {
 
 void DemSystem::advance_to_forces() {
   std::chrono::steady_clock::time_point t0;
+  const bool rebuild_now = dd_.parallel() ? needs_rebuild_parallel() : needs_rebuild();
+  drift_box_fresh_ = false;  // read by the test just made; a rebuild moves the references
   if (dd_.parallel()) {
-    if (needs_rebuild_parallel()) {
+    if (rebuild_now) {
       rebuild_parallel();
     } else {
       t0 = std::chrono::steady_clock::now();
       forward_ghosts();
       seconds_ghosts += seconds_since(t0);
     }
-  } else if (needs_rebuild()) {
+  } else if (rebuild_now) {
     rebuild();
   }
   compute_forces();
