@@ -121,15 +121,21 @@ void DemSystem::force_rebuild() {
   rebuild();
 }
 
+DisplacementSpread DemSystem::local_displacement_box() const {
+  if (drift_box_fresh_) return drift_box_;
+  return displacement_box(s_.n_local, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
+                          ref_z_.data());
+}
+
 bool DemSystem::needs_rebuild() const {
   // Exact while every particle is within skin/2 of a common centre (displacement_bound.hpp).
   // Walls are not in the list: every particle is tested against every wall each step.
   const std::size_t n = s_.size();
   if (n == 0) return false;
-  DisplacementSpread sp = drift_box_fresh_ && n == s_.n_local
-                              ? drift_box_
-                              : displacement_box(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(),
-                                                 ref_y_.data(), ref_z_.data());
+  // (one rank holds no ghost copies: n is the local count)
+  DisplacementSpread sp = n == s_.n_local ? local_displacement_box()
+                                          : displacement_box(n, s_.x.data(), s_.y.data(), s_.z.data(),
+                                                             ref_x_.data(), ref_y_.data(), ref_z_.data());
   if (box_within_half_skin(sp, cfg_.skin_m)) return false;
   sp.sum = displacement_sums(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
                              ref_z_.data());

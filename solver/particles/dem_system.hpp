@@ -158,6 +158,8 @@ class DemSystem {
   /// After the drift: the list rebuilt or the ghosts refreshed, then the forces.
   void advance_to_forces();
   bool needs_rebuild() const;
+  /// The displacement box of the local particles: the fused kick's when fresh, else a pass.
+  DisplacementSpread local_displacement_box() const;
   void rebuild();
   void collect_histories();
   /// Zeroes the shear history of the pairs that were in contact and are not among the first nc

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <type_traits>
 #include <vector>
 
 #include "core/timers.hpp"
@@ -125,6 +126,7 @@ void kick_spin(std::size_t n, double h, const double* __restrict I, double* __re
   }
 }
 
+/// Fused: also the displacement box of the drifted positions against ref (x, y, z), into box.
 template <bool Predict, bool Track, bool Wet, bool Fused = false, bool Record = false>
 void kick_all(std::size_t n, double h, double dt, const std::array<double, 3>& g, ParticleStore& s,
               std::vector<double>* pred, double* rz = nullptr, DisplacementBox* box = nullptr,
@@ -143,21 +145,23 @@ void kick_all(std::size_t n, double h, double dt, const std::array<double, 3>& g
     // The drifted positions' displacement box for the rebuild test, block by block while the
     // block's positions are in L1: the test then reads only the reference positions from memory
     // instead of those and the positions again.
-    if (box) {
-      constexpr std::size_t kBlock = 512;
-      for (std::size_t b = 0; b < n; b += kBlock) {
-        const std::size_t e = std::min(n, b + kBlock);
-        run(b, e);
-        box->add(b, e, s.x.data(), s.y.data(), s.z.data(), ref[0], ref[1], ref[2]);
-      }
-    } else {
-      run(0, n);
+    constexpr std::size_t kBlock = 512;
+    for (std::size_t b = 0; b < n; b += kBlock) {
+      const std::size_t e = std::min(n, b + kBlock);
+      run(b, e);
+      box->add(b, e, s.x.data(), s.y.data(), s.z.data(), ref[0], ref[1], ref[2]);
     }
   } else {
     run(0, n);
   }
   kick_spin<Predict, Fused>(n, h, s.inertia.data(), s.tx.data(), s.ty.data(), s.tz.data(), s.wx.data(),
                             s.wy.data(), s.wz.data(), p[3], p[4], p[5]);
+}
+/// a[0] + a[1] + ... in that order (the bits of a plain running sum).
+double sum_in_order(const double* a, std::size_t n) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i) sum += a[i];
+  return sum;
 }
 }  // namespace
 
@@ -206,27 +210,23 @@ void DemSystem::kick_kick_drift(double h, double* vz_sum) {
   const double dt = cfg_.dt_s;
   DisplacementBox box;
   const double* ref[3] = {ref_x_.data(), ref_y_.data(), ref_z_.data()};
-  double* rz = nullptr;
+  auto pass = [&](auto record, double* rz) {
+    constexpr bool R = decltype(record)::value;
+    if (track)
+      kick_all<true, true, true, true, R>(n, h, dt, g, s_, pred_, rz, &box, ref);
+    else if (wet)
+      kick_all<true, false, true, true, R>(n, h, dt, g, s_, pred_, rz, &box, ref);
+    else
+      kick_all<true, false, false, true, R>(n, h, dt, g, s_, pred_, rz, &box, ref);
+  };
   if (vz_sum) {
     // v_z at the end of the step exists only inside the pass: it is written out and summed after
     // (a sum inside the loop would keep it from vectorising).
     vz_end_.resize(n);
-    rz = vz_end_.data();
-    if (track)
-      kick_all<true, true, true, true, true>(n, h, dt, g, s_, pred_, rz, &box, ref);
-    else if (wet)
-      kick_all<true, false, true, true, true>(n, h, dt, g, s_, pred_, rz, &box, ref);
-    else
-      kick_all<true, false, false, true, true>(n, h, dt, g, s_, pred_, rz, &box, ref);
-    double sum = 0.0;
-    for (std::size_t i = 0; i < n; ++i) sum += rz[i];
-    *vz_sum = sum;
-  } else if (track) {
-    kick_all<true, true, true, true>(n, h, dt, g, s_, pred_, nullptr, &box, ref);
-  } else if (wet) {
-    kick_all<true, false, true, true>(n, h, dt, g, s_, pred_, nullptr, &box, ref);
+    pass(std::true_type{}, vz_end_.data());
+    *vz_sum = sum_in_order(vz_end_.data(), n);
   } else {
-    kick_all<true, false, false, true>(n, h, dt, g, s_, pred_, nullptr, &box, ref);
+    pass(std::false_type{}, nullptr);
   }
   drift_box_ = box.result();
   drift_box_fresh_ = true;
@@ -274,11 +274,7 @@ void DemSystem::advance(int count, double* vz_sums) {
     if (k == count - 1) {
       t0 = std::chrono::steady_clock::now();
       kick(0.5 * cfg_.dt_s, false);
-      if (vz_sums) {
-        double sum = 0.0;
-        for (std::size_t i = 0; i < s_.n_local; ++i) sum += s_.vz[i];
-        vz_sums[k] = sum;
-      }
+      if (vz_sums) vz_sums[k] = sum_in_order(s_.vz.data(), s_.n_local);
       seconds_integrate += seconds_since(t0);
     }
     time_ += cfg_.dt_s;

@@ -114,10 +114,7 @@ bool DemSystem::needs_rebuild_parallel() const {
   // least the cutoff apart then, and is covered by the same bound. The slabs: a local particle
   // may leave its slab by at most cfg_.slab_excursion_m along z before it moves rank.
   const std::size_t n = s_.n_local;
-  const DisplacementSpread sp = drift_box_fresh_
-                                    ? drift_box_
-                                    : displacement_box(n, s_.x.data(), s_.y.data(), s_.z.data(),
-                                                       ref_x_.data(), ref_y_.data(), ref_z_.data());
+  const DisplacementSpread sp = local_displacement_box();
   // One reduction for the bounding box (exact in any order); where the box does not settle it,
   // one ordered sum for the mean (the same bits on every rank, so that every rank takes the same
   // decision).

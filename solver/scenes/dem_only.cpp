@@ -63,10 +63,11 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
                 false);
   BatchMeans wp_avg;
   const double N = static_cast<double>(s.n_local);
+  auto mean_of_sum = [&](double sum) { return N > 0 ? sum / N : 0.0; };
   auto mean_of = [&](const std::vector<double>& a) {
     double sum = 0.0;
     for (std::size_t i = 0; i < s.n_local; ++i) sum += a[i];
-    return N > 0 ? sum / N : 0.0;
+    return mean_of_sum(sum);
   };
   SummaryBase sb;
   int exit_code = kExitOk;
@@ -83,7 +84,7 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
     vz_sums.resize(static_cast<std::size_t>(stop - n));
     dem.advance(static_cast<int>(stop - n), averaging ? vz_sums.data() : nullptr);
     if (averaging)
-      for (double sum : vz_sums) wp_avg.add(N > 0 ? sum / N : 0.0);
+      for (double sum : vz_sums) wp_avg.add(mean_of_sum(sum));
     n = stop;
     if (n % out_stride == 0 || n == nsteps) {
       const double ke = dem.kinetic_energy_j();
