@@ -143,8 +143,8 @@ class DemSystem {
   void exchange_ghosts();
   void forward_ghosts();
   void drop_ghosts();
-  /// Keeps the particles keep[0], keep[1], ... (local ones), with their predicted velocities and
-  /// wall histories, in that order.
+  /// Keeps the particles keep[0] < keep[1] < ... (local ones), with their predicted velocities
+  /// and wall histories, in that order.
   void select_particles(const std::vector<std::size_t>& keep);
   void set_cutoff_and_mass();
   void compute_forces();

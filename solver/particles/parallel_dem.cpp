@@ -78,19 +78,11 @@ void DemSystem::decompose(const SlabDecomposition& d) {
 }
 
 void DemSystem::select_particles(const std::vector<std::size_t>& keep) {
-  // permute() by a subset puts those particles first, in that order; resize drops the rest.
-  s_.permute(keep);
+  s_.keep_increasing(keep);
   s_.n_local = keep.size();
-  s_.resize(keep.size());
-  const auto pick = [&](std::vector<double>& a) {
-    if (a.empty()) return;
-    std::vector<double> kept(keep.size());
-    for (std::size_t k = 0; k < keep.size(); ++k) kept[k] = a[keep[k]];
-    a.swap(kept);
-  };
-  for (auto& a : pred_) pick(a);
+  for (auto& a : pred_) compact_increasing(a, keep);
   for (auto* wh : {&whx_, &why_, &whz_})
-    for (auto& a : *wh) pick(a);
+    for (auto& a : *wh) compact_increasing(a, keep);
 }
 
 void DemSystem::set_cutoff_and_mass() {

@@ -36,4 +36,10 @@ void ParticleStore::permute(const std::vector<std::size_t>& order) {
   id.swap(tid);
 }
 
+void ParticleStore::keep_increasing(const std::vector<std::size_t>& keep) {
+  for_each_array([&](std::vector<double>& a) { compact_increasing(a, keep); });
+  compact_increasing(id, keep);
+  n_local = std::min(n_local, keep.size());
+}
+
 }  // namespace boycott::particles

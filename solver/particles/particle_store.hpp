@@ -8,6 +8,17 @@
 
 namespace boycott::particles {
 
+/// a <- (a[keep[0]], a[keep[1]], ...) in place, for strictly increasing keep: element k is read
+/// from keep[k] >= k, which no earlier write has touched. The prefix where keep[k] == k stays.
+template <class T>
+void compact_increasing(std::vector<T>& a, const std::vector<std::size_t>& keep) {
+  if (a.empty()) return;  // an array the run does not use
+  std::size_t k = 0;
+  while (k < keep.size() && keep[k] == k) ++k;
+  for (; k < keep.size(); ++k) a[k] = a[keep[k]];
+  a.resize(keep.size());
+}
+
 struct ParticleStore {
   std::size_t n_local = 0;
 
@@ -47,6 +58,11 @@ struct ParticleStore {
   /// Reorders every per-particle array by `order` (new index k holds old particle order[k]).
   /// An order of fewer particles than stored puts those first; resize() then drops the rest.
   void permute(const std::vector<std::size_t>& order);
+
+  /// Keeps particles keep[0] < keep[1] < ... (strictly increasing), in that order, and drops the
+  /// rest: the same result as permute(keep) then resize(keep.size()), but in place (each array is
+  /// read and written once, from the first particle that moves, with no copy allocated).
+  void keep_increasing(const std::vector<std::size_t>& keep);
 
   template <class F>
   void for_each_array(F&& f) {
