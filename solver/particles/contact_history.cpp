@@ -23,15 +23,17 @@ void DemSystem::collect_histories() {
   carry_h_.clear();
   const std::size_t n = s_.size();
   if (nl_.offsets.size() != n + 1) return;
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
-      if (h_[3 * p] == 0.0 && h_[3 * p + 1] == 0.0 && h_[3 * p + 2] == 0.0) continue;
-      const std::int64_t a = s_.id[i], b = s_.id[nl_.neighbors[p]];
-      const double sg = a < b ? 1.0 : -1.0;
-      carry_a_.push_back(std::min(a, b));
-      carry_b_.push_back(std::max(a, b));
-      carry_h_.insert(carry_h_.end(), {sg * h_[3 * p], sg * h_[3 * p + 1], sg * h_[3 * p + 2]});
-    }
+  // Only the pairs of the last contact list (or of the last restore) can hold a history: every
+  // other slot is zero (forget_separated_pairs). They are in increasing slot order, so this
+  // visits the same slots in the same order as a scan of the whole list, at O(contacts).
+  for (const std::uint32_t p : prev_contacts_) {
+    if (h_[3 * p] == 0.0 && h_[3 * p + 1] == 0.0 && h_[3 * p + 2] == 0.0) continue;
+    const std::int64_t a = s_.id[pair_i_[p]], b = s_.id[nl_.neighbors[p]];
+    const double sg = a < b ? 1.0 : -1.0;
+    carry_a_.push_back(std::min(a, b));
+    carry_b_.push_back(std::max(a, b));
+    carry_h_.insert(carry_h_.end(), {sg * h_[3 * p], sg * h_[3 * p + 1], sg * h_[3 * p + 2]});
+  }
 }
 
 void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const std::vector<std::int64_t>& idb,
