@@ -104,11 +104,14 @@ for r in $(seq 1 "$rounds"); do
       python3 - "$out/summary.json" "$tag" "$n" "$r" "$(python3 -c "print($t1 - $t0)")" "$interval" \
         >> "$results" <<'PY'
 import json, sys
+import os
 s = json.load(open(sys.argv[1]))
+# This run's DEM step: the summary's step count runs from t = 0, through the warm-up's steps,
+# which a --set time.dt_dem=... variant does not share.
+dt_dem = json.load(open(os.path.join(os.path.dirname(sys.argv[1]), "params.json")))["time"]["dt_dem"]
 print(json.dumps({"tag": sys.argv[2], "ranks": int(sys.argv[3]), "round": int(sys.argv[4]),
                   "wall_s": float(sys.argv[5]), "interval_s": float(sys.argv[6]),
-                  "particles": s["particle_count"], "dt_dem_s": s["dem_steps"] and
-                  s["simulated_time_s"] / s["dem_steps"], "per_rank": s["ranks"]["per_rank"],
+                  "particles": s["particle_count"], "dt_dem_s": dt_dem, "per_rank": s["ranks"]["per_rank"],
                   "w_p": s.get("mean_settling_velocity_m_s"),
                   "rebuilds": s.get("neighbor_rebuilds_this_attempt")}))
 PY
