@@ -236,14 +236,15 @@ void CoupledSystem::restore_counters(const CoupledCounters& c) {
 }
 
 nlohmann::json CoupledSystem::rank_report() const {
-  const std::vector<std::pair<const char*, double>> phases = {{"fluid", seconds_fluid_},
-                                                              {"coupling_sample", coupler_->seconds_sample},
-                                                              {"coupling_deposit", coupler_->seconds_deposit},
-                                                              {"dem_contacts", dem_->seconds_force},
-                                                              {"neighbor_search", dem_->seconds_neighbor},
-                                                              {"integration", dem_->seconds_integrate},
-                                                              {"ghost_refresh", dem_->seconds_ghosts},
-                                                              {"waiting", seconds_wait_}};
+  const std::vector<std::pair<const char*, double>> phases = {
+      {"fluid", seconds_fluid_},
+      {"coupling_sample", coupler_->seconds_sample},
+      {"coupling_deposit", coupler_->seconds_deposit},
+      {"dem_contacts", dem_->seconds_force},
+      {"neighbor_search", dem_->seconds_neighbor},
+      {"integration", dem_->seconds_integrate},
+      {"ghost_refresh", dem_->seconds_ghosts},
+      {"waiting", seconds_wait_ + dem_->seconds_wait}};
   std::vector<double> mine{static_cast<double>(dem_->particles().n_local)};
   for (const auto& ph : phases) mine.push_back(ph.second);
   const int n = static_cast<int>(mine.size());

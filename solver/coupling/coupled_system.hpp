@@ -87,8 +87,9 @@ class CoupledSystem {
   void restore_counters(const CoupledCounters& c);
 
   /// Particles per rank (min, mean, max) and each rank's seconds per phase in this process,
-  /// communication inside them; "waiting" is the time a rank waited for the others at the end
-  /// of the particle phases. Collective; the same on every rank.
+  /// communication inside them; "waiting" is the time a rank waited for the others: in each DEM
+  /// step's rebuild test and at the end of the particle phases. Collective; the same on every
+  /// rank.
   nlohmann::json rank_report() const;
   /// Adds the wall time of each part to the timers (call once at the end).
   void report_timers(ModelTimers& t) const;

@@ -127,13 +127,17 @@ class DemSystem {
   /// Seconds spent in neighbour search (migration and ghost set-up included), force
   /// evaluation, integration, and the ghost updates of the steps between rebuilds.
   double seconds_neighbor = 0.0, seconds_force = 0.0, seconds_integrate = 0.0, seconds_ghosts = 0.0;
+  /// Several ranks: seconds in the rebuild test's reduction, the first point of every DEM step
+  /// where the ranks meet, so mostly the wait for the rank with the most work (the reduction of
+  /// a few doubles itself takes microseconds).
+  double seconds_wait = 0.0;
 
  private:
   template <class Rolling>
   void compute_forces_impl(const Rolling& rolling);
   // Several ranks (parallel_dem.cpp): the rebuild moves particles between ranks and renews the
   // ghost copies; between rebuilds the ghosts' positions and velocities are refreshed.
-  bool needs_rebuild_parallel() const;
+  bool needs_rebuild_parallel();
   /// collect: take the contact histories from the current list (false: from carry_*, set by
   /// the caller).
   void rebuild_parallel(bool collect = true);

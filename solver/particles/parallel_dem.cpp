@@ -99,7 +99,7 @@ void DemSystem::set_cutoff_and_mass() {
   uniform_mass_kg_ = std::isfinite(mmin) && mmin == mmax ? mmin : 0.0;
 }
 
-bool DemSystem::needs_rebuild_parallel() const {
+bool DemSystem::needs_rebuild_parallel() {
   // The pairs: as on one rank, every particle within skin/2 of a centre common to all ranks
   // (displacement_bound.hpp). A ghost held here is a particle that was within the cutoff of this
   // slab along z at the build, so a pair of a local particle and one that is not held was at
@@ -111,7 +111,9 @@ bool DemSystem::needs_rebuild_parallel() const {
   // one ordered sum for the mean (the same bits on every rank, so that every rank takes the same
   // decision).
   double ext[6] = {sp.hi[0], sp.hi[1], sp.hi[2], -sp.lo[0], -sp.lo[1], -sp.lo[2]};
+  const auto tw = std::chrono::steady_clock::now();
   MPI_Allreduce(MPI_IN_PLACE, ext, 6, MPI_DOUBLE, MPI_MAX, dd_.comm);
+  seconds_wait += seconds_since(tw);
   DisplacementSpread all;
   for (int c = 0; c < 3; ++c) all.hi[c] = ext[c], all.lo[c] = -ext[3 + c];
   if (std::max(all.hi[2], -all.lo[2]) > cfg_.slab_excursion_m) return true;
