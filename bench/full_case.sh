@@ -103,8 +103,7 @@ for r in $(seq 1 "$rounds"); do
       t1=$(date +%s.%N)
       python3 - "$out/summary.json" "$tag" "$n" "$r" "$(python3 -c "print($t1 - $t0)")" "$interval" \
         >> "$results" <<'PY'
-import json, sys
-import os
+import json, os, sys
 s = json.load(open(sys.argv[1]))
 # This run's DEM step: the summary's step count runs from t = 0, through the warm-up's steps,
 # which a --set time.dt_dem=... variant does not share.

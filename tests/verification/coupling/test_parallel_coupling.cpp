@@ -252,14 +252,10 @@ angle_deg = 60.0
   ASSERT_EQ(static_cast<int>(per.size()), ranks);
   auto sec = [&](int r, const char* phase) { return per[r]["seconds"][phase].get<double>(); };
   const double work0 = sec(0, "dem_contacts") + sec(0, "neighbor_search") + sec(0, "integration");
+  std::string waits;
+  for (int r = 0; r < ranks; ++r) waits += (r ? ", " : "") + std::to_string(sec(r, "waiting"));
   std::printf("[ report ] %d ranks, particles per rank %s: rank 0 particle phases %.3f s, waiting %s s\n",
-              ranks, report["particles"].dump().c_str(), work0,
-              [&] {
-                std::string w;
-                for (int r = 0; r < ranks; ++r) w += (r ? ", " : "") + std::to_string(sec(r, "waiting"));
-                return w;
-              }()
-                  .c_str());
+              ranks, report["particles"].dump().c_str(), work0, waits.c_str());
   EXPECT_GT(per[0]["particles"].get<std::int64_t>(), 0);
   if (ranks > static_cast<int>(std::thread::hardware_concurrency())) return;
   for (int r = 1; r < ranks; ++r) {
