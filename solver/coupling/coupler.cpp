@@ -143,6 +143,28 @@ inline double sample(const Offsets3& o, const std::vector<double>& field) {
   return s;
 }
 
+/// sample() of N fields that share one layout, in one pass over the stencil: the offsets and
+/// weights are read once for all of them, and each field's sums run in sample()'s order, so each
+/// result is sample()'s to the bit.
+template <int N>
+inline void sample_fields(const Offsets3& o, const double* const (&f)[N], double (&out)[N]) {
+  double s[N] = {};
+  for (int c = 0; c < o.n[2]; ++c) {
+    double sy[N] = {};
+    for (int b = 0; b < o.n[1]; ++b) {
+      const std::size_t row = o.off[2][c] + o.off[1][b];
+      double sx[N] = {};
+      for (int a = 0; a < o.n[0]; ++a) {
+        const std::size_t q = row + o.off[0][a];
+        for (int m = 0; m < N; ++m) sx[m] += o.w[0][a] * f[m][q];
+      }
+      for (int m = 0; m < N; ++m) sy[m] += o.w[1][b] * sx[m];
+    }
+    for (int m = 0; m < N; ++m) s[m] += o.w[2][c] * sy[m];
+  }
+  for (int m = 0; m < N; ++m) out[m] = s[m];
+}
+
 /// Calls f(index, w_x w_y w_z) for every stencil point.
 template <class F>
 inline void scatter(const Offsets3& o, F&& f) {
@@ -178,6 +200,17 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
       // the face fields of component c share one layout
       const Offsets3 o = offsets(wx, wy, wz, fields_.velocity(c));
       if (!linear) {
+        if (s_.pressure_gradient && s_.viscous && s_.added_mass) {  // the default forces: one pass
+          const double* const f[4] = {fields_.velocity(c).a.data(), fields_.pressure_gradient(c).a.data(),
+                                      fields_.viscous(c).a.data(), fields_.material_derivative(c).a.data()};
+          double v[4];
+          sample_fields(o, f, v);
+          uf[c] = v[0];
+          fe[c] -= vp * v[1];
+          fe[c] += rho * vp * v[2];
+          dudt[c] = v[3];
+          continue;
+        }
         uf[c] = sample(o, fields_.velocity(c).a);
         if (s_.pressure_gradient) fe[c] -= vp * sample(o, fields_.pressure_gradient(c).a);
         if (s_.viscous) fe[c] += rho * vp * sample(o, fields_.viscous(c).a);
@@ -218,8 +251,20 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
     }
     const Offsets3 oc = linear ? offsets(ls.x[0], ls.y_centre_extrapolated, ls.z[0], solid_)
                                : offsets(st.cell[0], st.cell[1], st.cell[2], solid_);  // cell-centred fields
-    const double solid =
-        linear ? sample(offsets(ls.x[0], ls.y_alpha, ls.z[0], solid_), solid_.a) : sample(oc, solid_.a);
+    // the vorticity (cell-centred, like the solid fraction) in the solid fraction's pass
+    double w[3] = {0.0, 0.0, 0.0};
+    double solid;
+    if (!linear && s_.saffman_lift) {
+      const double* const f[4] = {solid_.a.data(), fields_.vorticity(0).a.data(),
+                                  fields_.vorticity(1).a.data(), fields_.vorticity(2).a.data()};
+      double v[4];
+      sample_fields(oc, f, v);
+      solid = v[0], w[0] = v[1], w[1] = v[2], w[2] = v[3];
+    } else {
+      solid = linear ? sample(offsets(ls.x[0], ls.y_alpha, ls.z[0], solid_), solid_.a) : sample(oc, solid_.a);
+      if (s_.saffman_lift)
+        for (int c = 0; c < 3; ++c) w[c] = sample(oc, fields_.vorticity(c).a);
+    }
     const double alpha_f = 1.0 - solid;
     const double s0 = uf[0] - p.vx[i], s1 = uf[1] - p.vy[i], s2 = uf[2] - p.vz[i];
     const double slip = std::sqrt(s0 * s0 + s1 * s1 + s2 * s2);
@@ -228,11 +273,6 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
 
     double react[3] = {0.0, 0.0, 0.0};
     if (s_.saffman_lift) {
-      double w[3];
-      for (int c = 0; c < 3; ++c) {
-        const GridField& W = fields_.vorticity(c);
-        w[c] = sample(oc, W.a);
-      }
       const double wn = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
       if (wn > 0.0) {
         // Eq. 16: 1.61 rho d^2 sqrt(nu / |w|) (u_f - u_p) x w

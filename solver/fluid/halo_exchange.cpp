@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <cstring>
+#include <stdexcept>
 
 #include "fluid/petsc_check.hpp"
 
@@ -97,6 +98,28 @@ void HaloExchange::fill(Vec global, Vec local) const {
   }
   check(VecRestoreArray(local, &l), "VecRestoreArray");
   check(VecRestoreArrayRead(global, &g), "VecRestoreArrayRead");
+}
+
+void HaloExchange::boundary_planes(const double* global, double* below, double* above) const {
+  if (!fast_) throw std::logic_error("HaloExchange::boundary_planes: the slab decomposition is not in use");
+  const std::size_t plane = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_);
+  const double* first_owned = global;
+  const double* last_owned = global + (static_cast<std::size_t>(zm_) - 1) * plane;
+  int self;
+  MPI_Comm_rank(comm_, &self);
+  if (below_ == self && above_ == self) {
+    std::memcpy(below, last_owned, plane * sizeof(double));
+    std::memcpy(above, first_owned, plane * sizeof(double));
+    return;
+  }
+  // tags apart from fill()'s, though every rank makes the same calls in the same order
+  MPI_Request req[4];
+  const int n = static_cast<int>(plane);
+  MPI_Irecv(above, n, MPI_DOUBLE, above_, 2, comm_, &req[0]);  // the above rank's first plane
+  MPI_Irecv(below, n, MPI_DOUBLE, below_, 3, comm_, &req[1]);  // the below rank's last plane
+  MPI_Isend(first_owned, n, MPI_DOUBLE, below_, 2, comm_, &req[2]);
+  MPI_Isend(last_owned, n, MPI_DOUBLE, above_, 3, comm_, &req[3]);
+  MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
 }
 
 }  // namespace boycott::fluid

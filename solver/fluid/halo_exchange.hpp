@@ -22,6 +22,11 @@ class HaloExchange {
   void fill(Vec global, Vec local) const;
   /// Whether the block-copy path is used (else DMGlobalToLocal).
   bool fast() const { return fast_; }
+  /// Fast path only: the plane below this slab's first owned plane and the plane above its last
+  /// (z periodic; nx x ny values each, x fastest), from the owned values `global` (x fastest,
+  /// then y, then z). An operator that reads one plane beyond its slab needs these alone, not
+  /// a ghosted copy of the whole vector.
+  void boundary_planes(const double* global, double* below, double* above) const;
 
  private:
   DM dm_;

@@ -54,6 +54,27 @@ inline void row_product(const double* const* c, const double* __restrict x, doub
   }
 }
 
+/// The same row sum, each neighbour read from its own row: x (this row, periodic in x), ys / yn
+/// (the rows at -y / +y, read where lo / hi), zb / zt (the rows in the planes below and above).
+template <bool lo, bool hi>
+inline void row_product_rows(const double* const* c, const double* __restrict x, const double* __restrict ys,
+                             const double* __restrict yn, const double* __restrict zb,
+                             const double* __restrict zt, double* __restrict y, int n) {
+  const double* __restrict c0 = c[0], * __restrict c1 = c[1], * __restrict c2 = c[2], * __restrict c3 = c[3];
+  const double* __restrict c4 = c[4], * __restrict c5 = c[5], * __restrict c6 = c[6];
+  const auto one = [&](int i, int im, int ip) {
+    double s = c0[i] * x[i] + c1[i] * x[im] + c2[i] * x[ip];
+    if constexpr (lo) s += c3[i] * ys[i];
+    if constexpr (hi) s += c4[i] * yn[i];
+    y[i] = s + c5[i] * zb[i] + c6[i] * zt[i];
+  };
+  // the x ends wrap (periodic x); with n = 1 or 2 both neighbours are one cell
+  one(0, n - 1, n > 1 ? 1 : 0);
+#pragma GCC ivdep
+  for (int i = 1; i < n - 1; ++i) one(i, i - 1, i + 1);
+  if (n > 1) one(n - 1, n - 2, 0);
+}
+
 }  // namespace
 
 StencilOperator::StencilOperator(DM dm) : dm_(dm), halo_(dm) {
@@ -93,7 +114,53 @@ StencilOperator::~StencilOperator() {
   if (xl_) VecDestroy(&xl_);
 }
 
+// Where each rank owns whole z-planes (HaloExchange's fast path) the product reads the owned
+// values in place and only the two planes beyond the slab travel: filling a ghosted copy of x
+// first moved the whole vector once more per product (the copy was ~1/5 of a product's time).
+// Each row's sum is the ghosted path's, term for term, so the results are the same to the bit.
 void StencilOperator::apply(Vec x, Vec y) const {
+  if (!halo_.fast()) {
+    apply_ghosted(x, y);
+    return;
+  }
+  const double* g;
+  double* ya;
+  check(VecGetArrayRead(x, &g), "VecGetArrayRead");
+  check(VecGetArray(y, &ya), "VecGetArray");
+  const int nx = static_cast<int>(size_[0]), ny = static_cast<int>(size_[1]), nz = static_cast<int>(size_[2]);
+  const std::size_t plane = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
+  planes_.resize(2 * plane);
+  double* below = planes_.data();
+  double* above = below + plane;
+  halo_.boundary_planes(g, below, above);
+  const double* c[7];
+  std::int64_t o = 0;
+  for (int k = 0; k < nz; ++k) {
+    const double* P = g + static_cast<std::size_t>(k) * plane;
+    const double* Pb = k > 0 ? P - plane : below;
+    const double* Pt = k + 1 < nz ? P + plane : above;
+    for (int j = 0; j < ny; ++j, o += nx) {
+      for (int e = 0; e < 7; ++e) c[e] = coef_[e].data() + o;
+      const std::size_t r = static_cast<std::size_t>(j) * nx;
+      // -y / +y rows (periodic y wraps; at a wall the entry does not exist)
+      const double* ys = P + static_cast<std::size_t>((j + ny - 1) % ny) * nx;
+      const double* yn = P + static_cast<std::size_t>((j + 1) % ny) * nx;
+      const bool lo = !(wall_y_ && j == 0), hi = !(wall_y_ && j == ny - 1);
+      if (lo && hi)
+        row_product_rows<true, true>(c, P + r, ys, yn, Pb + r, Pt + r, ya + o, nx);
+      else if (lo)
+        row_product_rows<true, false>(c, P + r, ys, yn, Pb + r, Pt + r, ya + o, nx);
+      else if (hi)
+        row_product_rows<false, true>(c, P + r, ys, yn, Pb + r, Pt + r, ya + o, nx);
+      else
+        row_product_rows<false, false>(c, P + r, ys, yn, Pb + r, Pt + r, ya + o, nx);
+    }
+  }
+  check(VecRestoreArrayRead(x, &g), "VecRestoreArrayRead");
+  check(VecRestoreArray(y, &ya), "VecRestoreArray");
+}
+
+void StencilOperator::apply_ghosted(Vec x, Vec y) const {
   halo_.fill(x, xl_);
   const double* xa;
   double* ya;

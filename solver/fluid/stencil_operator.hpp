@@ -38,13 +38,17 @@ class StencilOperator {
   Mat mat() const { return shell_; }
   /// y = A x (global vectors of the DM).
   void apply(Vec x, Vec y) const;
+  /// The same product through a ghosted copy of x (any decomposition; apply() uses it where the
+  /// ranks do not own whole z-planes). Public so that tests can hold the two paths to the bit.
+  void apply_ghosted(Vec x, Vec y) const;
   /// Writes the coefficients into M (an AIJ matrix of the DM, whose slots W has looked up).
   void copy_to(Mat M, StencilMatrixWriter& W) const;
 
  private:
   DM dm_;
   HaloExchange halo_;
-  Vec xl_ = nullptr;  // ghosted work vector
+  Vec xl_ = nullptr;                    // ghosted work vector (apply_ghosted)
+  mutable std::vector<double> planes_;  // the planes below and above the slab (apply)
   Mat shell_ = nullptr;
   std::array<std::vector<double>, 7> coef_;
   std::array<PetscInt, 3> lo_{}, size_{}, glo_{}, gsize_{};

@@ -3,13 +3,17 @@
 // two cells long, where a row's two neighbours are the same cell and their values add. And
 // StencilOperator (the matrix-free operator of the momentum and pressure systems) gives the same
 // product as the AIJ matrix it copies itself into, on the same grids. Runs on PETSC_COMM_WORLD
-// (one rank under ctest; under mpirun the rows are split over ranks).
+// (one rank under ctest; under mpirun the rows are split over ranks). Where the ranks own whole
+// z-planes the product reads x in place; it must give the ghosted path's values to the bit.
 #include <gtest/gtest.h>
 #include <petscdmda.h>
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
+#include <utility>
 
+#include "fluid/halo_exchange.hpp"
 #include "fluid/stencil_matrix.hpp"
 #include "fluid/stencil_operator.hpp"
 
@@ -187,6 +191,61 @@ TEST(StencilOperator, MatchesItsAijCopyFullyPeriodic) {
 TEST(StencilOperator, AddsBothNeighboursWhereAPeriodicDirectionIsTwoCellsLong) {
   const Result r = compare(2, 3, 4, false);
   EXPECT_LT(r.max_difference, kRoundoff);
+}
+
+// ---- StencilOperator: the in-place product on z-slabs against the ghosted one
+
+/// Largest |apply - apply_ghosted| (0 when every value agrees to the bit) on a DMDA cut into
+/// z-slabs only (the fluid's decomposition, where apply() reads x in place), ghost width 2 as the
+/// momentum DM has where the grid is long enough (else 1); and whether that decomposition took the in-place
+/// path.
+std::pair<double, bool> in_place_against_ghosted(PetscInt nx, PetscInt ny, PetscInt nz, bool periodic_y) {
+  DM da;
+  const DMBoundaryType by = periodic_y ? DM_BOUNDARY_PERIODIC : DM_BOUNDARY_NONE;
+  EXPECT_EQ(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, by, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR,
+                         nx, ny, nz, 1, 1, PETSC_DECIDE, 1, std::min({nx, ny, PetscInt{2}}), nullptr, nullptr,
+                         nullptr, &da),
+            0);
+  EXPECT_EQ(DMSetUp(da), 0);
+  PetscInt xs, ys, zs, xm, ym, zm;
+  DMDAGetCorners(da, &xs, &ys, &zs, &xm, &ym, &zm);
+  StencilOperator op(da);
+  std::int64_t o = 0;
+  for (PetscInt k = zs; k < zs + zm; ++k)
+    for (PetscInt j = ys; j < ys + ym; ++j)
+      for (PetscInt i = xs; i < xs + xm; ++i, ++o)
+        for (int e = 0; e < 7; ++e) op.coef(e)[o] = coefficient(i, j, k, e) * (1.0 + 1e-3 * std::sin(o + e));
+  Vec x, y_in_place, y_ghosted;
+  DMCreateGlobalVector(da, &x);
+  VecDuplicate(x, &y_in_place);
+  VecDuplicate(x, &y_ghosted);
+  PetscScalar*** xa;
+  DMDAVecGetArray(da, x, &xa);
+  for (PetscInt k = zs; k < zs + zm; ++k)
+    for (PetscInt j = ys; j < ys + ym; ++j)
+      for (PetscInt i = xs; i < xs + xm; ++i) xa[k][j][i] = std::sin(1.3 * i + 0.7 * j * j + 2.1 * k) + 0.5;
+  DMDAVecRestoreArray(da, x, &xa);
+  op.apply(x, y_in_place);
+  op.apply_ghosted(x, y_ghosted);
+  VecAXPY(y_in_place, -1.0, y_ghosted);
+  PetscReal diff;
+  VecNorm(y_in_place, NORM_INFINITY, &diff);
+  const bool in_place = HaloExchange(da).fast();
+  for (Vec* v : {&x, &y_in_place, &y_ghosted}) VecDestroy(v);
+  DMDestroy(&da);
+  return {diff, in_place};
+}
+
+TEST(StencilOperator, InPlaceProductOnZSlabsIsTheGhostedOneToTheBit) {
+  int ranks;
+  MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
+  // walls in y, periodic y, and periodic directions one and two cells long
+  for (const auto& [nx, ny, periodic_y] :
+       {std::tuple{7, 6, false}, std::tuple{6, 4, true}, std::tuple{2, 3, false}, std::tuple{1, 2, true}}) {
+    const auto [diff, in_place] = in_place_against_ghosted(nx, ny, 3 * ranks, periodic_y);
+    EXPECT_TRUE(in_place) << nx << " x " << ny;
+    EXPECT_EQ(diff, 0.0) << nx << " x " << ny << (periodic_y ? ", periodic y" : ", walls in y");
+  }
 }
 
 }  // namespace
