@@ -160,80 +160,140 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
               [&](int i, int j, int k) { return inside(j, k) ? p_.at(i, j, k + kofs_) : 0.0; });
   fill_padded(nupad_, n[0], n[1], planes,
               [&](int i, int j, int k) { return inside(j, k) ? nu_cell(i, j, k + kofs_) : 0.0; });
-  const Padded* const U[3] = {&upad_[0], &upad_[1], &upad_[2]};
-  auto uv = [&](int c, int i, int j, int k) { return (*U[c])(i, j, k - kofs_); };
-  auto nuc = [&](int i, int j, int k) { return nupad_(i, j, k - kofs_); };
+  // The value at (i + di, j, k) of a padded copy is row(P, j, k)[i + di]: each stencil read below
+  // is one row pointer, set once per (j, k) row, plus the cell index; the sums are the same as
+  // reading node by node, in the same order.
+  auto row = [&](const Padded& P, int j, int k) {
+    return P.a.data() +
+           (static_cast<std::size_t>(k - kofs_ + Padded::kPad) * P.ny +
+            static_cast<std::size_t>(j + Padded::kPad)) *
+               P.nx +
+           Padded::kPad;
+  };
   const bool first = !have_prev_ || dt_s <= 0.0;
   have_prev_ = true;
   const double G = fs.mean_pressure_gradient_pa_m();
+  const int nx = n[0];
+
+  // One neighbour term of the viscous operator: the neighbour along d on side s.
+  enum class Kind { along, wall, across };
+  struct Term {
+    Kind kind = Kind::along;
+    int s = 1;
+    bool slip = false;
+    double h2 = 1.0, hd = 1.0;                                                // h_d^2, h_d
+    const double *n0 = nullptr, *n1 = nullptr, *n2 = nullptr, *n3 = nullptr;  // nu reads
+    const double *u0 = nullptr, *u1 = nullptr, *un = nullptr;                 // velocity reads
+  };
+  // The reads of the material derivative's term along d.
+  struct Conv {
+    const double *a0, *a1, *a2, *a3, *b0, *b1;
+  };
 
   for (int c = 0; c < 3; ++c) {
     const int ec[3] = {kE[c][0], kE[c][1], kE[c][2]};
     const int nyc = u_[c].ny;
+    const Padded& Uc = upad_[c];
     for (int k = kb_; k < ke_; ++k)
-      for (int j = 0; j < nyc; ++j)
-        for (int i = 0; i < n[0]; ++i) {
-          const bool wall_row = walls_ && c == 1 && (j == 0 || j == n[1]);
-          if (wall_row) continue;  // filled from the nearest interior row below
-          const int im = i - ec[0], jm = j - ec[1], km = k - ec[2];
-          gradp_[c].at(i, j, k) =
-              (ppad_(i, j, k - kofs_) - ppad_(im, jm, km - kofs_)) / h[c] + (c == 2 ? G : 0.0);
+      for (int j = 0; j < nyc; ++j) {
+        const bool wall_row = walls_ && c == 1 && (j == 0 || j == n[1]);
+        if (wall_row) continue;  // filled from the nearest interior row below
+        const int jm = j - ec[1], km = k - ec[2];
+        const std::size_t o = (static_cast<std::size_t>(k - u_[c].k0) * nyc + j) * nx;  // (0, j, k), in range
+        const double* up = u_[c].a.data() + o;
+        const double* uq = uprev_[c].a.data() + o;
+        double* gp = gradp_[c].a.data() + o;
+        double* vs = visc_[c].a.data() + o;
+        double* md = dudt_[c].a.data() + o;
+        const double* p0 = row(ppad_, j, k);
+        const double* p1 = row(ppad_, jm, km) - ec[0];
+        const double addG = c == 2 ? G : 0.0;
 
-          if (need_viscous) {
-            // The fluid momentum equation's viscous operator (fluid_solver.cpp), per unit mass.
-            const double uP = u_[c].at(i, j, k);
-            double lap = 0.0, tstress = 0.0;
-            for (int d = 0; d < 3; ++d)
-              for (int s = -1; s <= 1; s += 2) {
-                const int N[3] = {i + s * kE[d][0], j + s * kE[d][1], k + s * kE[d][2]};
-                double nuf = 0.0, tT = 0.0;
-                if (d == c) {
-                  const int Q[3] = {s > 0 ? i : im, s > 0 ? j : jm, s > 0 ? k : km};
-                  nuf = nuc(Q[0], Q[1], Q[2]);
-                  tT = nuf * (uv(c, Q[0] + ec[0], Q[1] + ec[1], Q[2] + ec[2]) - uv(c, Q[0], Q[1], Q[2])) /
-                       h[c];
-                  lap += nuf * (uv(c, N[0], N[1], N[2]) - uP) / (h[d] * h[d]);
-                } else {
-                  const int E[3] = {s > 0 ? N[0] : i, s > 0 ? N[1] : j, s > 0 ? N[2] : k};
-                  if (d == 1 && walls_ && (E[1] <= 0 || E[1] >= n[1])) {
-                    nuf = 0.5 * (nuc(i, j, k) + nuc(im, jm, km));
-                    const bool slip = s > 0 && top_slip_;
-                    if (!slip) lap += -2.0 * nuf * uP / (h[d] * h[d]);
-                    tT = 0.0;  // v = 0 along the wall
-                  } else {
-                    const int O[3] = {E[0] - kE[d][0], E[1] - kE[d][1], E[2] - kE[d][2]};
-                    nuf = 0.25 * (nuc(E[0], E[1], E[2]) + nuc(E[0] - ec[0], E[1] - ec[1], E[2] - ec[2]) +
-                                  nuc(O[0], O[1], O[2]) + nuc(O[0] - ec[0], O[1] - ec[1], O[2] - ec[2]));
-                    tT = nuf * (uv(d, E[0], E[1], E[2]) - uv(d, E[0] - ec[0], E[1] - ec[1], E[2] - ec[2])) /
-                         h[c];
-                    lap += nuf * (uv(c, N[0], N[1], N[2]) - uP) / (h[d] * h[d]);
-                  }
-                }
-                tstress += s * tT / h[d];
+        Term terms[6];
+        if (need_viscous)
+          for (int d = 0, t = 0; d < 3; ++d)
+            for (int s = -1; s <= 1; s += 2, ++t) {
+              Term& T = terms[t];
+              T.s = s, T.h2 = h[d] * h[d], T.hd = h[d];
+              const int N[3] = {s * kE[d][0], j + s * kE[d][1], k + s * kE[d][2]};  // i offset, j, k
+              if (d == c) {
+                T.kind = Kind::along;
+                const int Q[3] = {s > 0 ? 0 : -ec[0], s > 0 ? j : jm, s > 0 ? k : km};
+                T.n0 = row(nupad_, Q[1], Q[2]) + Q[0];
+                T.u0 = row(Uc, Q[1], Q[2]) + Q[0];
+                T.u1 = row(Uc, Q[1] + ec[1], Q[2] + ec[2]) + Q[0] + ec[0];
+                T.un = row(Uc, N[1], N[2]) + N[0];
+                continue;
               }
-            visc_[c].at(i, j, k) = lap + tstress;
+              const int E[3] = {s > 0 ? N[0] : 0, s > 0 ? N[1] : j, s > 0 ? N[2] : k};
+              if (d == 1 && walls_ && (E[1] <= 0 || E[1] >= n[1])) {
+                T.kind = Kind::wall;
+                T.slip = s > 0 && top_slip_;
+                T.n0 = row(nupad_, j, k);
+                T.n1 = row(nupad_, jm, km) - ec[0];
+                continue;
+              }
+              T.kind = Kind::across;
+              const int O[3] = {E[0] - kE[d][0], E[1] - kE[d][1], E[2] - kE[d][2]};
+              T.n0 = row(nupad_, E[1], E[2]) + E[0];
+              T.n1 = row(nupad_, E[1] - ec[1], E[2] - ec[2]) + E[0] - ec[0];
+              T.n2 = row(nupad_, O[1], O[2]) + O[0];
+              T.n3 = row(nupad_, O[1] - ec[1], O[2] - ec[2]) + O[0] - ec[0];
+              T.u1 = row(upad_[d], E[1], E[2]) + E[0];
+              T.u0 = row(upad_[d], E[1] - ec[1], E[2] - ec[2]) + E[0] - ec[0];
+              T.un = row(Uc, N[1], N[2]) + N[0];
+            }
+        Conv cv[3];
+        if (need_material)
+          for (int d = 0; d < 3; ++d) {
+            const int e[3] = {kE[d][0], kE[d][1], kE[d][2]};
+            const Padded& Ud = upad_[d];
+            cv[d].a0 = row(Ud, j, k);
+            cv[d].a1 = row(Ud, j + e[1], k + e[2]) + e[0];
+            cv[d].a2 = row(Ud, jm, km) - ec[0];
+            cv[d].a3 = row(Ud, jm + e[1], km + e[2]) - ec[0] + e[0];
+            cv[d].b1 = row(Uc, j + e[1], k + e[2]) + e[0];
+            cv[d].b0 = row(Uc, j - e[1], k - e[2]) - e[0];
           }
 
+        for (int i = 0; i < nx; ++i) {
+          gp[i] = (p0[i] - p1[i]) / h[c] + addG;
+          if (need_viscous) {
+            // The fluid momentum equation's viscous operator (fluid_solver.cpp), per unit mass.
+            const double uP = up[i];
+            double lap = 0.0, tstress = 0.0;
+            for (const Term& T : terms) {
+              double tT;
+              if (T.kind == Kind::along) {
+                const double nuf = T.n0[i];
+                tT = nuf * (T.u1[i] - T.u0[i]) / h[c];
+                lap += nuf * (T.un[i] - uP) / T.h2;
+              } else if (T.kind == Kind::wall) {
+                const double nuf = 0.5 * (T.n0[i] + T.n1[i]);
+                if (!T.slip) lap += -2.0 * nuf * uP / T.h2;
+                tT = 0.0;  // v = 0 along the wall
+              } else {
+                const double nuf = 0.25 * (T.n0[i] + T.n1[i] + T.n2[i] + T.n3[i]);
+                tT = nuf * (T.u1[i] - T.u0[i]) / h[c];
+                lap += nuf * (T.un[i] - uP) / T.h2;
+              }
+              tstress += T.s * tT / T.hd;
+            }
+            vs[i] = lap + tstress;
+          }
           if (need_material) {
             double conv = 0.0;
             for (int d = 0; d < 3; ++d) {
-              double ud;
-              if (d == c) {
-                ud = u_[c].at(i, j, k);
-              } else {
-                const int e[3] = {kE[d][0], kE[d][1], kE[d][2]};
-                ud = 0.25 * (uv(d, i, j, k) + uv(d, i + e[0], j + e[1], k + e[2]) + uv(d, im, jm, km) +
-                             uv(d, im + e[0], jm + e[1], km + e[2]));
-              }
-              const double dudx = (uv(c, i + kE[d][0], j + kE[d][1], k + kE[d][2]) -
-                                   uv(c, i - kE[d][0], j - kE[d][1], k - kE[d][2])) /
-                                  (2.0 * h[d]);
+              const Conv& C = cv[d];
+              const double ud = d == c ? up[i] : 0.25 * (C.a0[i] + C.a1[i] + C.a2[i] + C.a3[i]);
+              const double dudx = (C.b1[i] - C.b0[i]) / (2.0 * h[d]);
               conv += ud * dudx;
             }
-            const double dudt_local = first ? 0.0 : (u_[c].at(i, j, k) - uprev_[c].at(i, j, k)) / dt_s;
-            dudt_[c].at(i, j, k) = dudt_local + conv;
+            const double dudt_local = first ? 0.0 : (up[i] - uq[i]) / dt_s;
+            md[i] = dudt_local + conv;
           }
         }
+      }
     if (walls_ && c == 1) {
       // Wall rows are not fluid unknowns; a particle near the wall still feels the hydrostatic
       // gradient there, so they take the nearest interior face's value.
@@ -249,30 +309,53 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
   }
 
   if (need_vorticity) {
-    // Cell-centred velocity with the wall mirror rule, then central differences.
-    auto uc = [&](int e, int i, int j, int k) {
-      return 0.5 * (uv(e, i, j, k) + uv(e, i + kE[e][0], j + kE[e][1], k + kE[e][2]));
+    // Cell-centred velocity u_e at (i + di, j + dj, k + dk): sg (A[i] + B[i]) / 2, with the
+    // wall mirror rule in y as a sign and a mirrored row (sg = 1 inside: the same value).
+    struct CellRow {
+      double sg;
+      const double *A, *B;
     };
-    auto ucell = [&](int e, int i, int j, int k) {
+    const int ny = n[1];
+    auto cell_row = [&](int e, int di, int jj, int kk) {
+      double sg = 1.0;
       if (walls_ && e != 1) {
-        if (j < 0) return -uc(e, i, -1 - j, k);
-        if (j >= n[1]) return (top_slip_ ? 1.0 : -1.0) * uc(e, i, 2 * n[1] - 1 - j, k);
+        if (jj < 0) {
+          sg = -1.0, jj = -1 - jj;
+        } else if (jj >= ny) {
+          sg = top_slip_ ? 1.0 : -1.0, jj = 2 * ny - 1 - jj;
+        }
+      } else if (walls_ && e == 1 && (jj < 0 || jj >= ny)) {
+        sg = -1.0, jj = jj < 0 ? -1 - jj : 2 * ny - 1 - jj;
       }
-      if (walls_ && e == 1 && (j < 0 || j >= n[1])) return -uc(e, i, j < 0 ? -1 - j : 2 * n[1] - 1 - j, k);
-      return uc(e, i, j, k);
-    };
-    auto dd = [&](int e, int d, int i, int j, int k) {
-      return (ucell(e, i + kE[d][0], j + kE[d][1], k + kE[d][2]) -
-              ucell(e, i - kE[d][0], j - kE[d][1], k - kE[d][2])) /
-             (2.0 * h[d]);
+      return CellRow{sg, row(upad_[e], jj, kk) + di,
+                     row(upad_[e], jj + kE[e][1], kk + kE[e][2]) + di + kE[e][0]};
     };
     for (int k = kb_; k < kce_; ++k)
-      for (int j = 0; j < n[1]; ++j)
-        for (int i = 0; i < n[0]; ++i) {
-          vort_[0].at(i, j, k) = dd(2, 1, i, j, k) - dd(1, 2, i, j, k);
-          vort_[1].at(i, j, k) = dd(0, 2, i, j, k) - dd(2, 0, i, j, k);
-          vort_[2].at(i, j, k) = dd(1, 0, i, j, k) - dd(0, 1, i, j, k);
+      for (int j = 0; j < ny; ++j) {
+        // dd(e, d) = (u_e(+e_d) - u_e(-e_d)) / (2 h_d): rows [e][d][side]
+        CellRow r[3][3][2];
+        for (int e = 0; e < 3; ++e)
+          for (int d = 0; d < 3; ++d)
+            if (d != e)
+              for (int sd = 0; sd < 2; ++sd) {
+                const int s = sd == 0 ? 1 : -1;
+                r[e][d][sd] = cell_row(e, s * kE[d][0], j + s * kE[d][1], k + s * kE[d][2]);
+              }
+        const std::size_t o = (static_cast<std::size_t>(k - vort_[0].k0) * ny + j) * nx;
+        double* w0 = vort_[0].a.data() + o;
+        double* w1 = vort_[1].a.data() + o;
+        double* w2 = vort_[2].a.data() + o;
+        for (int i = 0; i < nx; ++i) {
+          const auto dd = [&](int e, int d) {
+            const CellRow& P = r[e][d][0];
+            const CellRow& M = r[e][d][1];
+            return (P.sg * (0.5 * (P.A[i] + P.B[i])) - M.sg * (0.5 * (M.A[i] + M.B[i]))) / (2.0 * h[d]);
+          };
+          w0[i] = dd(2, 1) - dd(1, 2);
+          w1[i] = dd(0, 2) - dd(2, 0);
+          w2[i] = dd(1, 0) - dd(0, 1);
         }
+      }
   }
 }
 
