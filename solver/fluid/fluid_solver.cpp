@@ -27,9 +27,8 @@ FluidSolver::~FluidSolver() {
     if (v) VecDestroy(&v);
   };
   for (int c = 0; c < 3; ++c) {
-    for (Vec* v :
-         {&U_[c], &Un_[c], &Unm1_[c], &alpha_[c], &Ustar_prev_[c], &D_[c], &S_[c], &K_[c], &KU_[c],
-          &inv_diag_[c], &Ul_[c], &alphal_[c], &Dl_[c], &dep_S_[c], &dep_K_[c], &dep_KU_[c], &Fl_[c]})
+    for (Vec* v : {&U_[c], &Un_[c], &Unm1_[c], &alpha_[c], &D_[c], &S_[c], &K_[c], &KU_[c], &inv_diag_[c],
+                   &Ul_[c], &alphal_[c], &Dl_[c], &dep_S_[c], &dep_K_[c], &dep_KU_[c], &Fl_[c]})
       vd(*v);
   }
   for (Vec* v : {&P_, &nut_, &rhs_, &sol_, &R_, &pc_, &Pl_, &nutl_, &pcl_, &dep_solid_, &nuel_}) vd(*v);
@@ -101,8 +100,7 @@ void FluidSolver::create_layout() {
   auto gv = [&](Vec* v) { BC_PETSC(DMCreateGlobalVector(da_, v)); };
   auto lv = [&](Vec* v) { BC_PETSC(DMCreateLocalVector(da_, v)); };
   for (int c = 0; c < 3; ++c) {
-    for (Vec* v : {&U_[c], &Un_[c], &Unm1_[c], &alpha_[c], &Ustar_prev_[c], &D_[c], &S_[c], &K_[c], &KU_[c],
-                   &inv_diag_[c]})
+    for (Vec* v : {&U_[c], &Un_[c], &Unm1_[c], &alpha_[c], &D_[c], &S_[c], &K_[c], &KU_[c], &inv_diag_[c]})
       gv(v);
     for (Vec* v : {&Ul_[c], &alphal_[c], &Dl_[c], &dep_S_[c], &dep_K_[c], &dep_KU_[c], &Fl_[c]}) lv(v);
     BC_PETSC(VecSet(alpha_[c], 1.0));

@@ -178,7 +178,7 @@ class FluidSolver {
   /// (simple_piso.cpp); one corrector and PISO keep the tolerances they always had.
   bool inexact_inner_solves() const { return !s_.piso && s_.simple_correctors > 1; }
   void step_piso(double dt, const double c[3], StepReport& rep);
-  /// U_[cc] = A^-1 rhs_ (from U_[cc]).
+  /// Solves component cc's momentum equations from the guess U_[cc]; the solution is left in sol_.
   void solve_momentum(int cc, const StencilOperator& A, StepReport& rep);
   /// The AIJ copy of op in *M (created on first use), for preconditioners that need entries.
   Mat aij_copy(const StencilOperator& op, Mat* M);
@@ -227,7 +227,6 @@ class FluidSolver {
 
   // global vectors
   Vec U_[3]{}, Un_[3]{}, Unm1_[3]{}, P_ = nullptr, alpha_[3]{};  // alpha_[0]=n+1, [1]=n, [2]=n-1
-  Vec Ustar_prev_[3]{};            // iterate before the momentum solve (relaxation)
   Vec D_[3]{};                     // a_face / (rho a_P') per face (SIMPLE correction coefficient)
   Vec inv_diag_[3]{};              // 1 / diagonal of each component's momentum matrix (Jacobi)
   Vec jacobi_inv_diag_ = nullptr;  // the one the momentum solve in progress uses

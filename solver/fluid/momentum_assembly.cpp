@@ -103,7 +103,7 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
   const std::int64_t off[3] = {1, gb.size[0], gb.size[0] * gb.size[1]};
   const std::int64_t oc = off[c];
   const double *u[3], *al[3], *p, *nue, *Fd[3], *un, *unm1, *S, *K, *KU;
-  double *rhs, *Dv, *prev, *idg;
+  double *rhs, *Dv, *idg;
   for (int d = 0; d < 3; ++d) BC_PETSC(VecGetArrayRead(Ul_[d], &u[d]));
   for (int d = 0; d < 3; ++d) BC_PETSC(VecGetArrayRead(Fl_[d], &Fd[d]));
   for (int l = 0; l < 3; ++l) BC_PETSC(VecGetArrayRead(alphal_[l], &al[l]));
@@ -116,7 +116,6 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
   BC_PETSC(VecGetArrayRead(KU_[c], &KU));
   BC_PETSC(VecGetArray(rhs_, &rhs));
   BC_PETSC(VecGetArray(D_[c], &Dv));
-  BC_PETSC(VecGetArray(Ustar_prev_[c], &prev));
   BC_PETSC(VecGetArray(inv_diag_[c], &idg));
   double* Ae[7];
   for (int e = 0; e < 7; ++e) Ae[e] = A.coef(e);
@@ -158,7 +157,6 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
           idg[o0 + i] = 1.0;
           rhs[o0 + i] = 0.0;
           if (first_iteration) Dv[o0 + i] = 0.0;
-          prev[o0 + i] = 0.0;
         }
         continue;
       }
@@ -281,13 +279,12 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
       }
       {
         const double* __restrict uP_ = uc + P0;
-        double* __restrict rh = rhs + o0, * __restrict pv = prev + o0, * __restrict Dd = Dv + o0;
+        double* __restrict rh = rhs + o0, * __restrict Dd = Dv + o0;
 #pragma GCC ivdep
         for (int i = 0; i < nx; ++i) {
           const double b_ = bb[i] + a1v[i] * ts[i];
           const double aPr = aP[i] * inv_lam;
           rh[i] = b_ + (aPr - aP[i]) * uP_[i];
-          pv[i] = uP_[i];
           aP[i] = aPr;
         }
         // SIMPLE: u' = -(a/(rho a_P)) grad p'; SIMPLEC (Van Doormaal and Raithby 1984) subtracts
@@ -320,7 +317,6 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
   BC_PETSC(VecRestoreArrayRead(KU_[c], &KU));
   BC_PETSC(VecRestoreArray(rhs_, &rhs));
   BC_PETSC(VecRestoreArray(D_[c], &Dv));
-  BC_PETSC(VecRestoreArray(Ustar_prev_[c], &prev));
   BC_PETSC(VecRestoreArray(inv_diag_[c], &idg));
 }
 

@@ -77,24 +77,27 @@ void FluidSolver::step_simple(double dt, const double c[3], StepReport& rep) {
       assemble_momentum(cc, dt, c[0], c[1], c[2], first, A);
       if (correctors > 1) BC_PETSC(VecCopy(rhs_, bm_[cc]));
       solve_momentum(cc, A, rep);
-      const double *u, *prev;
+      // the new iterate (in sol_) replaces the old one in U_ in the pass that measures the change
+      const double* un;
+      double* u;
       PetscInt n;
       BC_PETSC(VecGetLocalSize(U_[cc], &n));
-      BC_PETSC(VecGetArrayRead(U_[cc], &u));
-      BC_PETSC(VecGetArrayRead(Ustar_prev_[cc], &prev));
+      BC_PETSC(VecGetArrayRead(sol_, &un));
+      BC_PETSC(VecGetArray(U_[cc], &u));
       double d = loc[0], m = loc[1];
       bool nan = false;
       for (PetscInt q = 0; q < n; ++q) {
-        d = std::max(d, std::abs(u[q] - prev[q]));
-        m = std::max(m, std::abs(u[q]));
-        nan |= std::isnan(u[q]);
+        d = std::max(d, std::abs(un[q] - u[q]));
+        m = std::max(m, std::abs(un[q]));
+        nan |= std::isnan(un[q]);
+        u[q] = un[q];
       }
       // std::max drops a NaN (and MPI's MAX need not keep one): a NaN velocity counts as +inf,
       // which the continuity check below reports
       const double inf = std::numeric_limits<double>::infinity();
       loc[0] = nan ? inf : d, loc[1] = nan ? inf : m;
-      BC_PETSC(VecRestoreArrayRead(U_[cc], &u));
-      BC_PETSC(VecRestoreArrayRead(Ustar_prev_[cc], &prev));
+      BC_PETSC(VecRestoreArrayRead(sol_, &un));
+      BC_PETSC(VecRestoreArray(U_[cc], &u));
     }
     double glob[2];
     MPI_Allreduce(loc, glob, 2, MPI_DOUBLE, MPI_MAX, comm_);
@@ -155,6 +158,7 @@ void FluidSolver::step_piso(double dt, const double c[3], StepReport& rep) {
     assemble_momentum(cc, dt, c[0], c[1], c[2], true, *opm_[cc]);
     BC_PETSC(VecCopy(rhs_, bm_[cc]));
     solve_momentum(cc, *opm_[cc], rep);
+    BC_PETSC(VecCopy(sol_, U_[cc]));
   }
   if (std::isfinite(s_.target_mean_flux_z_m_s)) apply_flux_controller();
   for (int k = 0; k < s_.piso_correctors; ++k) {
@@ -264,7 +268,6 @@ void FluidSolver::solve_momentum(int cc, const StencilOperator& op, StepReport& 
   PetscInt its;
   BC_PETSC(KSPGetIterationNumber(ksp_m_, &its));
   rep.momentum_krylov_iterations += (int)its;
-  BC_PETSC(VecCopy(sol_, U_[cc]));
 }
 
 double FluidSolver::max_abs_velocity_all() const {
