@@ -40,7 +40,9 @@ Coupler::Coupler(const CouplingSettings& s, const GridSpec& g, std::shared_ptr<c
   solid_.resize(nx, ny, nz, per, k0);
   for (int c = 0; c < 3; ++c) {
     const int nyc = (c == 1 && !g.periodic[1]) ? ny + 1 : ny;
-    for (GridField* f : {&K_[c], &KU_[c], &S_[c]}) f->resize(nx, nyc, nz, per, k0);
+    face_layout_[c].resize(nx, nyc, nz, per, k0);
+    drag_[c].assign(3 * face_layout_[c].a.size(), 0.0);
+    face_layout_[c].a = {};
   }
 }
 
@@ -380,8 +382,7 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
   const double vcell = g_.cell_volume_m3();
   const auto& lo = dem.config().box.lo;
   std::fill(solid_.a.begin(), solid_.a.end(), 0.0);
-  for (int c = 0; c < 3; ++c)
-    for (GridField* f : {&K_[c], &KU_[c], &S_[c]}) std::fill(f->a.begin(), f->a.end(), 0.0);
+  for (int c = 0; c < 3; ++c) std::fill(drag_[c].begin(), drag_[c].end(), 0.0);
   const bool forces = dt_s > 0.0;
   const auto lag = totals_.lag_impulse_ns, mismatch = totals_.sampling_mismatch_ns;
   totals_ = ExchangeTotals{};
@@ -416,10 +417,12 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
       const Weights1D& wy = c == 1 ? st.face[1] : st.cell[1];
       const Weights1D& wz = c == 2 ? st.face[2] : st.cell[2];
       const double kb = b / vcell, kub = (b * uf[c] - J[c] / dt_s) / vcell, sr = rf[c] / vcell;
-      scatter(offsets(wx, wy, wz, K_[c]), [&](std::size_t q, double w) {
-        K_[c].a[q] += w * kb;
-        KU_[c].a[q] += w * kub;
-        S_[c].a[q] += w * sr;
+      double* dc = drag_[c].data();
+      scatter(offsets(wx, wy, wz, face_layout_[c]), [&](std::size_t q, double w) {
+        double* v = dc + 3 * q;
+        v[0] += w * kb;
+        v[1] += w * kub;
+        v[2] += w * sr;
       });
     }
   }
@@ -453,19 +456,22 @@ void Coupler::deposit(particles::DemSystem& dem, fluid::FluidSolver& fs, double 
       PetscScalar*** Ka = fs.drag_coefficient_local(c);
       PetscScalar*** KUa = fs.drag_momentum_local(c);
       PetscScalar*** Sa = fs.source_local(c);
-      std::vector<double> own[3];
-      if (window_) own[0] = sum_owned(K_[c]), own[1] = sum_owned(KU_[c]), own[2] = sum_owned(S_[c]);
-      const double* Kc = window_ ? own[0].data() : K_[c].a.data();
-      const double* KUc = window_ ? own[1].data() : KU_[c].a.data();
-      const double* Sc = window_ ? own[2].data() : S_[c].a.data();
+      const GridField& f = face_layout_[c];
+      std::vector<double> own;
+      if (window_) {
+        // a plane of the interleaved array is 3 plane_size() values
+        own.resize(3 * f.plane_size() * static_cast<std::size_t>(window_->own_end() - window_->own_begin()));
+        window_->sum_to_owned(drag_[c].data(), own.data(), 3 * f.plane_size());
+      }
+      const double* v = window_ ? own.data() : drag_[c].data();
       for (int k = k_lo; k < k_hi; ++k)
         for (int j = 0; j < ny; ++j)
           for (int i = 0; i < nx; ++i) {
             const std::size_t q =
-                (static_cast<std::size_t>(k - k_lo) * K_[c].ny + j) * nx + i;  // v has ny + 1 rows
-            Ka[k][j][i] += Kc[q];
-            KUa[k][j][i] += KUc[q];
-            Sa[k][j][i] += Sc[q];
+                3 * ((static_cast<std::size_t>(k - k_lo) * f.ny + j) * nx + i);  // v: ny + 1 rows
+            Ka[k][j][i] += v[q];
+            KUa[k][j][i] += v[q + 1];
+            Sa[k][j][i] += v[q + 2];
           }
     }
   }

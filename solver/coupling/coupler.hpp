@@ -128,7 +128,12 @@ class Coupler {
   GridSpec g_;
   std::shared_ptr<const SlabExchange> window_;
   FluidFields fields_;
-  GridField solid_, K_[3], KU_[3], S_[3];
+  GridField solid_;
+  // Per velocity component: the layout of its face nodes (`a` unused), and the drag coefficient
+  // K, the drag momentum K u_p and the explicit source S deposited there, interleaved per node
+  // (the deposit adds all three at each node it visits: one cache line instead of three).
+  GridField face_layout_[3];
+  std::vector<double> drag_[3];
   ExchangeTotals totals_;
 };
 
