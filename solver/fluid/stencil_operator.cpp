@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <exception>
 #include <stdexcept>
+#include <type_traits>
 
 #include "fluid/petsc_check.hpp"
 #include "fluid/stencil_matrix.hpp"
@@ -56,17 +57,23 @@ inline void row_product(const double* const* c, const double* __restrict x, doub
 
 /// The same row sum, each neighbour read from its own row: x (this row, periodic in x), ys / yn
 /// (the rows at -y / +y, read where lo / hi), zb / zt (the rows in the planes below and above).
-template <bool lo, bool hi>
+/// With `scaled`, each row's sum is multiplied by w[i] (y = diag(w) A x, the sum first).
+template <bool lo, bool hi, bool scaled>
 inline void row_product_rows(const double* const* c, const double* __restrict x, const double* __restrict ys,
                              const double* __restrict yn, const double* __restrict zb,
-                             const double* __restrict zt, double* __restrict y, int n) {
+                             const double* __restrict zt, const double* __restrict w, double* __restrict y,
+                             int n) {
   const double* __restrict c0 = c[0], * __restrict c1 = c[1], * __restrict c2 = c[2], * __restrict c3 = c[3];
   const double* __restrict c4 = c[4], * __restrict c5 = c[5], * __restrict c6 = c[6];
   const auto one = [&](int i, int im, int ip) {
     double s = c0[i] * x[i] + c1[i] * x[im] + c2[i] * x[ip];
     if constexpr (lo) s += c3[i] * ys[i];
     if constexpr (hi) s += c4[i] * yn[i];
-    y[i] = s + c5[i] * zb[i] + c6[i] * zt[i];
+    const double r = s + c5[i] * zb[i] + c6[i] * zt[i];
+    if constexpr (scaled)
+      y[i] = r * w[i];
+    else
+      y[i] = r;
   };
   // the x ends wrap (periodic x); with n = 1 or 2 both neighbours are one cell
   one(0, n - 1, n > 1 ? 1 : 0);
@@ -119,14 +126,24 @@ StencilOperator::~StencilOperator() {
 // first moved the whole vector once more per product (the copy was ~1/5 of a product's time).
 // Each row's sum is the ghosted path's, term for term, so the results are the same to the bit.
 void StencilOperator::apply(Vec x, Vec y) const {
+  product(x, y, nullptr);
+}
+
+void StencilOperator::apply_scaled(Vec x, Vec y, Vec w) const {
+  product(x, y, w);
+}
+
+void StencilOperator::product(Vec x, Vec y, Vec w) const {
   if (!halo_.fast()) {
     apply_ghosted(x, y);
+    if (w) check(VecPointwiseMult(y, y, w), "VecPointwiseMult");
     return;
   }
-  const double* g;
+  const double *g, *wa = nullptr;
   double* ya;
   check(VecGetArrayRead(x, &g), "VecGetArrayRead");
   check(VecGetArray(y, &ya), "VecGetArray");
+  if (w) check(VecGetArrayRead(w, &wa), "VecGetArrayRead");
   const int nx = static_cast<int>(size_[0]), ny = static_cast<int>(size_[1]), nz = static_cast<int>(size_[2]);
   const std::size_t plane = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
   planes_.resize(2 * plane);
@@ -146,18 +163,41 @@ void StencilOperator::apply(Vec x, Vec y) const {
       const double* ys = P + static_cast<std::size_t>((j + ny - 1) % ny) * nx;
       const double* yn = P + static_cast<std::size_t>((j + 1) % ny) * nx;
       const bool lo = !(wall_y_ && j == 0), hi = !(wall_y_ && j == ny - 1);
+      const auto run = [&](auto LO, auto HI, auto SCALED) {
+        row_product_rows<LO.value, HI.value, SCALED.value>(c, P + r, ys, yn, Pb + r, Pt + r,
+                                                           wa ? wa + o : nullptr, ya + o, nx);
+      };
+      const auto by_scale = [&](auto LO, auto HI) {
+        if (wa)
+          run(LO, HI, std::true_type{});
+        else
+          run(LO, HI, std::false_type{});
+      };
       if (lo && hi)
-        row_product_rows<true, true>(c, P + r, ys, yn, Pb + r, Pt + r, ya + o, nx);
+        by_scale(std::true_type{}, std::true_type{});
       else if (lo)
-        row_product_rows<true, false>(c, P + r, ys, yn, Pb + r, Pt + r, ya + o, nx);
+        by_scale(std::true_type{}, std::false_type{});
       else if (hi)
-        row_product_rows<false, true>(c, P + r, ys, yn, Pb + r, Pt + r, ya + o, nx);
+        by_scale(std::false_type{}, std::true_type{});
       else
-        row_product_rows<false, false>(c, P + r, ys, yn, Pb + r, Pt + r, ya + o, nx);
+        by_scale(std::false_type{}, std::false_type{});
     }
   }
+  if (w) check(VecRestoreArrayRead(w, &wa), "VecRestoreArrayRead");
   check(VecRestoreArrayRead(x, &g), "VecRestoreArrayRead");
   check(VecRestoreArray(y, &ya), "VecRestoreArray");
+}
+
+const StencilOperator* StencilOperator::of(Mat A) {
+  PetscBool shell = PETSC_FALSE;
+  check(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(A), MATSHELL, &shell), "PetscObjectTypeCompare");
+  if (!shell) return nullptr;
+  void (*mult)(void) = nullptr;
+  check(MatShellGetOperation(A, MATOP_MULT, &mult), "MatShellGetOperation");
+  if (mult != reinterpret_cast<void (*)(void)>(shell_mult)) return nullptr;
+  void* ctx = nullptr;
+  check(MatShellGetContext(A, &ctx), "MatShellGetContext");
+  return static_cast<const StencilOperator*>(ctx);
 }
 
 void StencilOperator::apply_ghosted(Vec x, Vec y) const {

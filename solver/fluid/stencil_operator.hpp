@@ -38,6 +38,11 @@ class StencilOperator {
   Mat mat() const { return shell_; }
   /// y = A x (global vectors of the DM).
   void apply(Vec x, Vec y) const;
+  /// y = diag(w) A x, each row's sum multiplied by w: a product and a point-Jacobi application
+  /// (w the reciprocal diagonal) in one pass, the same values as the two in sequence.
+  void apply_scaled(Vec x, Vec y, Vec w) const;
+  /// The operator behind `A` when A is one of these operators' MATSHELLs, else nullptr.
+  static const StencilOperator* of(Mat A);
   /// The same product through a ghosted copy of x (any decomposition; apply() uses it where the
   /// ranks do not own whole z-planes). Public so that tests can hold the two paths to the bit.
   void apply_ghosted(Vec x, Vec y) const;
@@ -45,6 +50,8 @@ class StencilOperator {
   void copy_to(Mat M, StencilMatrixWriter& W) const;
 
  private:
+  void product(Vec x, Vec y, Vec w) const;  // apply (w null) or apply_scaled
+
   DM dm_;
   HaloExchange halo_;
   Vec xl_ = nullptr;                    // ghosted work vector (apply_ghosted)
