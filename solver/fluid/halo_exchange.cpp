@@ -82,20 +82,7 @@ void HaloExchange::fill(Vec global, Vec local) const {
   double* first_owned = l + w * plane;
   double* last_owned = l + static_cast<std::size_t>(zm_) * plane;  // planes zm .. zm + w - 1 of the local box
   double* upper_ghost = l + (static_cast<std::size_t>(zm_) + w) * plane;
-  int self;
-  MPI_Comm_rank(comm_, &self);
-  if (below_ == self && above_ == self) {
-    std::memcpy(lower_ghost, last_owned, count * sizeof(double));
-    std::memcpy(upper_ghost, first_owned, count * sizeof(double));
-  } else {
-    MPI_Request req[4];
-    const int n = static_cast<int>(count);
-    MPI_Irecv(upper_ghost, n, MPI_DOUBLE, above_, 0, comm_, &req[0]);  // the above rank's first planes
-    MPI_Irecv(lower_ghost, n, MPI_DOUBLE, below_, 1, comm_, &req[1]);  // the below rank's last planes
-    MPI_Isend(first_owned, n, MPI_DOUBLE, below_, 0, comm_, &req[2]);
-    MPI_Isend(last_owned, n, MPI_DOUBLE, above_, 1, comm_, &req[3]);
-    MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
-  }
+  exchange_planes(first_owned, last_owned, lower_ghost, upper_ghost, count, 0);
   check(VecRestoreArray(local, &l), "VecRestoreArray");
   check(VecRestoreArrayRead(global, &g), "VecRestoreArrayRead");
 }
@@ -103,22 +90,25 @@ void HaloExchange::fill(Vec global, Vec local) const {
 void HaloExchange::boundary_planes(const double* global, double* below, double* above) const {
   if (!fast_) throw std::logic_error("HaloExchange::boundary_planes: the slab decomposition is not in use");
   const std::size_t plane = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_);
-  const double* first_owned = global;
-  const double* last_owned = global + (static_cast<std::size_t>(zm_) - 1) * plane;
+  // tags apart from fill()'s, though every rank makes the same calls in the same order
+  exchange_planes(global, global + (static_cast<std::size_t>(zm_) - 1) * plane, below, above, plane, 2);
+}
+
+void HaloExchange::exchange_planes(const double* first_owned, const double* last_owned, double* lower,
+                                   double* upper, std::size_t count, int tag) const {
   int self;
   MPI_Comm_rank(comm_, &self);
   if (below_ == self && above_ == self) {
-    std::memcpy(below, last_owned, plane * sizeof(double));
-    std::memcpy(above, first_owned, plane * sizeof(double));
+    std::memcpy(lower, last_owned, count * sizeof(double));
+    std::memcpy(upper, first_owned, count * sizeof(double));
     return;
   }
-  // tags apart from fill()'s, though every rank makes the same calls in the same order
   MPI_Request req[4];
-  const int n = static_cast<int>(plane);
-  MPI_Irecv(above, n, MPI_DOUBLE, above_, 2, comm_, &req[0]);  // the above rank's first plane
-  MPI_Irecv(below, n, MPI_DOUBLE, below_, 3, comm_, &req[1]);  // the below rank's last plane
-  MPI_Isend(first_owned, n, MPI_DOUBLE, below_, 2, comm_, &req[2]);
-  MPI_Isend(last_owned, n, MPI_DOUBLE, above_, 3, comm_, &req[3]);
+  const int n = static_cast<int>(count);
+  MPI_Irecv(upper, n, MPI_DOUBLE, above_, tag, comm_, &req[0]);      // the above rank's first planes
+  MPI_Irecv(lower, n, MPI_DOUBLE, below_, tag + 1, comm_, &req[1]);  // the below rank's last planes
+  MPI_Isend(first_owned, n, MPI_DOUBLE, below_, tag, comm_, &req[2]);
+  MPI_Isend(last_owned, n, MPI_DOUBLE, above_, tag + 1, comm_, &req[3]);
   MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
 }
 

@@ -9,6 +9,8 @@
 // non-periodic x or z) falls back to DMGlobalToLocal.
 #include <petscdmda.h>
 
+#include <cstddef>
+
 namespace boycott::fluid {
 
 class HaloExchange {
@@ -29,6 +31,12 @@ class HaloExchange {
   void boundary_planes(const double* global, double* below, double* above) const;
 
  private:
+  /// The rank below gets `count` values from first_owned (its upper ghosts), the rank above from
+  /// last_owned; lower and upper receive theirs (periodic z; on one rank, this slab's own).
+  /// Tags tag and tag + 1.
+  void exchange_planes(const double* first_owned, const double* last_owned, double* lower, double* upper,
+                       std::size_t count, int tag) const;
+
   DM dm_;
   MPI_Comm comm_ = MPI_COMM_NULL;  // a duplicate of the DM's: these messages meet no others
   bool fast_ = false;

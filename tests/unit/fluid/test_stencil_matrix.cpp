@@ -127,6 +127,33 @@ double coefficient(PetscInt i, PetscInt j, PetscInt k, int e) {
   return 1.0 + 0.37 * e + 0.011 * i - 0.13 * j + 1.7e-3 * k;
 }
 
+/// A global vector of the DM holding a smooth test field.
+Vec test_vector(DM da) {
+  PetscInt xs, ys, zs, xm, ym, zm;
+  DMDAGetCorners(da, &xs, &ys, &zs, &xm, &ym, &zm);
+  Vec x;
+  DMCreateGlobalVector(da, &x);
+  PetscScalar*** xa;
+  DMDAVecGetArray(da, x, &xa);
+  for (PetscInt k = zs; k < zs + zm; ++k)
+    for (PetscInt j = ys; j < ys + ym; ++j)
+      for (PetscInt i = xs; i < xs + xm; ++i) xa[k][j][i] = std::sin(1.3 * i + 0.7 * j * j + 2.1 * k) + 0.5;
+  DMDAVecRestoreArray(da, x, &xa);
+  return x;
+}
+
+/// The operator's coefficients: coefficient() times (1 + wobble sin(row + entry)).
+void fill_coefficients(DM da, StencilOperator& op, double wobble) {
+  PetscInt xs, ys, zs, xm, ym, zm;
+  DMDAGetCorners(da, &xs, &ys, &zs, &xm, &ym, &zm);
+  std::int64_t o = 0;
+  for (PetscInt k = zs; k < zs + zm; ++k)
+    for (PetscInt j = ys; j < ys + ym; ++j)
+      for (PetscInt i = xs; i < xs + xm; ++i, ++o)
+        for (int e = 0; e < 7; ++e)
+          op.coef(e)[o] = coefficient(i, j, k, e) * (1.0 + wobble * std::sin(static_cast<double>(o + e)));
+}
+
 struct Result {
   double max_difference = 0.0;  ///< max |A_shell x - A_aij x| / max |A_aij x|
   double diagonal_difference = 0.0;
@@ -134,31 +161,18 @@ struct Result {
 
 Result compare(PetscInt nx, PetscInt ny, PetscInt nz, bool periodic_y) {
   DM da = make_da(nx, ny, nz, periodic_y);
-  PetscInt xs, ys, zs, xm, ym, zm;
-  DMDAGetCorners(da, &xs, &ys, &zs, &xm, &ym, &zm);
   StencilOperator op(da);
-  std::int64_t o = 0;
-  for (PetscInt k = zs; k < zs + zm; ++k)
-    for (PetscInt j = ys; j < ys + ym; ++j)
-      for (PetscInt i = xs; i < xs + xm; ++i, ++o)
-        for (int e = 0; e < 7; ++e) op.coef(e)[o] = coefficient(i, j, k, e);
+  fill_coefficients(da, op, 0.0);
   Mat B;
   EXPECT_EQ(DMCreateMatrix(da, &B), 0);
   StencilMatrixWriter W(da, B);
   op.copy_to(B, W);
 
-  Vec x, y_shell, y_aij, d_shell, d_aij;
-  DMCreateGlobalVector(da, &x);
+  Vec x = test_vector(da), y_shell, y_aij, d_shell, d_aij;
   VecDuplicate(x, &y_shell);
   VecDuplicate(x, &y_aij);
   VecDuplicate(x, &d_shell);
   VecDuplicate(x, &d_aij);
-  PetscScalar*** xa;
-  DMDAVecGetArray(da, x, &xa);
-  for (PetscInt k = zs; k < zs + zm; ++k)
-    for (PetscInt j = ys; j < ys + ym; ++j)
-      for (PetscInt i = xs; i < xs + xm; ++i) xa[k][j][i] = std::sin(1.3 * i + 0.7 * j * j + 2.1 * k) + 0.5;
-  DMDAVecRestoreArray(da, x, &xa);
   EXPECT_EQ(MatMult(op.mat(), x, y_shell), 0);
   EXPECT_EQ(MatMult(B, x, y_aij), 0);
   PetscReal scale, diff, dscale, ddiff;
@@ -201,8 +215,8 @@ TEST(StencilOperator, AddsBothNeighboursWhereAPeriodicDirectionIsTwoCellsLong) {
 
 /// Largest |apply - apply_ghosted| (0 when every value agrees to the bit) on a DMDA cut into
 /// z-slabs only (the fluid's decomposition, where apply() reads x in place), ghost width 2 as the
-/// momentum DM has where the grid is long enough (else 1); and whether that decomposition took the in-place
-/// path.
+/// momentum DM has where the grid is long enough (else 1); and whether that decomposition took
+/// the in-place path.
 std::pair<double, bool> in_place_against_ghosted(PetscInt nx, PetscInt ny, PetscInt nz, bool periodic_y) {
   DM da;
   const DMBoundaryType by = periodic_y ? DM_BOUNDARY_PERIODIC : DM_BOUNDARY_NONE;
@@ -211,24 +225,11 @@ std::pair<double, bool> in_place_against_ghosted(PetscInt nx, PetscInt ny, Petsc
                          nullptr, &da),
             0);
   EXPECT_EQ(DMSetUp(da), 0);
-  PetscInt xs, ys, zs, xm, ym, zm;
-  DMDAGetCorners(da, &xs, &ys, &zs, &xm, &ym, &zm);
   StencilOperator op(da);
-  std::int64_t o = 0;
-  for (PetscInt k = zs; k < zs + zm; ++k)
-    for (PetscInt j = ys; j < ys + ym; ++j)
-      for (PetscInt i = xs; i < xs + xm; ++i, ++o)
-        for (int e = 0; e < 7; ++e) op.coef(e)[o] = coefficient(i, j, k, e) * (1.0 + 1e-3 * std::sin(o + e));
-  Vec x, y_in_place, y_ghosted;
-  DMCreateGlobalVector(da, &x);
+  fill_coefficients(da, op, 1e-3);
+  Vec x = test_vector(da), y_in_place, y_ghosted;
   VecDuplicate(x, &y_in_place);
   VecDuplicate(x, &y_ghosted);
-  PetscScalar*** xa;
-  DMDAVecGetArray(da, x, &xa);
-  for (PetscInt k = zs; k < zs + zm; ++k)
-    for (PetscInt j = ys; j < ys + ym; ++j)
-      for (PetscInt i = xs; i < xs + xm; ++i) xa[k][j][i] = std::sin(1.3 * i + 0.7 * j * j + 2.1 * k) + 0.5;
-  DMDAVecRestoreArray(da, x, &xa);
   op.apply(x, y_in_place);
   op.apply_ghosted(x, y_ghosted);
   VecAXPY(y_in_place, -1.0, y_ghosted);
@@ -273,10 +274,9 @@ struct SmallSystem {
     PetscInt xs, ys, zs, xm, ym, zm;
     DMDAGetCorners(da, &xs, &ys, &zs, &xm, &ym, &zm);
     op = std::make_unique<StencilOperator>(da);
-    DMCreateGlobalVector(da, &x);
+    x = test_vector(da);
     VecDuplicate(x, &w);
-    PetscScalar ***xa, ***wa;
-    DMDAVecGetArray(da, x, &xa);
+    PetscScalar*** wa;
     DMDAVecGetArray(da, w, &wa);
     std::int64_t o = 0;
     for (PetscInt k = zs; k < zs + zm; ++k)
@@ -285,9 +285,7 @@ struct SmallSystem {
           for (int e = 1; e < 7; ++e) op->coef(e)[o] = -0.1 * coefficient(i, j, k, e);
           op->coef(0)[o] = 3.0 + coefficient(i, j, k, 0);
           wa[k][j][i] = 1.0 / op->coef(0)[o];
-          xa[k][j][i] = std::sin(1.3 * i + 0.7 * j * j + 2.1 * k) + 0.5;
         }
-    DMDAVecRestoreArray(da, x, &xa);
     DMDAVecRestoreArray(da, w, &wa);
   }
   ~SmallSystem() {
