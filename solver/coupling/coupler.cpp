@@ -128,26 +128,9 @@ inline Offsets3 offsets(const Weights1D& wx, const Weights1D& wy, const Weights1
   return o;
 }
 
-/// Sum over the stencil of w_x(i) w_y(j) w_z(k) f(i,j,k).
-inline double sample(const Offsets3& o, const std::vector<double>& field) {
-  const double* f = field.data();
-  double s = 0.0;
-  for (int c = 0; c < o.n[2]; ++c) {
-    double sy = 0.0;
-    for (int b = 0; b < o.n[1]; ++b) {
-      const double* row = f + o.off[2][c] + o.off[1][b];
-      double sx = 0.0;
-      for (int a = 0; a < o.n[0]; ++a) sx += o.w[0][a] * row[o.off[0][a]];
-      sy += o.w[1][b] * sx;
-    }
-    s += o.w[2][c] * sy;
-  }
-  return s;
-}
-
-/// sample() of N fields that share one layout, in one pass over the stencil: the offsets and
-/// weights are read once for all of them, and each field's sums run in sample()'s order, so each
-/// result is sample()'s to the bit.
+/// For each of N fields that share one layout, the sum over the stencil of
+/// w_x(i) w_y(j) w_z(k) f(i,j,k) (x inside y inside z), in one pass: the offsets and weights are
+/// read once for all of them, and each field's sums run in the same order as alone.
 template <int N>
 inline void sample_fields(const Offsets3& o, const double* const (&f)[N], double (&out)[N]) {
   double s[N] = {};
@@ -165,6 +148,14 @@ inline void sample_fields(const Offsets3& o, const double* const (&f)[N], double
     for (int m = 0; m < N; ++m) s[m] += o.w[2][c] * sy[m];
   }
   for (int m = 0; m < N; ++m) out[m] = s[m];
+}
+
+/// Sum over the stencil of w_x(i) w_y(j) w_z(k) f(i,j,k).
+inline double sample(const Offsets3& o, const std::vector<double>& field) {
+  const double* const f[1] = {field.data()};
+  double v[1];
+  sample_fields(o, f, v);
+  return v[0];
 }
 
 /// Calls f(index, w_x w_y w_z) for every stencil point.
@@ -202,21 +193,15 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
       // the face fields of component c share one layout
       const Offsets3 o = offsets(wx, wy, wz, fields_.velocity(c));
       if (!linear) {
-        if (s_.pressure_gradient && s_.viscous && s_.added_mass) {  // the default forces: one pass
-          const double* const f[4] = {fields_.velocity(c).a.data(), fields_.pressure_gradient(c).a.data(),
-                                      fields_.viscous(c).a.data(), fields_.material_derivative(c).a.data()};
-          double v[4];
-          sample_fields(o, f, v);
-          uf[c] = v[0];
-          fe[c] -= vp * v[1];
-          fe[c] += rho * vp * v[2];
-          dudt[c] = v[3];
-          continue;
-        }
-        uf[c] = sample(o, fields_.velocity(c).a);
-        if (s_.pressure_gradient) fe[c] -= vp * sample(o, fields_.pressure_gradient(c).a);
-        if (s_.viscous) fe[c] += rho * vp * sample(o, fields_.viscous(c).a);
-        if (s_.added_mass) dudt[c] = sample(o, fields_.material_derivative(c).a);
+        // the four face fields in one pass (a field whose force is off is read and not used)
+        const double* const f[4] = {fields_.velocity(c).a.data(), fields_.pressure_gradient(c).a.data(),
+                                    fields_.viscous(c).a.data(), fields_.material_derivative(c).a.data()};
+        double v[4];
+        sample_fields(o, f, v);
+        uf[c] = v[0];
+        if (s_.pressure_gradient) fe[c] -= vp * v[1];
+        if (s_.viscous) fe[c] += rho * vp * v[2];
+        if (s_.added_mass) dudt[c] = v[3];
         continue;
       }
       const Weights1D& lx = ls.x[c == 0 ? 1 : 0];
@@ -256,14 +241,14 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
     // the vorticity (cell-centred, like the solid fraction) in the solid fraction's pass
     double w[3] = {0.0, 0.0, 0.0};
     double solid;
-    if (!linear && s_.saffman_lift) {
+    if (!linear) {  // the vorticity is read whether or not the lift uses it
       const double* const f[4] = {solid_.a.data(), fields_.vorticity(0).a.data(),
                                   fields_.vorticity(1).a.data(), fields_.vorticity(2).a.data()};
       double v[4];
       sample_fields(oc, f, v);
       solid = v[0], w[0] = v[1], w[1] = v[2], w[2] = v[3];
     } else {
-      solid = linear ? sample(offsets(ls.x[0], ls.y_alpha, ls.z[0], solid_), solid_.a) : sample(oc, solid_.a);
+      solid = sample(offsets(ls.x[0], ls.y_alpha, ls.z[0], solid_), solid_.a);
       if (s_.saffman_lift)
         for (int c = 0; c < 3; ++c) w[c] = sample(oc, fields_.vorticity(c).a);
     }

@@ -3,6 +3,7 @@
 // the order of additions), a dense one whose particles change rank hundreds of times (compared
 // with the spread that a one-ulp change of the initial positions causes on one rank), and the
 // momentum budget of a periodic suspension. Run under mpirun with 2 and 3 ranks.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <mpi.h>
 #include <petscsys.h>
@@ -178,23 +179,29 @@ sampling = "trilinear"
   EXPECT_EQ(one.particles, many.particles);
 }
 
+/// Table III's solid fraction at 60 deg in a box of nx x 6 x nz cells of 1 mm.
+CaseParams dense_case(int nx, int nz) {
+  return make_case(fmt::format(R"(
+scene = "inclined_settling"
+[domain]
+length_x = {}
+width_y = 0.006
+height_z = {}
+cells = [{}, 6, {}]
+[particles]
+volume_fraction = 0.113
+[gravity]
+angle_deg = 60.0
+)",
+                               nx / 1000.0, nz / 1000.0, nx, nz));
+}
+
 // A dense suspension (Table III's solid fraction 0.113) whose particles cross slab faces
 // hundreds of times: the distance of the N-rank run from the one-rank run is within 10 times the
 // distance a one-ulp change of every initial z makes on one rank (chaos amplifies both alike);
 // particle count and volume are conserved.
 TEST(ParallelCoupling, DenseSuspensionStaysWithinTheOneRankUlpSpread) {
-  const CaseParams p = make_case(R"(
-scene = "inclined_settling"
-[domain]
-length_x = 0.012
-width_y = 0.006
-height_z = 0.012
-cells = [12, 6, 12]
-[particles]
-volume_fraction = 0.113
-[gravity]
-angle_deg = 60.0
-)");
+  const CaseParams p = dense_case(12, 12);
   const int steps = 80;
   const RunResult one = run_case(p, PETSC_COMM_SELF, steps), ulp = run_case(p, PETSC_COMM_SELF, steps, true);
   const RunResult many = run_case(p, PETSC_COMM_WORLD, steps);
@@ -220,18 +227,7 @@ angle_deg = 60.0
 // with more ranks than cores the waits measure the scheduler as much as the imbalance.
 TEST(ParallelCoupling, WaitingShowsTheParticleLoadImbalance) {
   const int ranks = world_size();
-  const CaseParams p = make_case(R"(
-scene = "inclined_settling"
-[domain]
-length_x = 0.024
-width_y = 0.006
-height_z = 0.048
-cells = [24, 6, 48]
-[particles]
-volume_fraction = 0.113
-[gravity]
-angle_deg = 60.0
-)");
+  const CaseParams p = dense_case(24, 48);
   coupling::CoupledSystem run(p, coupling::CoupledOptions{true, true}, PETSC_COMM_WORLD);
   scenes::insert_case_particles(run.dem(), p);
   {
