@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <unistd.h>
+
 #include <fmt/format.h>
 
 #include "scenes/run_common.hpp"
@@ -21,7 +23,9 @@ WindowError window_error(const std::vector<double>& series, double window_from_s
 void add_warning(nlohmann::json& j, const std::string& text) {
   if (!j.contains("warnings")) j["warnings"] = nlohmann::json::array();
   j["warnings"].push_back(text);
-  if (output_rank()) std::fprintf(stderr, "warning: %s\n", text.c_str());
+  // On a terminal the live progress line may stand unfinished: clear it so the warning starts a
+  // line of its own (the progress line is drawn again below it).
+  if (output_rank()) std::fprintf(stderr, "%swarning: %s\n", isatty(STDERR_FILENO) ? "\r\033[K" : "", text.c_str());
 }
 
 void report_window_error(nlohmann::json& j, const std::string& prefix, const std::string& what,

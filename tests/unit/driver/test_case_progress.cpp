@@ -1,0 +1,67 @@
+// CaseProgress on a clock the test moves: lines are due by wall time, so the test owns the clock
+// (no test may judge the machine's speed).
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "driver/case_progress.hpp"
+
+namespace bd = boycott::driver;
+using Clock = bd::CaseProgress::Clock;
+
+namespace {
+struct FakeTerminal {
+  Clock::time_point now{};
+  std::vector<std::string> out;
+  bd::CaseProgress::Io io() {
+    return {[this] { return now; }, [this](const std::string& s) { out.push_back(s); }};
+  }
+  void advance(double s) { now += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s)); }
+};
+}  // namespace
+
+TEST(CaseProgress, PlainLinesComeEveryProgressEverySecondsOfWallTime) {
+  FakeTerminal term;
+  bd::CaseProgress p(1.0, false, 0.5, term.io());
+  // 0.2 wall s per 0.01 simulated s over 40 steps: 8 wall s, a line each 0.5 s past the first at()
+  // (steps land on 0.2 s ticks, so a line is due every third step: at 0.6, 1.2, ... 7.8 s).
+  for (int k = 0; k <= 40; ++k) {
+    p.at(0.01 * k);
+    term.advance(0.2);
+  }
+  ASSERT_EQ(term.out.size(), 13u);
+  for (const auto& l : term.out) {
+    EXPECT_EQ(l.rfind("progress: t = ", 0), 0u) << l;
+    EXPECT_NE(l.find("20 wall s per simulated s"), std::string::npos) << l;
+  }
+  p.finish();  // not a terminal: nothing more (the outcome line is the caller's)
+  EXPECT_EQ(term.out.size(), 13u);
+}
+
+TEST(CaseProgress, EtaFollowsTheRecentRateNotTheWholeRun) {
+  FakeTerminal term;
+  bd::CaseProgress p(20.0, false, 1.0, term.io());
+  // 100 s of cheap start (1 wall s per 0.1 simulated s), then 10x slower for 100 wall s.
+  double t = 0.0;
+  for (int k = 0; k < 100; ++k) p.at(t), t += 0.1, term.advance(1.0);
+  for (int k = 0; k < 100; ++k) p.at(t), t += 0.01, term.advance(1.0);
+  p.at(t);
+  // The last 50 wall s (a quarter of the run) ran at 100 wall s per simulated s: 9 simulated s
+  // left take 900 s (the whole run's mean rate, 18.2, would say 164 s).
+  const std::string& last = term.out.back();
+  EXPECT_NE(last.find("100 wall s per simulated s, ETA 15m00s"), std::string::npos) << last;
+}
+
+TEST(CaseProgress, TheFinishedLiveLineShowsTheWallTimeAndNoEta) {
+  FakeTerminal term;
+  bd::CaseProgress p(1.0, true, 30.0, term.io());
+  for (int k = 0; k <= 10; ++k) p.at(0.1 * k), term.advance(1.0);
+  ASSERT_FALSE(term.out.empty());
+  EXPECT_NE(term.out.back().find("ETA"), std::string::npos);
+  p.finish();
+  const std::string& last = term.out.back();
+  EXPECT_EQ(last.find("ETA"), std::string::npos) << last;
+  EXPECT_NE(last.find("11s wall"), std::string::npos) << last;
+  EXPECT_EQ(last.back(), '\n');
+}
