@@ -97,6 +97,7 @@ void visit_keys(P& p, V&& v) {
 
   v("forces.drag", p.forces.drag, choice(drag_law_names()));
   v("forces.saffman_lift", p.forces.saffman_lift, any());
+  v("forces.lift", p.forces.lift, choice(lift_law_names()));
   v("forces.added_mass", p.forces.added_mass, any());
   v("forces.pressure_gradient", p.forces.pressure_gradient, any());
   v("forces.viscous", p.forces.viscous, any());
@@ -121,6 +122,7 @@ void visit_keys(P& p, V&& v) {
   v("output.snapshot_times", p.output.snapshot_times_s, nonneg("s"));
   v("output.image_times", p.output.image_times_s, nonneg("s"));
   v("output.pdf_bins", p.output.pdf_bins, range(2, 100000));
+  v("output.force_budget_y", p.output.force_budget_y, any());
 
   v("ergun.pressure_gradients", p.ergun.pressure_gradients_pa_m, positive("Pa/m"));
   v("sediment.bulk_velocity", p.sediment.bulk_velocity_m_s, any("m/s"));

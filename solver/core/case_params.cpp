@@ -54,8 +54,8 @@ struct LateKey {
   const char* key;
   const char* old_behaviour;  ///< the value as JSON text
 };
-constexpr std::array<LateKey, 2> kLateKeys{
-    {{"numerics.sampling", "\"kernel\""}, {"numerics.simple_correctors", "1"}}};
+constexpr std::array<LateKey, 3> kLateKeys{
+    {{"numerics.sampling", "\"kernel\""}, {"numerics.simple_correctors", "1"}, {"forces.lift", "\"saffman\""}}};
 }  // namespace
 
 std::string case_id(const CaseParams& p) {
@@ -65,6 +65,12 @@ std::string case_id(const CaseParams& p) {
       const auto ptr = pointer_of(key);
       if (j.contains(ptr)) j.at(ptr.parent_pointer()).erase(ptr.back());
     }
+  // One lift, one id: forces.lift = "none" is saffman_lift = false, which leaves forces.lift out.
+  if (const auto lift = pointer_of("forces.lift"); j.contains(lift)) {
+    const auto on = pointer_of("forces.saffman_lift");
+    if (j.at(lift) == "none" && j.contains(on)) j.at(on) = false;
+    if (j.contains(on) && j.at(on) == false) j.at(lift.parent_pointer()).erase(lift.back());
+  }
   for (const auto& late : kLateKeys) {
     const auto ptr = pointer_of(late.key);
     if (j.contains(ptr) && j.at(ptr) == nlohmann::json::parse(late.old_behaviour))

@@ -77,6 +77,9 @@ struct TimeParams {
 struct ForceParams {
   std::string drag = "difelice_paper";  ///< "difelice_paper" | "schiller_naumann" | "stokes" | "none"
   bool saffman_lift = true;
+  /// The shear lift law while saffman_lift is on: "saffman" (Eq. 16), "saffman_mei" (Mei's
+  /// finite-Re factor) or "none" (coupling/lift_laws.hpp). saffman_lift = false means "none".
+  std::string lift = "saffman";
   bool added_mass = true;
   bool pressure_gradient = true;
   bool viscous = true;
@@ -120,6 +123,9 @@ struct OutputParams {
   std::vector<double> snapshot_times_s;
   std::vector<double> image_times_s;
   std::int64_t pdf_bins = 40;
+  /// Write force_budget_y.csv: every force on the particles per band of y over the averaging
+  /// window (coupling/force_budget.hpp), in pdf_bins bands.
+  bool force_budget_y = false;
 };
 
 struct ErgunParams {

@@ -14,6 +14,11 @@ inline const std::vector<std::string>& drag_law_names() {
                                              "none"};
   return n;
 }
+/// forces.lift (coupling/lift_laws.hpp)
+inline const std::vector<std::string>& lift_law_names() {
+  static const std::vector<std::string> n = {"saffman", "saffman_mei", "none"};
+  return n;
+}
 /// numerics.void_fraction_kernel
 inline const std::vector<std::string>& kernel_names() {
   static const std::vector<std::string> n = {"trilinear_smoothed", "trilinear", "cell"};

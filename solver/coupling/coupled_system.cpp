@@ -51,6 +51,12 @@ CoupledSystem::CoupledSystem(const CaseParams& p, const CoupledOptions& opt, MPI
   coupler_ = std::make_unique<Coupler>(CouplingSettings::from_case(p), fs.grid, window);
 }
 
+void CoupledSystem::set_force_budget(ForceBudget* b) {
+  budget_ = opt_.move_particles ? b : nullptr;
+  coupler_->set_force_budget(budget_);
+  dem_->wall_force_y_budget = budget_ ? &budget_->impulses(ForceBudget::walls) : nullptr;
+}
+
 int CoupledSystem::max_ranks(int nz) {
   // FFTW's slabs (its default block, ceil(nz / N) planes) with at least 2 planes on every rank.
   int best = 1;
@@ -118,6 +124,7 @@ CoupledStep CoupledSystem::step() {
   coupler_->prepare(*dem_, *fluid_, dt_prev_);
   if (opt_.move_particles) {
     dem_->advance(st.dem_substeps);
+    if (budget_) budget_->commit(dem_->particles(), dt, p_.gravity_vector()[1]);
   } else {
     // A frozen bed takes the whole drag impulse beta (u_f - v) dt (it is held in place).
     auto& s = dem_->particles();
@@ -206,7 +213,10 @@ void CoupledSystem::activate_models(ModelTimers& t) const {
   if (f.pressure_gradient)
     t.activate("pressure_gradient_force", "-V_p grad P incl. G (timed with coupling_sample)");
   if (f.viscous) t.activate("viscous_force", "V_p div tau (timed with coupling_sample)");
-  if (f.saffman_lift) t.activate("saffman_lift", "Eq. 16 (timed with coupling_sample)");
+  if (coupler_->settings().lift == LiftLaw::saffman)
+    t.activate("saffman_lift", "Eq. 16 (timed with coupling_sample)");
+  if (coupler_->settings().lift == LiftLaw::saffman_mei)
+    t.activate("saffman_mei_lift", "Eq. 16 times Mei's (1992) finite-Re factor (timed with coupling_sample)");
   if (f.added_mass)
     t.activate("added_mass", "Eq. 17, particle side in the mass matrix (timed with coupling_sample)");
   if (opt_.zero_slurry_flux) t.activate("slurry_flux_control", "Eq. 25 through the mean gradient G");

@@ -50,6 +50,9 @@ class CoupledSystem {
   fluid::FluidSolver& fluid() { return *fluid_; }
   const fluid::FluidSolver& fluid() const { return *fluid_; }
   Coupler& coupler() { return *coupler_; }
+  /// Arms (or, with nullptr, disarms) the transverse force budget for the coming steps: the
+  /// coupling's forces, the walls' and the contacts' (force_budget.hpp). Moving particles only.
+  void set_force_budget(ForceBudget* b);
   const Coupler& coupler() const { return *coupler_; }
   const CaseParams& params() const { return p_; }
 
@@ -113,6 +116,7 @@ class CoupledSystem {
   std::int64_t steps_ = 0;
   std::int64_t unconverged_ = 0, fallbacks_before_ = 0;  // counts before this process: from the checkpoint
   double seconds_fluid_ = 0.0, seconds_wait_ = 0.0;
+  ForceBudget* budget_ = nullptr;
 };
 
 }  // namespace boycott::coupling

@@ -19,7 +19,7 @@ namespace boycott::coupling {
 CouplingSettings CouplingSettings::from_case(const CaseParams& p) {
   CouplingSettings s;
   s.drag = p.forces.drag;
-  s.saffman_lift = p.forces.saffman_lift;
+  s.lift = p.forces.saffman_lift ? lift_law_from_name(p.forces.lift) : LiftLaw::none;
   s.added_mass = p.forces.added_mass;
   s.pressure_gradient = p.forces.pressure_gradient;
   s.viscous = p.forces.viscous;
@@ -186,6 +186,7 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
     double ufk[3], fek[3] = {0.0, 0.0, 0.0};  // read with the kernel's weights (trilinear: mismatch)
     LinearStencil ls;
     if (linear) ls = linear_stencil(px, py, pz, st.z_image);
+    double pg_y = 0.0, visc_y = 0.0;  // the force budget's split of fe[1]
     for (int c = 0; c < 3; ++c) {
       const Weights1D& wx = c == 0 ? st.face[0] : st.cell[0];
       const Weights1D& wy = c == 1 ? st.face[1] : st.cell[1];
@@ -202,6 +203,10 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
         if (s_.pressure_gradient) fe[c] -= vp * v[1];
         if (s_.viscous) fe[c] += rho * vp * v[2];
         if (s_.added_mass) dudt[c] = v[3];
+        if (c == 1 && budget_) {
+          pg_y = s_.pressure_gradient ? -vp * v[1] : 0.0;
+          visc_y = s_.viscous ? rho * vp * v[2] : 0.0;
+        }
         continue;
       }
       const Weights1D& lx = ls.x[c == 0 ? 1 : 0];
@@ -214,10 +219,13 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
       if (s_.pressure_gradient) {
         fe[c] -= vp * sample(og, fields_.pressure_gradient(c).a);
         fek[c] -= vp * sample(o, fields_.pressure_gradient(c).a);
+        if (c == 1) pg_y = fe[c];
       }
       if (s_.viscous) {
-        fe[c] += rho * vp * sample(og, fields_.viscous(c).a);
+        const double fv = rho * vp * sample(og, fields_.viscous(c).a);
+        fe[c] += fv;
         fek[c] += rho * vp * sample(o, fields_.viscous(c).a);
+        if (c == 1) visc_y = fv;
       }
       if (s_.added_mass) dudt[c] = sample(og, fields_.material_derivative(c).a);
     }
@@ -249,7 +257,7 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
       solid = v[0], w[0] = v[1], w[1] = v[2], w[2] = v[3];
     } else {
       solid = sample(offsets(ls.x[0], ls.y_alpha, ls.z[0], solid_), solid_.a);
-      if (s_.saffman_lift)
+      if (s_.lift != LiftLaw::none)
         for (int c = 0; c < 3; ++c) w[c] = sample(oc, fields_.vorticity(c).a);
     }
     const double alpha_f = 1.0 - solid;
@@ -259,15 +267,10 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
     p.ufx[i] = uf[0], p.ufy[i] = uf[1], p.ufz[i] = uf[2];
 
     double react[3] = {0.0, 0.0, 0.0};
-    if (s_.saffman_lift) {
-      const double wn = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-      if (wn > 0.0) {
-        // Eq. 16: 1.61 rho d^2 sqrt(nu / |w|) (u_f - u_p) x w
-        const double cst = 1.61 * rho * d * d * std::sqrt(nu / wn);
-        const double fl[3] = {cst * (s1 * w[2] - s2 * w[1]), cst * (s2 * w[0] - s0 * w[2]),
-                              cst * (s0 * w[1] - s1 * w[0])};
-        for (int c = 0; c < 3; ++c) fe[c] += fl[c], react[c] -= fl[c];
-      }
+    double fl[3] = {0.0, 0.0, 0.0};
+    if (s_.lift != LiftLaw::none) {
+      lift_force(s_.lift, {s0, s1, s2}, w, d, rho, nu, fl);
+      for (int c = 0; c < 3; ++c) fe[c] += fl[c], react[c] -= fl[c];
     }
     if (s_.added_mass) {
       // Eq. 17, with the particle's own acceleration moved into its mass matrix (madd): the
@@ -279,6 +282,12 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
       p.madd[i] = 0.0;
     }
     p.ext_x[i] = fe[0], p.ext_y[i] = fe[1], p.ext_z[i] = fe[2];
+    if (budget_) {
+      budget_->add_prepared(ForceBudget::lift, p.y[i], fl[1]);
+      budget_->add_prepared(ForceBudget::pressure_gradient, p.y[i], pg_y);
+      budget_->add_prepared(ForceBudget::viscous, p.y[i], visc_y);
+      budget_->add_prepared(ForceBudget::added_mass, p.y[i], p.madd[i] * dudt[1]);
+    }
 
     p.v0x[i] = p.vx[i], p.v0y[i] = p.vy[i], p.v0z[i] = p.vz[i];
     p.react_x[i] = react[0], p.react_y[i] = react[1], p.react_z[i] = react[2];
@@ -354,7 +363,7 @@ std::vector<double> Coupler::sum_owned(const GridField& f) const {
 
 void Coupler::prepare(particles::DemSystem& dem, fluid::FluidSolver& fs, double dt_prev_s) {
   const auto t0 = std::chrono::steady_clock::now();
-  fields_.update(fs, dt_prev_s, s_.viscous, s_.added_mass, s_.saffman_lift);
+  fields_.update(fs, dt_prev_s, s_.viscous, s_.added_mass, s_.lift != LiftLaw::none);
   totals_.lag_impulse_ns = {0.0, 0.0, 0.0};
   totals_.sampling_mismatch_ns = {0.0, 0.0, 0.0};
   visit_drag_law(s_.drag, [&](const auto& law) { prepare_impl(law, dem, dt_prev_s); });

@@ -27,7 +27,9 @@
 #include "core/case_params.hpp"
 #include "core/grid_spec.hpp"
 #include "coupling/fluid_fields.hpp"
+#include "coupling/force_budget.hpp"
 #include "coupling/kernels.hpp"
+#include "coupling/lift_laws.hpp"
 #include "coupling/sampling.hpp"
 #include "coupling/slab_exchange.hpp"
 
@@ -42,7 +44,8 @@ namespace boycott::coupling {
 
 struct CouplingSettings {
   std::string drag = "difelice_paper";
-  bool saffman_lift = true, added_mass = true, pressure_gradient = true, viscous = true;
+  LiftLaw lift = LiftLaw::saffman;  ///< none: no lift (and no vorticity sampled)
+  bool added_mass = true, pressure_gradient = true, viscous = true;
   KernelKind kernel = KernelKind::trilinear_smoothed;
   Sampling sampling = Sampling::kernel;  ///< how the fluid is read at the particles (sampling.hpp)
   double rho_f_kg_m3 = 1000.0, mu_pa_s = 1.0e-3;
@@ -84,6 +87,8 @@ class Coupler {
 
   /// Over all ranks.
   const ExchangeTotals& totals() const { return totals_; }
+  /// While set, prepare() adds each particle's fluid forces to the budget (output.force_budget_y).
+  void set_force_budget(ForceBudget* b) { budget_ = b; }
   /// The deposited solid fraction per cell (last deposit), x fastest: this rank's window.
   const GridField& solid_fraction() const { return solid_; }
   const FluidFields& fields() const { return fields_; }
@@ -135,6 +140,7 @@ class Coupler {
   GridField face_layout_[3];
   std::vector<double> drag_[3];
   ExchangeTotals totals_;
+  ForceBudget* budget_ = nullptr;
 };
 
 }  // namespace boycott::coupling

@@ -250,6 +250,10 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
     }
     prev_wall_contacts_[w].assign(wc, wc + nw);
     contacts += static_cast<std::int64_t>(nw);
+    // The force budget (off in production runs): each contact's y-force, as what the loop adds.
+    std::vector<double> fy_before;
+    if (wall_force_y_budget)
+      for (std::size_t k = 0; k < nw; ++k) fy_before.push_back(fy[wc[k]]);
     auto wall_loop = [&](auto uniform_masses) {
 #pragma GCC ivdep
       for (std::size_t k = 0; k < nw; ++k) {
@@ -284,6 +288,9 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       wall_loop(std::true_type{});
     else
       wall_loop(std::false_type{});
+    if (wall_force_y_budget)
+      for (std::size_t k = 0; k < nw; ++k)
+        wall_force_y_budget->add(y[wc[k]], (fy[wc[k]] - fy_before[k]) * cfg_.dt_s);
   }
   contacts_ = contacts;
 }

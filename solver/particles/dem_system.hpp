@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/case_params.hpp"
+#include "core/statistics.hpp"
 #include "particles/contact_models.hpp"
 #include "particles/displacement_bound.hpp"
 #include "particles/neighbor_list.hpp"
@@ -131,6 +132,10 @@ class DemSystem {
   /// where the ranks meet, so mostly the wait for the rank with the most work (the reduction of
   /// a few doubles itself takes microseconds).
   double seconds_wait = 0.0;
+
+  /// When set (output.force_budget_y), every force evaluation adds the y-force (N) of each wall
+  /// contact times dt_s into this histogram at the particle's y: the walls' share of the budget.
+  Histogram* wall_force_y_budget = nullptr;
 
  private:
   template <class Rolling>

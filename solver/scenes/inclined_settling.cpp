@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -75,6 +76,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   // w_p range: a few isolated terminal speeds either way (values outside are counted apart).
   const double wrange = std::max(8.0 * vt, 0.05);
   Histogram pdf_w(-wrange, 0.5 * wrange, bins);
+  // The transverse force budget over the same window and bands as pdf_y (output.force_budget_y).
+  std::optional<coupling::ForceBudget> budget;
+  if (p.output.force_budget_y) budget.emplace(run.dem().config().box.lo[1], W, bins);
   BatchMeans wp_avg, wf_avg, slurry_avg;
   // Every <w_p> sample of the window, for its error (20 s of 1 ms steps: 15 000 doubles).
   std::vector<double> wp_series;
@@ -95,6 +99,11 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
         if (output_rank()) {
           io::load(r, "stats.pdf_y.", pdf_y);
           io::load(r, "stats.pdf_w.", pdf_w);
+          // A run that was not recording its budget has none to carry on (it starts now).
+          if (budget && r.has("stats.budget.0.counts")) {
+            const auto h = budget->all();
+            for (std::size_t k = 0; k < h.size(); ++k) io::load(r, fmt::format("stats.budget.{}.", k), *h[k]);
+          }
         }
         slurry_max = r.scalar("stats.slurry_max");
         next_out = r.scalar("stats.next_out");
@@ -133,6 +142,11 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       io::save(w, "stats.slurry.", slurry_avg);
       io::save(w, "stats.pdf_y.", all_y);
       io::save(w, "stats.pdf_w.", all_w);
+      if (budget) {
+        const auto h = budget->all();
+        for (std::size_t k = 0; k < h.size(); ++k)
+          io::save(w, fmt::format("stats.budget.{}.", k), over_ranks(run, *h[k]));
+      }
       w.put("stats.slurry_max", slurry_max);
       w.put("stats.next_out", out.next_out_s());
       w.put("stats.alpha_min_seen", alpha_min_seen);
@@ -147,6 +161,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   SummaryBase sb;
   const double end = p.time.end_s;
   while (run.time_s() < end - 1e-12) {
+    if (budget) run.set_force_budget(run.time_s() >= p.time.average_from_s - 1e-12 ? &*budget : nullptr);
     const coupling::CoupledStep st = run.step();
     const double t = run.time_s();
     const double wp = run.mean_particle_velocity(2);
@@ -197,6 +212,14 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   if (wp_avg.count()) {
     write_pdf(ctx.out_dir / "pdf_y.csv", "y_m", pdf_y);
     write_pdf(ctx.out_dir / "pdf_wp.csv", "wp_m_s", pdf_w);
+  }
+  if (budget) {
+    run.set_force_budget(nullptr);
+    for (Histogram* h : budget->all()) *h = over_ranks(run, *h);
+    const double vp = p.particle_volume_m3();
+    const double weight = std::abs(p.particles.density_kg_m3 - p.fluid.density_kg_m3) * vp * p.gravity.magnitude_m_s2;
+    if (output_rank() && budget->exposure().total_ > 0)
+      write_file_atomic(ctx.out_dir / "force_budget_y.csv", budget->csv(weight > 0 ? weight : 1.0));
   }
 
   sb.simulated_time_s = run.time_s();

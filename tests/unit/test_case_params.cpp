@@ -216,3 +216,43 @@ TEST(ExitCodes, EachErrorKindMapsToItsDocumentedCode) {
   EXPECT_EQ(exit_code_of(StorageError("x")), 74);
   EXPECT_EQ(exit_code_of(std::runtime_error("x")), 1);
 }
+
+TEST(CaseParams, LiftLawIsALateKeyWithOneIdPerPhysics) {
+  // forces.lift = "saffman" is the behaviour before the key existed: left out of the id, so every
+  // stored case keeps its id (the default case's is pinned above).
+  CaseParams a;
+  validate(a);
+  CaseParams b;
+  apply_override(b, "forces.lift=\"saffman\"");
+  validate(b);
+  EXPECT_EQ(case_id(b), case_id(a));
+  // "none" is saffman_lift = false: one case, one id, whichever way it is said.
+  CaseParams off, none;
+  apply_override(off, "forces.saffman_lift=false");
+  apply_override(none, "forces.lift=\"none\"");
+  validate(off);
+  validate(none);
+  EXPECT_EQ(case_id(none), case_id(off));
+  EXPECT_NE(case_id(off), case_id(a));
+  // Mei's law is another case.
+  CaseParams mei;
+  apply_override(mei, "forces.lift=\"saffman_mei\"");
+  validate(mei);
+  EXPECT_NE(case_id(mei), case_id(a));
+  EXPECT_NE(case_id(mei), case_id(off));
+  // A law with the lift switched off is a contradiction, refused with both keys named.
+  CaseParams bad;
+  apply_override(bad, "forces.saffman_lift=false");
+  apply_override(bad, "forces.lift=\"saffman_mei\"");
+  try {
+    validate(bad);
+    FAIL() << "saffman_mei accepted with saffman_lift = false";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("forces.saffman_lift"), std::string::npos) << e.what();
+  }
+  // The force budget is output: not the case.
+  CaseParams budget;
+  apply_override(budget, "output.force_budget_y=true");
+  validate(budget);
+  EXPECT_EQ(case_id(budget), case_id(a));
+}

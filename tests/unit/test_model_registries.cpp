@@ -13,6 +13,7 @@
 #include "core/scene_specs.hpp"
 #include "coupling/drag_laws.hpp"
 #include "coupling/kernels.hpp"
+#include "coupling/lift_laws.hpp"
 #include "coupling/sampling.hpp"
 #include "particles/contact_models.hpp"
 #include "scenes/scene.hpp"
@@ -39,6 +40,11 @@ TEST(ModelRegistries, DragLawsResolveExactlyTheListedNames) {
 TEST(ModelRegistries, KernelsResolveExactlyTheListedNames) {
   for (const auto& name : kernel_names()) EXPECT_NO_THROW(coupling::kernel_from_name(name)) << name;
   EXPECT_THROW(coupling::kernel_from_name("gaussian"), InputError);
+}
+
+TEST(ModelRegistries, LiftLawsResolveExactlyTheListedNames) {
+  for (const auto& name : lift_law_names()) EXPECT_NO_THROW(coupling::lift_law_from_name(name)) << name;
+  EXPECT_THROW(coupling::lift_law_from_name("mclaughlin"), InputError);
 }
 
 TEST(ModelRegistries, SamplingsResolveExactlyTheListedNames) {
