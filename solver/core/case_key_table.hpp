@@ -2,6 +2,7 @@
 // The table of case keys (solver/core/case_params.cpp and the files beside it read it): every
 // key once, with the member it sets and its limits. Internal to boycott_core: parsing
 // (case_parse.cpp), checking (case_rules.cpp) and identity (case_params.cpp) all walk this one list.
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -116,6 +117,7 @@ void visit_keys(P& p, V&& v) {
   v("numerics.neighbor_skin", p.numerics.neighbor_skin_m, positive("m"));
   v("numerics.void_fraction_kernel", p.numerics.void_fraction_kernel, choice(kernel_names()));
   v("numerics.sampling", p.numerics.sampling, choice(sampling_names()));
+  v("numerics.vorticity", p.numerics.vorticity, choice(vorticity_names()));
 
   v("output.timeseries_every", p.output.timeseries_every_s, optional(positive("s")));
   v("output.keep_checkpoints", p.output.keep_checkpoints, range(1, 1000));
@@ -129,6 +131,20 @@ void visit_keys(P& p, V&& v) {
   v("sediment.bed_height", p.sediment.bed_height_m, optional(positive("m")));
   v("sediment.initial_flow", p.sediment.initial_flow, choice({"turbulent", "rest"}));
 }
+
+/// Keys added after identity version 2, each with the value that reproduces the behaviour
+/// before it existed: the key enters a case's id only when its value differs from that, so
+/// adding a key never changes the id of a case that does not use it; and a stored case (JSON of
+/// an earlier build) that lacks it had that behaviour, whatever the default is now. Append every
+/// new key here.
+struct LateKey {
+  const char* key;
+  const char* old_behaviour;  ///< the value as JSON text (valid TOML too)
+};
+inline constexpr std::array<LateKey, 4> kLateKeys{{{"numerics.sampling", "\"kernel\""},
+                                                   {"numerics.simple_correctors", "1"},
+                                                   {"forces.lift", "\"saffman\""},
+                                                   {"numerics.vorticity", "\"cell_centres\""}}};
 
 /// Sets one key from its TOML text (a bare word is a string); false for an unknown key
 /// (case_parse.cpp).

@@ -46,18 +46,6 @@ bool is_output_only_key(const std::string& key) {
          key.rfind("output.", 0) == 0;
 }
 
-namespace {
-/// Keys added after identity version 2, each with the value that reproduces the behaviour
-/// before it existed: the key enters a case's id only when its value differs from that, so
-/// adding a key never changes the id of a case that does not use it. Append every new key here.
-struct LateKey {
-  const char* key;
-  const char* old_behaviour;  ///< the value as JSON text
-};
-constexpr std::array<LateKey, 3> kLateKeys{
-    {{"numerics.sampling", "\"kernel\""}, {"numerics.simple_correctors", "1"}, {"forces.lift", "\"saffman\""}}};
-}  // namespace
-
 std::string case_id(const CaseParams& p) {
   nlohmann::json j = to_json(p);
   for (const auto& key : case_key_names(p.scene))
@@ -69,7 +57,12 @@ std::string case_id(const CaseParams& p) {
   if (const auto lift = pointer_of("forces.lift"); j.contains(lift)) {
     const auto on = pointer_of("forces.saffman_lift");
     if (j.at(lift) == "none" && j.contains(on)) j.at(on) = false;
-    if (j.contains(on) && j.at(on) == false) j.at(lift.parent_pointer()).erase(lift.back());
+    if (j.contains(on) && j.at(on) == false) {
+      j.at(lift.parent_pointer()).erase(lift.back());
+      // Without lift the vorticity is not used.
+      if (const auto vort = pointer_of("numerics.vorticity"); j.contains(vort))
+        j.at(vort.parent_pointer()).erase(vort.back());
+    }
   }
   for (const auto& late : kLateKeys) {
     const auto ptr = pointer_of(late.key);

@@ -115,6 +115,10 @@ struct NumericsParams {
   /// first round's way) or "trilinear" (each field from its own staggered nodes with its wall
   /// rule; coupling/sampling.hpp).
   std::string sampling = "kernel";
+  /// Where the vorticity (the lift's shear) is formed: "cell_centres" (central differences of
+  /// cell-centred velocities over two cells, blind to a profile that alternates cell by cell) or
+  /// "edges" (compact differences at the staggered grid's edges, read from there).
+  std::string vorticity = "cell_centres";
 };
 
 struct OutputParams {

@@ -221,6 +221,10 @@ CaseParams case_from_json(const nlohmann::json& j) {
     auto ptr = pointer_of(key);
     if (j.contains(ptr)) from_json(key, j.at(ptr), ref);
   });
+  // A record of an earlier build lacks the keys added since: it ran with their old behaviour,
+  // not with today's default (a key of another scene is set too, and read by nothing).
+  for (const auto& late : kLateKeys)
+    if (!j.contains(pointer_of(late.key))) set_key(p, late.key, late.old_behaviour);
   if (j.contains("branch")) {
     from_json("branch.parent_id", j["branch"].value("parent_id", nlohmann::json("")), p.branch.parent_id);
     from_json("branch.parent_time_s", j["branch"].value("parent_time_s", nlohmann::json(nullptr)),

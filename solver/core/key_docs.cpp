@@ -59,6 +59,7 @@ constexpr std::array kDocs = {
     KeyDoc{"numerics.neighbor_skin", "m", "Verlet skin of the contact neighbour lists"},
     KeyDoc{"numerics.void_fraction_kernel", "", "deposition kernel of particle volume and forces"},
     KeyDoc{"numerics.sampling", "", "fluid read at particles: kernel or trilinear (wall rules)"},
+    KeyDoc{"numerics.vorticity", "", "vorticity for the lift: cell_centres (2-cell central) or edges (compact)"},
     KeyDoc{"output.timeseries_every", "s",
            "simulated time between rows of timeseries.csv (unset: every step)"},
     KeyDoc{"output.keep_checkpoints", "-", "newest checkpoints kept"},

@@ -24,6 +24,11 @@ inline const std::vector<std::string>& kernel_names() {
   static const std::vector<std::string> n = {"trilinear_smoothed", "trilinear", "cell"};
   return n;
 }
+/// numerics.vorticity (coupling/fluid_fields.hpp)
+inline const std::vector<std::string>& vorticity_names() {
+  static const std::vector<std::string> n = {"cell_centres", "edges"};
+  return n;
+}
 /// numerics.sampling
 inline const std::vector<std::string>& sampling_names() {
   static const std::vector<std::string> n = {"kernel", "trilinear"};

@@ -25,6 +25,7 @@ CouplingSettings CouplingSettings::from_case(const CaseParams& p) {
   s.viscous = p.forces.viscous;
   s.kernel = kernel_from_name(p.numerics.void_fraction_kernel);
   s.sampling = sampling_from_name(p.numerics.sampling);
+  s.edge_vorticity = edge_vorticity_from_name(p.numerics.vorticity);
   s.rho_f_kg_m3 = p.fluid.density_kg_m3;
   s.mu_pa_s = p.fluid.viscosity_pa_s;
   s.top_slip = p.domain.top_wall == "slip";
@@ -32,7 +33,7 @@ CouplingSettings CouplingSettings::from_case(const CaseParams& p) {
 }
 
 Coupler::Coupler(const CouplingSettings& s, const GridSpec& g, std::shared_ptr<const SlabExchange> window)
-    : s_(s), g_(g), window_(std::move(window)), fields_(g, s.top_slip, window_.get()) {
+    : s_(s), g_(g), window_(std::move(window)), fields_(g, s.top_slip, window_.get(), s.edge_vorticity) {
   bool per[3] = {g.periodic[0], g.periodic[1], g.periodic[2]};
   const int nx = (int)g.n[0], ny = (int)g.n[1];
   int nz = (int)g.n[2], k0 = 0;
@@ -249,7 +250,21 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
     // the vorticity (cell-centred, like the solid fraction) in the solid fraction's pass
     double w[3] = {0.0, 0.0, 0.0};
     double solid;
-    if (!linear) {  // the vorticity is read whether or not the lift uses it
+    if (s_.edge_vorticity) {
+      // Each component from its own edges (fluid_fields.hpp), with the weights of its location.
+      solid = linear ? sample(offsets(ls.x[0], ls.y_alpha, ls.z[0], solid_), solid_.a) : sample(oc, solid_.a);
+      if (s_.lift != LiftLaw::none) {
+        if (linear) {
+          w[0] = sample(offsets(ls.x[0], ls.y_normal, ls.z[1], fields_.vorticity(0)), fields_.vorticity(0).a);
+          w[1] = sample(offsets(ls.x[1], ls.y_tangential, ls.z[1], fields_.vorticity(1)), fields_.vorticity(1).a);
+          w[2] = sample(offsets(ls.x[1], ls.y_normal, ls.z[0], fields_.vorticity(2)), fields_.vorticity(2).a);
+        } else {
+          w[0] = sample(offsets(st.cell[0], st.face[1], st.face[2], fields_.vorticity(0)), fields_.vorticity(0).a);
+          w[1] = sample(offsets(st.face[0], st.cell[1], st.face[2], fields_.vorticity(1)), fields_.vorticity(1).a);
+          w[2] = sample(offsets(st.face[0], st.face[1], st.cell[2], fields_.vorticity(2)), fields_.vorticity(2).a);
+        }
+      }
+    } else if (!linear) {  // the vorticity is read whether or not the lift uses it
       const double* const f[4] = {solid_.a.data(), fields_.vorticity(0).a.data(),
                                   fields_.vorticity(1).a.data(), fields_.vorticity(2).a.data()};
       double v[4];
@@ -287,6 +302,8 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
       budget_->add_prepared(ForceBudget::pressure_gradient, p.y[i], pg_y);
       budget_->add_prepared(ForceBudget::viscous, p.y[i], visc_y);
       budget_->add_prepared(ForceBudget::added_mass, p.y[i], p.madd[i] * dudt[1]);
+      budget_->add_prepared(ForceBudget::re_p, p.y[i], slip * d / nu);
+      budget_->add_prepared(ForceBudget::re_w, p.y[i], std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * d * d / nu);
     }
 
     p.v0x[i] = p.vx[i], p.v0y[i] = p.vy[i], p.v0z[i] = p.vz[i];

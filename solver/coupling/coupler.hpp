@@ -48,6 +48,7 @@ struct CouplingSettings {
   bool added_mass = true, pressure_gradient = true, viscous = true;
   KernelKind kernel = KernelKind::trilinear_smoothed;
   Sampling sampling = Sampling::kernel;  ///< how the fluid is read at the particles (sampling.hpp)
+  bool edge_vorticity = false;           ///< numerics.vorticity = "edges" (fluid_fields.hpp)
   double rho_f_kg_m3 = 1000.0, mu_pa_s = 1.0e-3;
   bool top_slip = false;
   /// The case's [forces], [fluid], numerics.void_fraction_kernel and numerics.sampling.

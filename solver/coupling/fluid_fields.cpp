@@ -16,8 +16,8 @@ namespace {
 constexpr int kE[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 }
 
-FluidFields::FluidFields(const GridSpec& g, bool top_slip, const SlabExchange* window)
-    : g_(g), walls_(!g.periodic[1]), top_slip_(top_slip), window_(window) {
+FluidFields::FluidFields(const GridSpec& g, bool top_slip, const SlabExchange* window, bool edge_vorticity)
+    : g_(g), walls_(!g.periodic[1]), top_slip_(top_slip), edge_vorticity_(edge_vorticity), window_(window) {
   bool per[3] = {g.periodic[0], g.periodic[1], g.periodic[2]};
   const int nx = (int)g.n[0], ny = (int)g.n[1];
   int nz = (int)g.n[2], k0 = 0;
@@ -33,7 +33,8 @@ FluidFields::FluidFields(const GridSpec& g, bool top_slip, const SlabExchange* w
     const int nyc = (c == 1 && walls_) ? ny + 1 : ny;
     for (GridField* f : {&u_[c], &uprev_[c], &gradp_[c], &visc_[c], &dudt_[c]})
       f->resize(nx, nyc, nz, per, k0);
-    vort_[c].resize(nx, ny, nz, per, k0);
+    // Edges: omega_x and omega_z have the y faces (walls included).
+    vort_[c].resize(nx, edge_vorticity_ && c != 1 && walls_ ? ny + 1 : ny, nz, per, k0);
   }
   p_.resize(nx, ny, nz, per, k0);
   nut_.resize(nx, ny, nz, per, k0);
@@ -308,7 +309,8 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
     }
   }
 
-  if (need_vorticity) {
+  if (need_vorticity && edge_vorticity_) update_edge_vorticity();
+  if (need_vorticity && !edge_vorticity_) {
     // Cell-centred velocity u_e at (i + di, j + dj, k + dk): sg (A[i] + B[i]) / 2, with the
     // wall mirror rule in y as a sign and a mirrored row (sg = 1 inside: the same value).
     struct CellRow {
@@ -356,6 +358,31 @@ void FluidFields::update(fluid::FluidSolver& fs, double dt_s, bool need_viscous,
           w2[i] = dd(1, 0) - dd(0, 1);
         }
       }
+  }
+}
+
+void FluidFields::update_edge_vorticity() {
+  // Compact differences of the face velocities with their wall rules (uval: the tangential
+  // velocity mirrored beyond a wall, v = 0 on the wall rows), on the planes of the face fields,
+  // [kb_, ke_): they are read with face weights in z as those are, and reach one face below.
+  const int nx = (int)g_.n[0], ny = (int)g_.n[1];
+  const double hx = g_.dx(0), hy = g_.dx(1), hz = g_.dx(2);
+  const int nyf = walls_ ? ny + 1 : ny;  // y faces of omega_x and omega_z
+  for (int k = kb_; k < ke_; ++k) {
+    for (int j = 0; j < nyf; ++j)
+      for (int i = 0; i < nx; ++i) {
+        // omega_x at (i, j - 1/2, k - 1/2) = dw/dy - dv/dz
+        vort_[0].at(i, j, k) =
+            (uval(2, i, j, k) - uval(2, i, j - 1, k)) / hy - (uval(1, i, j, k) - uval(1, i, j, k - 1)) / hz;
+        // omega_z at (i - 1/2, j - 1/2, k) = dv/dx - du/dy
+        vort_[2].at(i, j, k) =
+            (uval(1, i, j, k) - uval(1, i - 1, j, k)) / hx - (uval(0, i, j, k) - uval(0, i, j - 1, k)) / hy;
+      }
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+        // omega_y at (i - 1/2, j, k - 1/2) = du/dz - dw/dx
+        vort_[1].at(i, j, k) =
+            (uval(0, i, j, k) - uval(0, i, j, k - 1)) / hz - (uval(2, i, j, k) - uval(2, i - 1, j, k)) / hx;
   }
 }
 

@@ -3,15 +3,31 @@
 // velocity u_c on c-faces (levels n and n-1), pressure gradient (plus the mean driving gradient G
 // in z) on c-faces, the viscous stress divergence on c-faces (the same discrete operator the
 // fluid momentum equation uses, so particle and fluid forces cancel), the material derivative
-// Du/Dt on c-faces and the vorticity at cell centres. Read from the fluid solver once per CFD
-// step; particles then sample them with their kernel weights (coupler.hpp).
+// Du/Dt on c-faces and the vorticity, at cell centres or at the grid's edges (numerics.vorticity).
+// Read from the fluid solver once per CFD step; particles then sample them with their kernel
+// weights (coupler.hpp).
+//
+// The vorticity at cell centres is a central difference of cell-centred velocities over two
+// cells, omega_x(j) = (w(j+1) - w(j-1)) / 2h: a profile that alternates cell by cell has none, so
+// the lift cannot see, and so cannot oppose, structure of the grid's period. At the edges of the
+// staggered grid the same derivative is compact, omega_x(j - 1/2) = (w(j) - w(j-1)) / h (the
+// no-slip mirror makes it 2 w(0) / h on the wall edge): each component lives where its two
+// derivatives are centred,
+//   omega_x at (i, j - 1/2, k - 1/2): x cell, y face, z face
+//   omega_y at (i - 1/2, j, k - 1/2): x face, y cell, z face
+//   omega_z at (i - 1/2, j - 1/2, k): x face, y face, z cell
+// and is read from there (the y faces include both walls).
 //
 // One MPI rank: the fields are dense copies of the whole grid with periodic wrap. Several: each
 // rank holds the planes of its window (slab_exchange.hpp), filled from the ranks that own them,
 // and derives the fields on the planes its particles can reach.
 #include <array>
+#include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
+#include "core/error.hpp"
 #include "core/grid_spec.hpp"
 
 namespace boycott::fluid {
@@ -21,6 +37,13 @@ class FluidSolver;
 namespace boycott::coupling {
 
 class SlabExchange;
+
+/// numerics.vorticity: true for "edges", false for "cell_centres".
+inline bool edge_vorticity_from_name(const std::string& s) {
+  if (s == "cell_centres") return false;
+  if (s == "edges") return true;
+  throw InputError(fmt::format("numerics.vorticity = \"{}\": not a vorticity of the coupling", s));
+}
 
 /// A dense grid array of nx x ny x nz values (x fastest) with periodic wrap where asked. With z
 /// not periodic it is a window of planes: plane k (grid index) is stored at k - k0.
@@ -61,7 +84,8 @@ struct GridField {
 class FluidFields {
  public:
   /// window: the planes this rank holds on several ranks (nullptr: one rank, the whole grid).
-  FluidFields(const GridSpec& g, bool top_slip, const SlabExchange* window = nullptr);
+  /// edge_vorticity: the vorticity at the grid's edges (see above) instead of cell centres.
+  FluidFields(const GridSpec& g, bool top_slip, const SlabExchange* window = nullptr, bool edge_vorticity = false);
 
   /// Reads velocity, pressure and nu_t from the solver at its current level and derives the
   /// fields above. `dt_s` is the step that led to this level (for Du/Dt; 0 = first call, then
@@ -76,7 +100,10 @@ class FluidFields {
   const GridField& pressure_gradient(int c) const { return gradp_[c]; }   ///< Pa/m, includes G e_z
   const GridField& viscous(int c) const { return visc_[c]; }              ///< div tau / rho, m/s^2
   const GridField& material_derivative(int c) const { return dudt_[c]; }  ///< m/s^2
-  const GridField& vorticity(int c) const { return vort_[c]; }            ///< 1/s, cell centres
+  /// 1/s: at cell centres, or (edge_vorticity()) at the edges above, component c's layout
+  /// having the y faces (ny + 1 rows with walls) for c = 0 and 2.
+  const GridField& vorticity(int c) const { return vort_[c]; }
+  bool edge_vorticity() const { return edge_vorticity_; }
 
   /// The velocity read at the last update (the next update's previous level, for Du/Dt), for
   /// checkpoints: u, v, w arrays of this rank's own planes and whether a previous level exists.
@@ -106,7 +133,7 @@ class FluidFields {
   static void fill_padded(Padded& dst, int nx, int ny, int nz, Rule&& value);
 
   GridSpec g_;
-  bool walls_, top_slip_;
+  bool walls_, top_slip_, edge_vorticity_;
   const SlabExchange* window_ = nullptr;
   // Planes [kb_, ke_) get the face-derived fields, [kb_, kce_) the vorticity; kofs_ is the grid
   // plane of the padded arrays' plane 0.
@@ -115,6 +142,7 @@ class FluidFields {
   GridField u_[3], uprev_[3], gradp_[3], visc_[3], dudt_[3], vort_[3], p_, nut_;
   Padded upad_[3], ppad_, nupad_;  // uval, p and nu + nu_t, padded
   bool have_prev_ = false;
+  void update_edge_vorticity();
 };
 
 }  // namespace boycott::coupling

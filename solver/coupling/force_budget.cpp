@@ -42,9 +42,9 @@ std::vector<Histogram*> ForceBudget::all() {
 
 std::string ForceBudget::csv(double buoyant_weight_n) const {
   std::string text = "y_m,particle_density_1_m";
-  for (const char* n : kNames) text += fmt::format(",{}_n", n);
-  for (const char* n : kNames) text += fmt::format(",{}_per_weight", n);
-  text += "\n";
+  for (int t = 0; t < kForces; ++t) text += fmt::format(",{}_n", kNames[t]);
+  for (int t = 0; t < kForces; ++t) text += fmt::format(",{}_per_weight", kNames[t]);
+  text += ",re_p,re_w\n";
   const auto dens = exposure_.density();
   for (int b = 0; b < exposure_.bins(); ++b) {
     const double e = exposure_.counts_[b];
@@ -52,9 +52,9 @@ std::string ForceBudget::csv(double buoyant_weight_n) const {
     for (int t = 0; t < kTerms; ++t) mean[t] = e > 0 ? impulse_[t].counts_[b] / e : 0.0;
     mean[particle_contacts] -= mean[walls];
     text += fmt::format("{:.9g},{:.9g}", exposure_.bin_center(b), dens[b]);
-    for (double v : mean) text += fmt::format(",{:.9g}", v);
-    for (double v : mean) text += fmt::format(",{:.9g}", v / buoyant_weight_n);
-    text += "\n";
+    for (int t = 0; t < kForces; ++t) text += fmt::format(",{:.9g}", mean[t]);
+    for (int t = 0; t < kForces; ++t) text += fmt::format(",{:.9g}", mean[t] / buoyant_weight_n);
+    text += fmt::format(",{:.9g},{:.9g}\n", mean[re_p], mean[re_w]);
   }
   return text;
 }

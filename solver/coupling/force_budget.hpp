@@ -16,6 +16,8 @@
 //   particle_contacts  the particle-particle contacts: every particle's momentum change less the
 //                      terms above (the integrator's contact impulse, exact to round-off)
 //   net                m dv_y/dt
+// and, beside the forces, the band's mean inputs of the lift laws (lift_laws.hpp): the particle
+// Reynolds number Re_p = |u_f - u_p| d / nu and the shear Reynolds number Re_w = |w| d^2 / nu.
 // Fluid-side terms are read when the step's forces are set (positions at the step's start), the
 // others at its end: they bin a particle where it was within one step (~0.01 mm).
 #include <array>
@@ -33,15 +35,20 @@ namespace boycott::coupling {
 
 class ForceBudget {
  public:
-  enum Term { drag, lift, pressure_gradient, viscous, added_mass, gravity, walls, particle_contacts, net, kTerms };
+  enum Term {
+    drag, lift, pressure_gradient, viscous, added_mass, gravity, walls, particle_contacts, net,
+    kForces,  // the forces above; the lift law's inputs below
+    re_p = kForces, re_w, kTerms
+  };
   static constexpr std::array<const char*, kTerms> kNames = {
-      "drag", "lift", "pressure_gradient", "viscous", "added_mass", "gravity", "walls", "particle_contacts", "net"};
+      "drag", "lift", "pressure_gradient", "viscous", "added_mass", "gravity", "walls", "particle_contacts", "net",
+      "re_p", "re_w"};
 
   /// Bands over [y0, y0 + width) m.
   ForceBudget(double y0_m, double width_m, int bands);
 
-  /// A step's fluid forces, per particle (N) at its y (m): set when the step's forces are, kept
-  /// until commit.
+  /// A step's fluid forces, per particle (N) at its y (m), or a lift input: set when the step's
+  /// forces are, kept until commit.
   void add_prepared(Term t, double y_m, double force_n) { prepared_[t].add(y_m, force_n); }
   /// The step of dt_s is done: the prepared forces times dt_s, and the end-of-step terms from
   /// the particles (v0: velocity at the step's start; drag_j: the drag impulse of the step).
@@ -55,8 +62,9 @@ class ForceBudget {
 
   /// Every histogram (exposure first, then the terms), for checkpoints and sums over ranks.
   std::vector<Histogram*> all();
-  /// The CSV: y_m, particle_density (1/m, the time-weighted pdf of y), then each term's mean
-  /// force per particle (N), and the same divided by the buoyant weight w_b (N) in *_per_weight.
+  /// The CSV: y_m, particle_density (1/m, the time-weighted pdf of y), then each force's mean
+  /// per particle (N), the same divided by the buoyant weight w_b (N) in *_per_weight, and the
+  /// band's mean Re_p and Re_w.
   std::string csv(double buoyant_weight_n) const;
 
  private:

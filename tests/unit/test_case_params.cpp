@@ -256,3 +256,24 @@ TEST(CaseParams, LiftLawIsALateKeyWithOneIdPerPhysics) {
   validate(budget);
   EXPECT_EQ(case_id(budget), case_id(a));
 }
+
+TEST(CaseParams, AStoredRecordWithoutALateKeyHadItsOldBehaviour) {
+  // params.json of an earlier build has no forces.lift: it ran Saffman's lift, whatever the
+  // default is now, and keeps its id.
+  CaseParams a;
+  apply_override(a, "forces.lift=\"saffman\"");
+  validate(a);
+  nlohmann::json old = to_json(a);
+  old["forces"].erase("lift");
+  old["numerics"].erase("vorticity");
+  const CaseParams back = case_from_json(old);
+  EXPECT_EQ(back.forces.lift, "saffman");
+  EXPECT_EQ(back.numerics.vorticity, "cell_centres");
+  EXPECT_EQ(case_id(back), case_id(a));
+  // A record that names the key keeps its value.
+  CaseParams m;
+  apply_override(m, "forces.lift=\"saffman_mei\"");
+  validate(m);
+  EXPECT_EQ(case_from_json(to_json(m)).forces.lift, "saffman_mei");
+  EXPECT_EQ(case_id(case_from_json(to_json(m))), case_id(m));
+}

@@ -12,6 +12,7 @@
 #include "core/model_names.hpp"
 #include "core/scene_specs.hpp"
 #include "coupling/drag_laws.hpp"
+#include "coupling/fluid_fields.hpp"
 #include "coupling/kernels.hpp"
 #include "coupling/lift_laws.hpp"
 #include "coupling/sampling.hpp"
@@ -45,6 +46,11 @@ TEST(ModelRegistries, KernelsResolveExactlyTheListedNames) {
 TEST(ModelRegistries, LiftLawsResolveExactlyTheListedNames) {
   for (const auto& name : lift_law_names()) EXPECT_NO_THROW(coupling::lift_law_from_name(name)) << name;
   EXPECT_THROW(coupling::lift_law_from_name("mclaughlin"), InputError);
+}
+
+TEST(ModelRegistries, VorticitiesResolveExactlyTheListedNames) {
+  for (const auto& name : vorticity_names()) EXPECT_NO_THROW(coupling::edge_vorticity_from_name(name)) << name;
+  EXPECT_THROW(coupling::edge_vorticity_from_name("nodes"), InputError);
 }
 
 TEST(ModelRegistries, SamplingsResolveExactlyTheListedNames) {

@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+"""Where the particles sit across the gap, and which forces hold them there.
+
+  scripts/gap_profile.py [--budget] RUN_DIR [RUN_DIR ...]
+
+Averages pdf_y.csv (and, with --budget, force_budget_y.csv) of the runs given (replicas of one
+case), prints the profile as density over its mean from wall to wall, and two numbers:
+  interior_cv   the coefficient of variation (rms / mean) of the density over the bands whose
+                centre lies at least 0.75 mm from both walls: 0 for a flat interior; sheets that
+                the grid imprints raise it, and a grid artefact moves when the grid does;
+  wall_layer    the mean density of the bands from the contact distance d/2 out to d/2 + 0.45 mm,
+                both walls, over the mean density (the paper's Fig. 12(a): a rise at both walls).
+With --budget, the mean y-force per particle of every term by band, over the buoyant weight,
+and the band's mean particle and shear Reynolds numbers (the lift law's inputs).
+"""
+import csv
+import statistics
+import sys
+from pathlib import Path
+
+
+def read(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def mean_columns(dirs, name):
+    tables = [read(Path(d) / name) for d in dirs]
+    cols = [c for c in tables[0][0].keys()]
+    out = []
+    for b in range(len(tables[0])):
+        out.append({c: statistics.fmean(float(t[b][c]) for t in tables) for c in cols})
+    return out
+
+
+def main(argv):
+    budget = "--budget" in argv
+    dirs = [a for a in argv if a != "--budget"]
+    if not dirs:
+        sys.exit(__doc__)
+    pdf = mean_columns(dirs, "pdf_y.csv")
+    y = [r["y_m"] for r in pdf]
+    dens = [r["probability_density"] for r in pdf]
+    width = 2 * y[0] * len(y)  # bins tile [0, W)
+    rel = [d * width for d in dens]  # density over its mean
+    radius = 0.3e-3
+    inner = [r for yy, r in zip(y, rel) if 0.75e-3 <= yy <= width - 0.75e-3]
+    cv = statistics.pstdev(inner) / statistics.fmean(inner)
+    layer = [r for yy, r in zip(y, rel) if radius <= yy <= radius + 0.45e-3 or width - radius - 0.45e-3 <= yy <= width - radius]
+    print(f"runs {len(dirs)}; W = {width * 1e3:.3g} mm; interior_cv {cv:.3f}; wall_layer {statistics.fmean(layer):.2f}")
+    print("y_mm    " + " ".join(f"{yy * 1e3:5.2f}" for yy in y))
+    print("density " + " ".join(f"{r:5.2f}" for r in rel))
+    if budget:
+        b = mean_columns(dirs, "force_budget_y.csv")
+        terms = [c[: -len("_per_weight")] for c in b[0] if c.endswith("_per_weight")]
+        for t in terms:
+            print(f"{t[:8]:8s}" + " ".join(f"{r[t + '_per_weight'] * 100:+5.1f}" for r in b))
+        print("(forces in % of the buoyant weight, + toward the far wall)")
+        if "re_p" in b[0]:
+            for t in ("re_p", "re_w"):
+                print(f"{t:8s}" + " ".join(f"{r[t]:5.1f}" for r in b))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
