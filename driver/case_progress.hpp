@@ -31,7 +31,9 @@ class CaseProgress {
  private:
   std::string line(double t_s, bool finished) const;
   void write(const std::string& s) const;
-  double seconds(Clock::time_point a, Clock::time_point b) const { return std::chrono::duration<double>(b - a).count(); }
+  double seconds(Clock::time_point a, Clock::time_point b) const {
+    return std::chrono::duration<double>(b - a).count();
+  }
 
   double end_s_;
   bool live_;

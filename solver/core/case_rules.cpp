@@ -180,10 +180,14 @@ void validate(CaseParams& p) {
       throw InputError(
           fmt::format("{} = {} s would take {:.3g} steps to time.end = {} s: must be at most {:g}", key,
                       fmt_num(dt), p.time.end_s / dt, fmt_num(p.time.end_s), kMaxSteps));
-  if (reads("forces.lift") && !p.forces.saffman_lift && p.forces.lift != "saffman" && p.forces.lift != "none")
-    throw InputError(fmt::format("forces.lift = \"{}\" contradicts forces.saffman_lift = false (which means no "
-                                 "lift): leave one of them out",
-                                 p.forces.lift));
+  // A law other than the default named beside saffman_lift = false (a case written back with every
+  // key holds the default law there, which the switch turns off).
+  if (reads("forces.lift") && !p.forces.saffman_lift && p.forces.lift != ForceParams{}.lift &&
+      p.forces.lift != "none")
+    throw InputError(
+        fmt::format("forces.lift = \"{}\" contradicts forces.saffman_lift = false (which means no "
+                    "lift): leave one of them out",
+                    p.forces.lift));
   if (reads("time.average_from") && p.time.average_from_s >= p.time.end_s)
     throw InputError(fmt::format(
         "time.average_from = {} s{} must be < time.end = {} s", fmt_num(p.time.average_from_s),

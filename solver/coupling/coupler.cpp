@@ -256,12 +256,16 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
       if (s_.lift != LiftLaw::none) {
         if (linear) {
           w[0] = sample(offsets(ls.x[0], ls.y_normal, ls.z[1], fields_.vorticity(0)), fields_.vorticity(0).a);
-          w[1] = sample(offsets(ls.x[1], ls.y_tangential, ls.z[1], fields_.vorticity(1)), fields_.vorticity(1).a);
+          w[1] = sample(offsets(ls.x[1], ls.y_tangential, ls.z[1], fields_.vorticity(1)),
+                        fields_.vorticity(1).a);
           w[2] = sample(offsets(ls.x[1], ls.y_normal, ls.z[0], fields_.vorticity(2)), fields_.vorticity(2).a);
         } else {
-          w[0] = sample(offsets(st.cell[0], st.face[1], st.face[2], fields_.vorticity(0)), fields_.vorticity(0).a);
-          w[1] = sample(offsets(st.face[0], st.cell[1], st.face[2], fields_.vorticity(1)), fields_.vorticity(1).a);
-          w[2] = sample(offsets(st.face[0], st.face[1], st.cell[2], fields_.vorticity(2)), fields_.vorticity(2).a);
+          w[0] = sample(offsets(st.cell[0], st.face[1], st.face[2], fields_.vorticity(0)),
+                        fields_.vorticity(0).a);
+          w[1] = sample(offsets(st.face[0], st.cell[1], st.face[2], fields_.vorticity(1)),
+                        fields_.vorticity(1).a);
+          w[2] = sample(offsets(st.face[0], st.face[1], st.cell[2], fields_.vorticity(2)),
+                        fields_.vorticity(2).a);
         }
       }
     } else if (!linear) {  // the vorticity is read whether or not the lift uses it
@@ -303,7 +307,8 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
       budget_->add_prepared(ForceBudget::viscous, p.y[i], visc_y);
       budget_->add_prepared(ForceBudget::added_mass, p.y[i], p.madd[i] * dudt[1]);
       budget_->add_prepared(ForceBudget::re_p, p.y[i], slip * d / nu);
-      budget_->add_prepared(ForceBudget::re_w, p.y[i], std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * d * d / nu);
+      budget_->add_prepared(ForceBudget::re_w, p.y[i],
+                            std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * d * d / nu);
     }
 
     p.v0x[i] = p.vx[i], p.v0y[i] = p.vy[i], p.v0z[i] = p.vz[i];

@@ -10,9 +10,9 @@
 // The vorticity at cell centres is a central difference of cell-centred velocities over two
 // cells, omega_x(j) = (w(j+1) - w(j-1)) / 2h: a profile that alternates cell by cell has none, so
 // the lift cannot see, and so cannot oppose, structure of the grid's period. At the edges of the
-// staggered grid the same derivative is compact, omega_x(j - 1/2) = (w(j) - w(j-1)) / h (the
-// no-slip mirror makes it 2 w(0) / h on the wall edge): each component lives where its two
-// derivatives are centred,
+// staggered grid the same derivative is compact, omega_x(j - 1/2) = (w(j) - w(j-1)) / h, and on a
+// no-slip wall edge one-sided from the two nearest nodes and w = 0 there, (9 w(0) - w(1)) / 3h
+// (exact for a parabola): each component lives where its two derivatives are centred,
 //   omega_x at (i, j - 1/2, k - 1/2): x cell, y face, z face
 //   omega_y at (i - 1/2, j, k - 1/2): x face, y cell, z face
 //   omega_z at (i - 1/2, j - 1/2, k): x face, y face, z cell
@@ -85,7 +85,8 @@ class FluidFields {
  public:
   /// window: the planes this rank holds on several ranks (nullptr: one rank, the whole grid).
   /// edge_vorticity: the vorticity at the grid's edges (see above) instead of cell centres.
-  FluidFields(const GridSpec& g, bool top_slip, const SlabExchange* window = nullptr, bool edge_vorticity = false);
+  FluidFields(const GridSpec& g, bool top_slip, const SlabExchange* window = nullptr,
+              bool edge_vorticity = false);
 
   /// Reads velocity, pressure and nu_t from the solver at its current level and derives the
   /// fields above. `dt_s` is the step that led to this level (for Du/Dt; 0 = first call, then

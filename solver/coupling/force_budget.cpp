@@ -7,9 +7,7 @@
 namespace boycott::coupling {
 
 ForceBudget::ForceBudget(double y0_m, double width_m, int bands)
-    : exposure_(y0_m, y0_m + width_m, bands),
-      impulse_(kTerms, exposure_),
-      prepared_(kTerms, exposure_) {}
+    : exposure_(y0_m, y0_m + width_m, bands), impulse_(kTerms, exposure_), prepared_(kTerms, exposure_) {}
 
 void ForceBudget::commit(const particles::ParticleStore& s, double dt_s, double gravity_y_m_s2) {
   for (int t = 0; t < kTerms; ++t) {

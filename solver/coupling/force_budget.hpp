@@ -36,13 +36,24 @@ namespace boycott::coupling {
 class ForceBudget {
  public:
   enum Term {
-    drag, lift, pressure_gradient, viscous, added_mass, gravity, walls, particle_contacts, net,
+    drag,
+    lift,
+    pressure_gradient,
+    viscous,
+    added_mass,
+    gravity,
+    walls,
+    particle_contacts,
+    net,
     kForces,  // the forces above; the lift law's inputs below
-    re_p = kForces, re_w, kTerms
+    re_p = kForces,
+    re_w,
+    kTerms
   };
   static constexpr std::array<const char*, kTerms> kNames = {
-      "drag", "lift", "pressure_gradient", "viscous", "added_mass", "gravity", "walls", "particle_contacts", "net",
-      "re_p", "re_w"};
+      "drag",    "lift",  "pressure_gradient", "viscous", "added_mass",
+      "gravity", "walls", "particle_contacts", "net",     "re_p",
+      "re_w"};
 
   /// Bands over [y0, y0 + width) m.
   ForceBudget(double y0_m, double width_m, int bands);

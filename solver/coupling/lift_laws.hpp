@@ -48,8 +48,8 @@ inline double mei_lift_factor(double re_p, double re_w) {
 /// The lift of law `law` on a sphere of diameter d (m) at slip s = u_f - u_p (m/s) in vorticity
 /// w (1/s), fluid density rho (kg/m^3) and kinematic viscosity nu (m^2/s), into f (N). Zero where
 /// the vorticity or the slip is zero.
-inline void lift_force(LiftLaw law, const double (&s)[3], const double (&w)[3], double d, double rho, double nu,
-                       double (&f)[3]) {
+inline void lift_force(LiftLaw law, const double (&s)[3], const double (&w)[3], double d, double rho,
+                       double nu, double (&f)[3]) {
   f[0] = f[1] = f[2] = 0.0;
   if (law == LiftLaw::none) return;
   const double wn = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);

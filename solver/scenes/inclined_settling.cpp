@@ -217,7 +217,8 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     run.set_force_budget(nullptr);
     for (Histogram* h : budget->all()) *h = over_ranks(run, *h);
     const double vp = p.particle_volume_m3();
-    const double weight = std::abs(p.particles.density_kg_m3 - p.fluid.density_kg_m3) * vp * p.gravity.magnitude_m_s2;
+    const double weight =
+        std::abs(p.particles.density_kg_m3 - p.fluid.density_kg_m3) * vp * p.gravity.magnitude_m_s2;
     if (output_rank() && budget->exposure().total_ > 0)
       write_file_atomic(ctx.out_dir / "force_budget_y.csv", budget->csv(weight > 0 ? weight : 1.0));
   }

@@ -25,7 +25,8 @@ void add_warning(nlohmann::json& j, const std::string& text) {
   j["warnings"].push_back(text);
   // On a terminal the live progress line may stand unfinished: clear it so the warning starts a
   // line of its own (the progress line is drawn again below it).
-  if (output_rank()) std::fprintf(stderr, "%swarning: %s\n", isatty(STDERR_FILENO) ? "\r\033[K" : "", text.c_str());
+  if (output_rank())
+    std::fprintf(stderr, "%swarning: %s\n", isatty(STDERR_FILENO) ? "\r\033[K" : "", text.c_str());
 }
 
 void report_window_error(nlohmann::json& j, const std::string& prefix, const std::string& what,

@@ -102,8 +102,13 @@ TEST(CaseParams, IdentityVersion2LeavesOutTheRunLengthAndOutputOnly) {
   validate(c);
   EXPECT_NE(case_id(c), case_id(a));
   // The default case's id under version 2 (a change of the scheme must bump kCaseIdVersion and
-  // migrate stored ids, see driver/case_id_migration.cpp).
-  EXPECT_EQ(case_id(a), "feaf57c856c9fbc2");
+  // migrate stored ids, see driver/case_id_migration.cpp). Mei's lift became the default after
+  // it: the default case of earlier builds, Saffman's lift, keeps its id.
+  EXPECT_EQ(case_id(a), "98d95b7d3ced7ffb");
+  CaseParams saffman;
+  apply_override(saffman, "forces.lift=\"saffman\"");
+  validate(saffman);
+  EXPECT_EQ(case_id(saffman), "feaf57c856c9fbc2");
 }
 
 TEST(CaseParams, IdHashesOnlyTheKeysTheSceneReads) {
@@ -219,13 +224,16 @@ TEST(ExitCodes, EachErrorKindMapsToItsDocumentedCode) {
 
 TEST(CaseParams, LiftLawIsALateKeyWithOneIdPerPhysics) {
   // forces.lift = "saffman" is the behaviour before the key existed: left out of the id, so every
-  // stored case keeps its id (the default case's is pinned above).
+  // stored case keeps its id (pinned above); Mei's law, the default now, is in the id.
   CaseParams a;
+  apply_override(a, "forces.lift=\"saffman\"");
   validate(a);
-  CaseParams b;
-  apply_override(b, "forces.lift=\"saffman\"");
-  validate(b);
-  EXPECT_EQ(case_id(b), case_id(a));
+  nlohmann::json j = to_json(a);
+  j["forces"].erase("lift");
+  EXPECT_EQ(case_id(a), case_id(case_from_json(j)));
+  CaseParams dflt;
+  validate(dflt);
+  EXPECT_NE(case_id(dflt), case_id(a));
   // "none" is saffman_lift = false: one case, one id, whichever way it is said.
   CaseParams off, none;
   apply_override(off, "forces.saffman_lift=false");
@@ -234,19 +242,22 @@ TEST(CaseParams, LiftLawIsALateKeyWithOneIdPerPhysics) {
   validate(none);
   EXPECT_EQ(case_id(none), case_id(off));
   EXPECT_NE(case_id(off), case_id(a));
-  // Mei's law is another case.
+  // Mei's law is another case, the default one.
   CaseParams mei;
   apply_override(mei, "forces.lift=\"saffman_mei\"");
   validate(mei);
   EXPECT_NE(case_id(mei), case_id(a));
+  EXPECT_EQ(case_id(mei), case_id(dflt));
   EXPECT_NE(case_id(mei), case_id(off));
-  // A law with the lift switched off is a contradiction, refused with both keys named.
+  // A law other than the default named beside the lift switched off is a contradiction, refused
+  // with both keys named (the default law beside it is how a case written back with every key
+  // reads: the switch turns it off).
   CaseParams bad;
   apply_override(bad, "forces.saffman_lift=false");
-  apply_override(bad, "forces.lift=\"saffman_mei\"");
+  apply_override(bad, "forces.lift=\"saffman\"");
   try {
     validate(bad);
-    FAIL() << "saffman_mei accepted with saffman_lift = false";
+    FAIL() << "saffman accepted with saffman_lift = false";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("forces.saffman_lift"), std::string::npos) << e.what();
   }
@@ -254,7 +265,7 @@ TEST(CaseParams, LiftLawIsALateKeyWithOneIdPerPhysics) {
   CaseParams budget;
   apply_override(budget, "output.force_budget_y=true");
   validate(budget);
-  EXPECT_EQ(case_id(budget), case_id(a));
+  EXPECT_EQ(case_id(budget), case_id(dflt));
 }
 
 TEST(CaseParams, AStoredRecordWithoutALateKeyHadItsOldBehaviour) {

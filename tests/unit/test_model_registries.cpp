@@ -49,7 +49,8 @@ TEST(ModelRegistries, LiftLawsResolveExactlyTheListedNames) {
 }
 
 TEST(ModelRegistries, VorticitiesResolveExactlyTheListedNames) {
-  for (const auto& name : vorticity_names()) EXPECT_NO_THROW(coupling::edge_vorticity_from_name(name)) << name;
+  for (const auto& name : vorticity_names())
+    EXPECT_NO_THROW(coupling::edge_vorticity_from_name(name)) << name;
   EXPECT_THROW(coupling::edge_vorticity_from_name("nodes"), InputError);
 }
 

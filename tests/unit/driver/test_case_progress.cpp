@@ -17,7 +17,9 @@ struct FakeTerminal {
   bd::CaseProgress::Io io() {
     return {[this] { return now; }, [this](const std::string& s) { out.push_back(s); }};
   }
-  void advance(double s) { now += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s)); }
+  void advance(double s) {
+    now += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  }
 };
 }  // namespace
 

@@ -79,6 +79,7 @@ pressure_gradient = false
 viscous = false
 added_mass = false
 saffman_lift = true
+lift = "saffman"
 )");
   coupling::CoupledSystem run(p, coupling::CoupledOptions{true, false});
   const double shear = 20.0, W = 0.006, yp = 0.5 * W + 0.4e-3;
