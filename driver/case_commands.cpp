@@ -54,9 +54,11 @@ void print_outcome(const std::filesystem::path& dir) {
       result = fmt::format(", <<w_p>> = {:.5g} m/s +- {}", j["mean_settling_velocity_m_s"].get<double>(),
                            e.is_number() ? fmt::format("{:.2g}", e.get<double>()) : std::string("n/a"));
     }
-    std::fprintf(stderr, "%s at t = %.6g s after %.1f s of wall time%s (%s)\n",
-                 j.value("status", "?").c_str(), j.value("simulated_time_s", 0.0),
-                 j.value("wall_time_s", 0.0), result.c_str(), (dir / "summary.json").c_str());
+    // The result, on stdout (progress and warnings are on stderr): `case run ... > result.txt`.
+    std::printf("%s at t = %.6g s after %.1f s of wall time%s (%s)\n", j.value("status", "?").c_str(),
+                j.value("simulated_time_s", 0.0), j.value("wall_time_s", 0.0), result.c_str(),
+                (dir / "summary.json").c_str());
+    std::fflush(stdout);
   } catch (const std::exception&) {
     // The summary is the record; a line about it is not worth failing the run.
   }

@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "driver/cost_model.hpp"
+#include "driver/progress.hpp"
 #include "driver/store.hpp"
 
 namespace fs = std::filesystem;
@@ -63,9 +64,10 @@ std::string plan_summary_line(Database& db, const Study& study, const std::vecto
   std::string basis;
   for (const auto& [scene, _] : scenes)
     basis += (basis.empty() ? "" : ", ") + scene + ": " + model.basis(scene);
-  return fmt::format("plan: {} cases to run, estimated {} on {} jobs x {} ranks (cost model {})",
-                     costs.size(), duration(study_wall_s(costs, jobs, ranks)), jobs, ranks,
-                     basis.empty() ? "-" : basis);
+  return fmt::format("plan: {} to run, estimated {} on {} x {} (cost model {})",
+                     count_of(static_cast<long long>(costs.size()), "case"),
+                     duration(study_wall_s(costs, jobs, ranks)), count_of(jobs, "job"),
+                     count_of(ranks, "rank"), basis.empty() ? "-" : basis);
 }
 
 int study_plan(const PlanOptions& opt) {
@@ -133,13 +135,13 @@ int study_plan(const PlanOptions& opt) {
                             .c_str());
     return 0;
   }
-  std::printf("study %s: %zu cases, %zu to run\n", study.name.c_str(), study.cases.size(),
-              pending_costs.size());
+  std::printf("study %s: %s, %zu to run\n", study.name.c_str(),
+              count_of(static_cast<long long>(study.cases.size()), "case").c_str(), pending_costs.size());
   std::printf("%-10s %-34s %-16s %-11s %10s\n%s", "group", "varied", "case", "state", "core time",
               table.c_str());
-  std::printf(
-      "estimated wall time of the cases to run: %s on %d jobs x %d ranks (parallel efficiency %.2f)\n",
-      duration(wall).c_str(), opt.jobs, opt.ranks, ranks_efficiency(opt.ranks));
+  std::printf("estimated wall time of the cases to run: %s on %s x %s (parallel efficiency %.2f)\n",
+              duration(wall).c_str(), count_of(opt.jobs, "job").c_str(), count_of(opt.ranks, "rank").c_str(),
+              ranks_efficiency(opt.ranks));
   std::map<std::string, bool> scenes;
   for (const auto& c : study.cases) scenes[c.params.scene] = true;
   for (const auto& [scene, _] : scenes)

@@ -18,6 +18,10 @@ using Clock = std::chrono::steady_clock;
 
 }  // namespace
 
+std::string count_of(long long n, const std::string& noun) {
+  return fmt::format("{} {}{}", n, noun, n == 1 ? "" : "s");
+}
+
 std::string eta_text(double s) {
   if (!std::isfinite(s) || s < 0) return "?";
   const long v = std::lround(s);

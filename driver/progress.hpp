@@ -14,6 +14,8 @@ namespace boycott::driver {
 
 /// A remaining time for a progress line: "42s", "3m07s", "2h05m"; "?" when unknown.
 std::string eta_text(double seconds);
+/// "1 case", "2 cases": a count with its noun, plural by an s.
+std::string count_of(long long n, const std::string& noun);
 
 /// Simulated time of a running case: first column of the last line of <run_dir>/timeseries.csv;
 /// 0 before the solver wrote one.

@@ -15,6 +15,7 @@
 #include "driver/curve.hpp"
 #include "driver/database.hpp"
 #include "driver/plan.hpp"
+#include "driver/progress.hpp"
 #include "driver/replica_rounds.hpp"
 #include "driver/run_tree.hpp"
 #include "driver/scheduler.hpp"
@@ -110,11 +111,12 @@ int study_run(const StudyRunOptions& opt) {
     failed += s.status == CaseStatus::kFailed;
   }
   if (stopped) {
-    std::printf("study %s stopped by signal %d: %d of %d cases done; run the same command to resume\n",
-                study.name.c_str(), stop_signal(), done, n_total);
+    std::printf("study %s stopped by signal %d: %d of %s done; run the same command to resume\n",
+                study.name.c_str(), stop_signal(), done, count_of(n_total, "case").c_str());
     return kExitInterrupted;
   }
-  std::printf("study %s: %d of %d cases done, %d failed\n", study.name.c_str(), done, n_total, failed);
+  std::printf("study %s: %d of %s done, %d failed\n", study.name.c_str(), done,
+              count_of(n_total, "case").c_str(), failed);
   // The settling curve where the study has one; otherwise (ergun, single_particle, channel_flow,
   // sediment_transport) each finished case's validation errors against their tolerances.
   const auto curve = query_curve(db, study.name);
@@ -170,9 +172,9 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
         "{:<16} {:<12} {:6.1f} {:<12} {:>5}{} {}\n", c.id, c.group, c.params.gravity.angle_deg, st, ranks,
         job_col, it != known.end() && it->second.status != CaseStatus::kDone ? it->second.last_error : "");
   }
-  std::printf("study %s: %zu cases: %d done, %d running, %d failed, %d interrupted, %d pending\n",
-              study.name.c_str(), study.cases.size(), counts["done"], counts["running"], counts["failed"],
-              counts["interrupted"], counts["pending"]);
+  std::printf("study %s: %s: %d done, %d running, %d failed, %d interrupted, %d pending\n",
+              study.name.c_str(), count_of(static_cast<long long>(study.cases.size()), "case").c_str(),
+              counts["done"], counts["running"], counts["failed"], counts["interrupted"], counts["pending"]);
   if (!open_slurm.empty() && !queue) std::printf("Slurm job states unknown: %s\n", queue_why.c_str());
   if (uncollected > 0)
     std::printf("%d finished run folders are not recorded yet: boycott study collect %s --db %s\n",

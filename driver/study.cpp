@@ -12,6 +12,7 @@
 #include <toml++/toml.h>
 
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 #include "core/key_docs.hpp"
 #include "core/scene_specs.hpp"
 
@@ -367,11 +368,7 @@ std::string readable_value(const std::string& toml_text) {
 }
 
 Study expand_study_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("cannot read study file '{}'", path));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return expand_study_string(ss.str(), path);
+  return expand_study_string(read_input_file(path, "study file"), path);
 }
 
 namespace {

@@ -12,6 +12,7 @@
 #include "core/case_key_table.hpp"
 #include "core/case_params.hpp"
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 #include "core/key_docs.hpp"
 #include "core/scene_specs.hpp"
 
@@ -208,11 +209,7 @@ CaseParams parse_case_string(const std::string& text, const std::string& origin)
 }
 
 CaseParams parse_case_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("cannot read case file '{}'", path));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_case_string(ss.str(), path);
+  return parse_case_string(read_input_file(path, "case file"), path);
 }
 
 CaseParams case_from_json(const nlohmann::json& j) {

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -172,6 +174,14 @@ void validate(CaseParams& p) {
     if (std::abs(ratio - std::round(ratio)) > 1e-6 * ratio)
       throw InputError(
           fmt::format("time.dt_cfd / time.dt_dem = {} must be a whole number of DEM sub-steps", ratio));
+    // A run stops (signal, Slurm's warning) between fluid steps: a fluid step of more sub-steps
+    // than this could not be stopped in any reasonable time (the paper's cases take 50).
+    constexpr double kMaxSubsteps = 1e5;
+    if (ratio > kMaxSubsteps * (1.0 + 1e-9))
+      throw InputError(
+          fmt::format("time.dt_cfd / time.dt_dem = {:.6g} DEM sub-steps per fluid step: must be at "
+                      "most {:g} (a run stops only between fluid steps)",
+                      ratio, kMaxSubsteps));
   }
   // A step so small that the run would not end in any time a machine has.
   constexpr double kMaxSteps = 1e12;
@@ -188,6 +198,20 @@ void validate(CaseParams& p) {
         fmt::format("forces.lift = \"{}\" contradicts forces.saffman_lift = false (which means no "
                     "lift): leave one of them out",
                     p.forces.lift));
+  // Each time writes a file: a bounded number of them, none twice.
+  for (auto [key, times] : {std::pair{"output.snapshot_times", &p.output.snapshot_times_s},
+                            std::pair{"output.image_times", &p.output.image_times_s}}) {
+    if (!reads(key)) continue;
+    constexpr std::size_t kMaxTimes = 10000;
+    if (times->size() > kMaxTimes)
+      throw InputError(fmt::format("{} lists {} times: must be at most {} (each writes a file)", key,
+                                   times->size(), kMaxTimes));
+    std::vector<double> sorted = *times;
+    std::sort(sorted.begin(), sorted.end());
+    if (const auto dup = std::adjacent_find(sorted.begin(), sorted.end()); dup != sorted.end())
+      throw InputError(
+          fmt::format("{} lists {} s more than once: each time may appear once", key, fmt_num(*dup)));
+  }
   if (reads("time.average_from") && p.time.average_from_s >= p.time.end_s)
     throw InputError(fmt::format(
         "time.average_from = {} s{} must be < time.end = {} s", fmt_num(p.time.average_from_s),

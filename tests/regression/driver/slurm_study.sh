@@ -24,7 +24,7 @@ skip() {
   exit 77
 }
 for p in munged slurmctld slurmd sbatch squeue scontrol scancel sinfo flock; do
-  command -v "$p" > /dev/null || skip "no $p (scripts/install_deps.sh installs slurmctld slurmd slurm-client munge)"
+  command -v "$p" > /dev/null || skip "no $p (scripts/install_deps.sh --with-slurm installs slurmctld slurmd slurm-client munge)"
 done
 [ "$(id -u)" = 0 ] || skip "the private slurmd runs jobs as their user and must be started as root"
 [ -r /etc/munge/munge.key ] || skip "no /etc/munge/munge.key (the munge package creates it)"

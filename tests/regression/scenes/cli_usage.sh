@@ -34,10 +34,10 @@ grep -q ' 4 pending' "$work/out.txt" || fail "status does not list the pending c
 # line follows every step after the first whatever the machine's speed (the timing of the lines
 # themselves is tested on a clock the test moves: test_case_progress.cpp).
 "$bin" case run "$case_file" --out "$work/run" --set time.end=0.15 --set time.average_from=0.05 \
-  --progress-every 1e-9 -- -pressure_ksp_typ cg > /dev/null 2> "$work/err.txt" || fail "the run failed: $(cat "$work/err.txt")"
+  --progress-every 1e-9 -- -pressure_ksp_typ cg > "$work/out.txt" 2> "$work/err.txt" || fail "the run failed: $(cat "$work/err.txt")"
 n=$(grep -c '^progress: t = .* wall s per simulated s, ETA .*mean_wp_m_s' "$work/err.txt")
 [ "$n" -ge 2 ] || fail "expected progress lines, got: $(cat "$work/err.txt")"
-grep -q '^completed at t = 0.15 s after .* <<w_p>> = ' "$work/err.txt" || fail "no outcome line: $(cat "$work/err.txt")"
+grep -q '^completed at t = 0.15 s after .* <<w_p>> = ' "$work/out.txt" || fail "no outcome line on stdout: $(cat "$work/out.txt")"
 grep -q 'PETSc option -pressure_ksp_typ .* nothing used it' "$work/err.txt" || fail "unused PETSc option not reported"
 grep -q 'no_signal_handler' "$work/err.txt" && fail "the program's own PETSc option reported as unused"
 "$bin" case run "$case_file" --out "$work/quiet" --set time.end=0.05 --set time.average_from=0.02 --quiet \

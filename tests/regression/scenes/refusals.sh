@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # What `case run` and `case check` refuse, and that a refused run writes nothing:
-# non-finite values in any key, steps so small a run would never end, sizes beyond this
+# non-finite values in any key, steps so small a run would never end or a fluid step never stop,
+# repeated output times, case and study files that are FIFOs, devices or folders, sizes beyond this
 # machine's memory (refused by case run, a warning of case check), a settling case without
 # particles, an --out folder holding the user's own files, and a run folder whose params.json is
 # damaged (unusable, exit 4, not bad input).
@@ -28,6 +29,17 @@ expect 0 "a 4096 x 6 x 4096 grid, case check warns" "$bin" case check "$case_fil
 grep -q "on this machine" "$work/out.txt" || { echo "FAIL: no machine warning"; fails=$((fails + 1)); }
 expect 2 "2e8 particles, case run" run --set particles.count=200000000 --set domain.length_x=2.0 --set domain.height_z=10.0
 expect 2 "a settling case without particles" run --set particles.count=0
+# A fluid step of 1e9 sub-steps could not be stopped (a run stops between fluid steps).
+expect 2 "time.dt_dem=1e-12 (1e9 sub-steps per fluid step)" run --set time.dt_dem=1e-12
+expect 2 "case check --set time.dt_dem=1e-12" "$bin" case check "$case_file" --set time.dt_dem=1e-12
+expect 2 "a snapshot time listed twice" run --set 'output.snapshot_times=[0.01, 0.02, 0.01]'
+# Files that are not files: a FIFO would block a reader, a link to /dev/zero would never end.
+mkfifo "$work/fifo.toml"; ln -s /dev/zero "$work/zero.toml"; mkdir "$work/dir.toml"
+for f in fifo.toml zero.toml dir.toml; do
+  expect 2 "case check of $f" timeout 60 "$bin" case check "$work/$f"
+  expect 2 "case run of $f" timeout 60 "$bin" case run "$work/$f" --out "$work/r"
+  expect 2 "study plan of $f" timeout 60 "$bin" study plan "$work/$f"
+done
 [ ! -e "$work/r" ] || { echo "FAIL: a refused run wrote $work/r"; ls -la "$work/r"; fails=$((fails + 1)); }
 # An --out folder with the user's own files: refused, untouched, nothing written.
 mkdir -p "$work/mine"
