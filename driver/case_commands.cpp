@@ -121,6 +121,10 @@ int case_check(const std::string& file, const std::vector<std::string>& sets) {
               pre.errors.empty()
                   ? (pre.warnings.empty() && pre.machine_errors.empty() ? "valid" : "valid, with warnings")
                   : "REFUSED");
+  std::printf("  box %g x %g x %g m (x, y, z), cells [%lld, %lld, %lld], inclination %g deg\n",
+              p.domain.length_x_m, p.domain.width_y_m, p.domain.height_z_m,
+              static_cast<long long>(p.domain.cells[0]), static_cast<long long>(p.domain.cells[1]),
+              static_cast<long long>(p.domain.cells[2]), p.gravity.angle_deg);
   std::printf("  particles %lld, solid fraction %.4f, dt_dem %.4g us, dt_cfd %.4g ms\n",
               static_cast<long long>(p.particles.count), p.solid_fraction(), p.time.dt_dem_s * 1e6,
               p.time.dt_cfd_s * 1e3);

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "core/constants.hpp"
+#include "core/scene_specs.hpp"
 #include "coupling/drag_laws.hpp"
 
 namespace boycott::scenes {
@@ -233,6 +234,13 @@ Preflight preflight(const CaseParams& p, int ranks) {
         fmt::format("an impact at {:.3g} m/s overlaps {:.2f} d (> 0.1 d): soft contacts compress "
                     "the packing",
                     v_imp, overlap));
+  // An inclination in radians written where degrees are read (1.2 meant as 69 degrees).
+  const double th = p.gravity.angle_deg;
+  if (scene_reads(scene_spec(p.scene), "gravity.angle_deg") && th > 0.0 && th < 2.0 && th != std::floor(th))
+    r.warnings.push_back(fmt::format(
+        "gravity.angle_deg = {:g}: an inclination in degrees below 2 that is not a whole number; if it "
+        "was meant in radians it is {:.4g} degrees",
+        th, th * 180.0 / kPi));
   if (fluid && rho_p / rho_f < 1.1)
     r.warnings.push_back(
         fmt::format("nearly neutrally buoyant particles (rho_p/rho_f = {:.3g}): settling is slow "

@@ -183,7 +183,7 @@ TEST(StudyRunStorage, ExitSeventyFourIsRetriedAfterABackOffNeitherCountedNorSetA
     EXPECT_NE(r.err.find(wait), std::string::npos) << r.err;
   const auto status =
       run({"study", "status", (d.path / "s.toml").string(), "--db", db.string(), "--retries", "0"}, d.path);
-  EXPECT_NE(status.out.find("1 cases: 1 done, 0 running, 0 failed"), std::string::npos) << status.out;
+  EXPECT_NE(status.out.find("1 case: 1 done, 0 running, 0 failed"), std::string::npos) << status.out;
 }
 
 TEST(StudyRunStorage, FiveStorageErrorsInARowStopTheStudyNamingTheCause) {

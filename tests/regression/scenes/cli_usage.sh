@@ -23,6 +23,13 @@ expect_usage nofile.toml case run "$work/nofile.toml" --out "$work/never"
 expect_usage xml query curve --db "$work/none.db" --study s --format xml
 expect_usage "only \`case run\`" study status s.toml --db "$work/none.db" -- -ksp_view
 "$bin" --help > /dev/null || fail "--help did not exit 0"
+# case check shows the case's geometry, and an angle that looks like radians gets a warning.
+"$bin" case check "$case_file" --set gravity.angle_deg=1.2 > "$work/out.txt" 2>&1 || fail "case check failed: $(cat "$work/out.txt")"
+grep -q 'inclination 1.2 deg' "$work/out.txt" || fail "case check does not print the angle: $(cat "$work/out.txt")"
+grep -q 'cells \[' "$work/out.txt" || fail "case check does not print the cells: $(cat "$work/out.txt")"
+grep -q 'radians it is 68.75 degrees' "$work/out.txt" || fail "no radians warning: $(cat "$work/out.txt")"
+"$bin" case check "$case_file" --set gravity.angle_deg=1 > "$work/out.txt" 2>&1
+grep -q 'radians' "$work/out.txt" && fail "a whole-number angle warned of radians"
 # status only reads: on a database that does not exist it lists the cases as pending, creates none.
 demo=$(dirname "$case_file")/../demo.toml
 "$bin" study status "$demo" --db "$work/new.db" > "$work/out.txt" 2>&1 || fail "status on no database: $(cat "$work/out.txt")"
