@@ -328,25 +328,10 @@ namespace {
 /// dw/dy. Returns the largest |read - exact| over the particles, over the largest |dw/dy| there
 /// (Poiseuille's vorticity passes through 0 at the centreline, y = 5 d).
 double vorticity_error(const std::string& sampling, const std::string& vorticity, bool poiseuille) {
-  CaseParams p = parse_case_string(R"(
-scene = "inclined_settling"
-[fluid]
-subgrid_model = "none"
-[domain]
-length_x = 0.008
-width_y = 0.006
-height_z = 0.008
-cells = [8, 6, 8]
-[particles]
-count = 1
-[forces]
-drag = "none"
-pressure_gradient = false
-viscous = false
-added_mass = false
-lift = "saffman"
-)");
-  p.numerics.sampling = sampling;
+  // The wall-sampling channel with only Saffman's lift on (Eq. 16, whose inversion is below).
+  CaseParams p = channel_case(sampling);
+  p.forces.saffman_lift = true;
+  p.forces.lift = "saffman";
   p.numerics.vorticity = vorticity;
   validate(p);
   coupling::CoupledSystem run(p, coupling::CoupledOptions{true, false});
