@@ -31,8 +31,8 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
     s = "group,angle_deg,mean_settling_velocity_m_s,stderr_m_s,n_replicas,between_replica_stderr_m_s,"
         "mean_within_run_stderr_m_s,r_acc,r_acc_err,error_method,case_id,setting\n";
     for (const auto& p : pts)
-      s += fmt::format("{},{:g},{:.9g},{},{},{},{},{},{},{},{},{}\n", p.group, p.angle_deg, p.w_m_s,
-                       opt9(p.w_err_m_s), p.n_replicas, opt9(p.between_replica_stderr_m_s),
+      s += fmt::format("{},{:g},{:.9g},{},{},{},{},{},{},{},{},{}\n", report::csv_field(p.group), p.angle_deg,
+                       p.w_m_s, opt9(p.w_err_m_s), p.n_replicas, opt9(p.between_replica_stderr_m_s),
                        opt9(p.mean_within_run_stderr_m_s), opt(p.r_acc), opt(p.r_acc_err), p.error_method,
                        p.case_id, report::csv_field(p.setting));
   } else if (f == CurveFormat::kJson) {

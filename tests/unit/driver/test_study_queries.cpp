@@ -464,3 +464,19 @@ scene = "single_particle"
   EXPECT_NE(table.find("(|.| <= 2 %: pass)"), std::string::npos) << table;
   EXPECT_NE(table.find("(|.| <= 2 %: FAIL)"), std::string::npos) << table;
 }
+
+TEST(CurveQuery, CsvQuotesAGroupOrSettingThatHoldsACommaQuoteOrLineBreak) {
+  bd::CurvePoint p;
+  p.group = "a,b";
+  p.setting = "domain.cells=[20, 6, 20]";
+  p.case_id = "0123456789abcdef";
+  p.angle_deg = 65;
+  p.w_m_s = -0.1;
+  p.error_method = "sokal_autocorrelation";
+  bd::CurvePoint q = p;
+  q.group = "line\nbreak \"quoted\"";
+  const auto csv = bd::format_curve({p, q}, bd::CurveFormat::kCsv);
+  EXPECT_NE(csv.find("\n\"a,b\",65,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n\"line\nbreak \"\"quoted\"\"\",65,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",\"domain.cells=[20, 6, 20]\"\n"), std::string::npos) << csv;
+}
