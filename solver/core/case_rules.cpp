@@ -198,6 +198,15 @@ void validate(CaseParams& p) {
         fmt::format("forces.lift = \"{}\" contradicts forces.saffman_lift = false (which means no "
                     "lift): leave one of them out",
                     p.forces.lift));
+  // The fluid grid needs two cells per direction (its stencils and wall rules): refused here, before
+  // a run folder is written, not when the solver is built.
+  if (reads("domain.cells") && p.scene != "dem_only")
+    for (int d = 0; d < 3; ++d)
+      if (p.domain.cells[d] < 2)
+        throw InputError(fmt::format(
+            "domain.cells = [{}, {}, {}]: the fluid grid needs at least 2 cells per "
+            "direction ({} has {})",
+            p.domain.cells[0], p.domain.cells[1], p.domain.cells[2], "xyz"[d], p.domain.cells[d]));
   // Each time writes a file: a bounded number of them, none twice.
   for (auto [key, times] : {std::pair{"output.snapshot_times", &p.output.snapshot_times_s},
                             std::pair{"output.image_times", &p.output.image_times_s}}) {

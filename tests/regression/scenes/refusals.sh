@@ -33,6 +33,8 @@ expect 2 "a settling case without particles" run --set particles.count=0
 expect 2 "time.dt_dem=1e-12 (1e9 sub-steps per fluid step)" run --set time.dt_dem=1e-12
 expect 2 "case check --set time.dt_dem=1e-12" "$bin" case check "$case_file" --set time.dt_dem=1e-12
 expect 2 "a snapshot time listed twice" run --set 'output.snapshot_times=[0.01, 0.02, 0.01]'
+expect 2 "one cell across the gap, case check" "$bin" case check "$case_file" --set 'domain.cells=[20, 1, 20]'
+expect 2 "one cell across the gap, case run" run --set 'domain.cells=[20, 1, 20]'
 # Files that are not files: a FIFO would block a reader, a link to /dev/zero would never end.
 mkfifo "$work/fifo.toml"; ln -s /dev/zero "$work/zero.toml"; mkdir "$work/dir.toml"
 for f in fifo.toml zero.toml dir.toml; do
