@@ -321,19 +321,26 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
     setting_pos.emplace_back(st.integer(5));
     pts.push_back(p);
   }
-  // The setting names only what varies within the group (a group's own `set` is its name's job).
+  // The setting names only what varies within the group (a group's own `set` is its name's job)
+  // at a given angle. A key zipped with the angle (each angle its own time.end, say) takes one
+  // value per angle: it belongs to the angle's point, not to a second curve.
   // Replicas differ in the seed alone, which a study with replicas does not sweep: they share
   // their setting and angle.
   std::vector<std::vector<SweptValue>> swept(pts.size());
-  std::map<std::string, std::map<std::string, std::set<std::string>>>
-      values_in_group;  // group -> key -> values
+  std::map<std::string, std::map<std::string, std::map<double, std::set<std::string>>>>
+      values_at_angle;  // group -> key -> angle -> values
   for (std::size_t i = 0; i < pts.size(); ++i) {
     swept[i] = case_swept_values(db, pts[i].case_id);
-    for (const auto& v : swept[i]) values_in_group[pts[i].group][v.key].insert(v.value);
+    for (const auto& v : swept[i]) values_at_angle[pts[i].group][v.key][pts[i].angle_deg].insert(v.value);
   }
+  const auto splits_curve = [&](const std::string& grp, const std::string& key) {
+    for (const auto& [angle, values] : values_at_angle[grp][key])
+      if (values.size() >= 2) return true;
+    return false;
+  };
   for (std::size_t i = 0; i < pts.size(); ++i)
     for (const auto& v : swept[i]) {
-      if (v.key == "gravity.angle_deg" || values_in_group[pts[i].group][v.key].size() < 2) continue;
+      if (v.key == "gravity.angle_deg" || !splits_curve(pts[i].group, v.key)) continue;
       pts[i].setting += (pts[i].setting.empty() ? "" : "; ") + v.key + "=" + v.display();
     }
   // A setting's place: the first position of any of its cases in the study file.

@@ -427,6 +427,34 @@ set = { "fluid.density" = 1000.0 }
   }
 }
 
+TEST(CurveQuery, KeysZippedWithTheAngleBelongToItsPointNotToASecondCurve) {
+  // Each angle its own run length (as the full-size campaign): one curve, r_acc against its 90 deg.
+  TempDir tmp;
+  bd::Database db((tmp.path / "z.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(R"(
+name = "z"
+[[group]]
+name = "base"
+[group.zip]
+"gravity.angle_deg" = [90, 65, 15]
+"time.end" = [20.0, 20.0, 5.0]
+"time.average_from" = [5.0, 5.0, 2.0]
+)");
+  bd::register_study(db, study);
+  for (const auto& c : study.cases) {
+    const double w =
+        c.params.gravity.angle_deg == 90.0 ? -0.08 : (c.params.gravity.angle_deg == 65.0 ? -0.18 : -0.01);
+    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, summary_of(c, ::Run{w, 0.0, 1.0}));
+  }
+  const auto pts = bd::query_curve(db, "z");
+  ASSERT_EQ(pts.size(), 3u);
+  for (const auto& p : pts) {
+    EXPECT_EQ(p.setting, "") << p.angle_deg;
+    ASSERT_TRUE(p.r_acc.has_value()) << p.angle_deg;
+  }
+  EXPECT_NEAR(*pts[1].r_acc, 0.18 / 0.08, 1e-12);  // 65 deg, angles ascending
+}
+
 TEST(ValidationQuery, ErrorsWithAToleranceShowItAndPassOrFail) {
   // Two single_particle cases: one within the scene's 2 % of the drag law's terminal velocity,
   // one outside it. An error without a tolerance (none for this key) gets no verdict.
