@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "driver/cost_model.hpp"
 #include "driver/progress.hpp"
+#include "driver/report_util.hpp"
 #include "driver/store.hpp"
 
 namespace fs = std::filesystem;
@@ -90,7 +91,9 @@ int study_plan(const PlanOptions& opt) {
 
   nlohmann::json rows = nlohmann::json::array();
   std::vector<double> pending_costs;
-  std::string table;
+  std::vector<std::string> header{"group", "varied", "case", "state", "core time"};
+  if (opt.check_model) header.emplace_back("leave one out");
+  report::TextTable table(header, {false, false, false, false, true, false});
   double total_core_s = 0.0;
   for (const auto& c : study.cases) {
     const auto it = states.find(c.id);
@@ -114,12 +117,13 @@ int study_plan(const PlanOptions& opt) {
         if (f.case_id != c.id) others.push_back(f);
       row["predicted_by_others_core_s"] = CostModel(others).core_s(m->second->work);
     }
-    table += fmt::format("{:<10} {:<34} {:<16} {:<11} {:>10}{}\n", c.group, swept_text(c), c.id,
-                         to_string(st), duration(est),
-                         row.contains("predicted_by_others_core_s")
-                             ? fmt::format("  measured {}, from the others {}", duration(m->second->core_s),
-                                           duration(row["predicted_by_others_core_s"].get<double>()))
-                             : std::string());
+    std::vector<std::string> cells{c.group, swept_text(c), c.id, to_string(st), duration(est)};
+    if (opt.check_model)
+      cells.push_back(row.contains("predicted_by_others_core_s")
+                          ? fmt::format("measured {}, from the others {}", duration(m->second->core_s),
+                                        duration(row["predicted_by_others_core_s"].get<double>()))
+                          : std::string("-"));
+    table.add(std::move(cells));
     rows.push_back(row);
   }
   const double wall = study_wall_s(pending_costs, opt.jobs, opt.ranks);
@@ -137,8 +141,7 @@ int study_plan(const PlanOptions& opt) {
   }
   std::printf("study %s: %s, %zu to run\n", study.name.c_str(),
               count_of(static_cast<long long>(study.cases.size()), "case").c_str(), pending_costs.size());
-  std::printf("%-10s %-34s %-16s %-11s %10s\n%s", "group", "varied", "case", "state", "core time",
-              table.c_str());
+  std::printf("%s", table.str().c_str());
   std::printf("estimated wall time of the cases to run: %s on %s x %s (parallel efficiency %.2f)\n",
               duration(wall).c_str(), count_of(opt.jobs, "job").c_str(), count_of(opt.ranks, "rank").c_str(),
               ranks_efficiency(opt.ranks));
