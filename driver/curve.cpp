@@ -28,11 +28,13 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
     return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
   };
   if (f == CurveFormat::kCsv) {
-    s = "group,angle_deg,mean_settling_velocity_m_s,stderr_m_s,n_replicas,between_replica_stderr_m_s,"
-        "mean_within_run_stderr_m_s,r_acc,r_acc_err,error_method,case_id,setting\n";
+    s = "group,angle_deg,mean_settling_velocity_m_s,error_m_s,error_basis,stderr_m_s,n_replicas,"
+        "between_replica_stderr_m_s,mean_within_run_stderr_m_s,r_acc,r_acc_err,error_method,case_id,"
+        "setting\n";
     for (const auto& p : pts)
-      s += fmt::format("{},{:g},{:.9g},{},{},{},{},{},{},{},{},{}\n", report::csv_field(p.group), p.angle_deg,
-                       p.w_m_s, opt9(p.w_err_m_s), p.n_replicas, opt9(p.between_replica_stderr_m_s),
+      s += fmt::format("{},{:g},{:.9g},{},{},{},{},{},{},{},{},{},{},{}\n", report::csv_field(p.group),
+                       p.angle_deg, p.w_m_s, opt9(p.error.error_m_s), report::csv_field(p.error.basis),
+                       opt9(p.w_err_m_s), p.n_replicas, opt9(p.between_replica_stderr_m_s),
                        opt9(p.mean_within_run_stderr_m_s), opt(p.r_acc), opt(p.r_acc_err), p.error_method,
                        p.case_id, report::csv_field(p.setting));
   } else if (f == CurveFormat::kJson) {
@@ -43,6 +45,8 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
                           {"mean_settling_velocity_m_s", p.w_m_s},
                           {"case_id", p.case_id},
                           {"setting", p.setting}};
+      e["error_m_s"] = opt_json(p.error.error_m_s);
+      e["error_basis"] = p.error.basis;
       e["stderr_m_s"] = opt_json(p.w_err_m_s);
       e["n_replicas"] = p.n_replicas;
       e["between_replica_stderr_m_s"] = opt_json(p.between_replica_stderr_m_s);
@@ -58,21 +62,22 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
   } else if (pts.empty()) {
     s = "(no finished cases)\n";
   } else {
-    // A missing error is "n/a", never a zero that reads as an exact value. With replicas the
-    // error of <<w_p>> is their scatter (between, the error of their mean); "within" is the mean
-    // of the runs' own errors, one run's: honest run errors give between x sqrt(n) ~ within.
+    // A missing error is "n/a", never a zero that reads as an exact value. The error after +-
+    // covers ~68 % (error_m_s, its basis in the last columns); "between" is the replicas' plain
+    // sd/sqrt(n), "within" the mean of the runs' own plain errors, one run's: honest run errors
+    // give between x sqrt(n) ~ within.
     auto mm = [](const std::optional<double>& v) { return v ? fmt::format("{:.4f}", *v * 1e3) : "n/a"; };
-    report::TextTable t({"group", "angle", "<<w_p>> (mm/s)", "n", "between (mm/s)", "within, 1 run (mm/s)",
-                         "r_acc", "error method", "setting"},
+    report::TextTable t({"group", "angle", "<<w_p>> +- 68 % (mm/s)", "n", "between (mm/s)",
+                         "within, 1 run (mm/s)", "r_acc +- 68 %", "error basis", "setting"},
                         {false, true, true, true, true, true, true, false, false});
     for (const auto& p : pts) {
       const std::string r = p.r_acc ? fmt::format("{:.3f} +- {}", *p.r_acc,
                                                   p.r_acc_err ? fmt::format("{:.3f}", *p.r_acc_err) : "n/a")
                                     : "-";
       t.add({p.group, fmt::format("{:g}", p.angle_deg),
-             fmt::format("{:.4f} +- {}", p.w_m_s * 1e3, mm(p.w_err_m_s)), std::to_string(p.n_replicas),
+             fmt::format("{:.4f} +- {}", p.w_m_s * 1e3, mm(p.error.error_m_s)), std::to_string(p.n_replicas),
              p.n_replicas >= 2 ? mm(p.between_replica_stderr_m_s) : "-", mm(p.mean_within_run_stderr_m_s), r,
-             p.error_method, p.setting});
+             p.error.basis.empty() ? "-" : p.error.basis, p.setting});
     }
     s = t.str();
   }
@@ -119,7 +124,7 @@ plot::Plot curve_plot(const std::vector<CurvePoint>& pts, const std::string& tit
       // Left: <<w_p>> in mm/s; right: r_acc (dimensionless).
       auto value = [&](const CurvePoint& p) -> std::optional<std::pair<double, double>> {
         // An unknown error draws no bar.
-        if (panel == 0) return std::pair{p.w_m_s * 1e3, p.w_err_m_s.value_or(0.0) * 1e3};
+        if (panel == 0) return std::pair{p.w_m_s * 1e3, p.error.error_m_s.value_or(0.0) * 1e3};
         if (!p.r_acc) return std::nullopt;
         return std::pair{*p.r_acc, p.r_acc_err.value_or(0.0)};
       };
@@ -211,9 +216,12 @@ plot::Plot curve_plot(const std::vector<CurvePoint>& pts, const std::string& tit
         }
       }
     }
-    if (std::any_of(pts.begin(), pts.end(), [](const CurvePoint& p) { return p.n_replicas > 1; }))
-      c.text(500, 436, "faint dots: replicas (seeds); error bars: their standard error of the mean",
-             Anchor::kMiddle, 11, "#555");
+    c.text(500, 436,
+           std::any_of(pts.begin(), pts.end(), [](const CurvePoint& p) { return p.n_replicas > 1; })
+               ? "error bars: the interval that covers the mean ~68 % of the time (Student's t); faint dots: "
+                 "replicas (seeds)"
+               : "error bars: the interval that covers the mean ~68 % of the time (Student's t)",
+           Anchor::kMiddle, 11, "#555");
   });
 }
 

@@ -6,6 +6,7 @@
 #include <map>
 #include <string>
 
+#include "driver/point_error.hpp"
 #include "driver/store.hpp"
 
 namespace boycott::driver {
@@ -28,27 +29,28 @@ ReplicaRound next_replica_round(Database& db, const Study& s) {
     const auto& reps = replicas[point];
     const auto plan = s.replica_plans.find(reps.front()->group);
     if (plan == s.replica_plans.end() || !plan->second.target_rel_error) continue;
-    std::vector<double> w;
-    for (const auto* c : reps)
-      if (const auto v = result_settling_velocity(db, c->id)) w.push_back(*v);
-    if (w.size() < reps.size()) {
+    // Stein's two-stage rule (driver/point_error.hpp): the first plan.replicas replicas decide how
+    // many the point needs, all of them added in one round.
+    std::vector<double> stage_one;
+    bool all_done = true;
+    for (const auto* c : reps) {
+      const auto v = result_settling_velocity(db, c->id);
+      if (!v) all_done = false;
+      if (v && c->replica < plan->second.replicas) stage_one.push_back(*v);
+    }
+    if (!all_done || static_cast<int>(stage_one.size()) < plan->second.replicas) {
       ++round.waiting;
       continue;
     }
-    const double n = static_cast<double>(w.size());
-    double rel = std::numeric_limits<double>::infinity();
-    if (w.size() >= 2) {
-      double mean = 0.0, ss = 0.0;
-      for (double x : w) mean += x / n;
-      for (double x : w) ss += (x - mean) * (x - mean);
-      rel = std::sqrt(ss / (n - 1.0)) / std::sqrt(n) / std::abs(mean);
-    }
-    if (rel <= *plan->second.target_rel_error) {
-      ++round.precise;
-      continue;
-    }
-    if (static_cast<int>(reps.size()) >= plan->second.max) {
-      ++round.at_max;
+    const int needed = stein_replicas_needed(stage_one, *plan->second.target_rel_error, plan->second.max);
+    const int have = static_cast<int>(reps.size());
+    if (have >= needed) {
+      // Needed more than replicas_max allows: at the limit, above the target.
+      if (needed == plan->second.max &&
+          stein_replicas_needed(stage_one, *plan->second.target_rel_error, plan->second.max + 1) > needed)
+        ++round.at_max;
+      else
+        ++round.precise;
       continue;
     }
     const StudyCase* first = nullptr;
@@ -57,7 +59,7 @@ ReplicaRound next_replica_round(Database& db, const Study& s) {
       if (c->replica == 0) first = c;
       next = std::max(next, c->replica + 1);
     }
-    if (first) round.added.push_back(replica_of(*first, next));
+    for (int k = have; first && k < needed; ++k) round.added.push_back(replica_of(*first, next++));
   }
   return round;
 }

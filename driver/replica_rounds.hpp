@@ -1,10 +1,10 @@
 #pragma once
-// `study run`'s rounds of replicas (study keys replicas_target_rel_error and replicas_max): when a
-// round has run, each point of a group with a target whose replicas all have a result, whose
-// between-replica standard error is above the target fraction of |<<w_p>>|, and which has fewer
-// than replicas_max replicas gets one more replica (seed + N); the study runs those and looks
-// again, until no point needs one. Seeds are deterministic, so a rerun of `study run` finds the
-// replicas of earlier rounds done and ends where the first run ended.
+// `study run`'s rounds of replicas (study keys replicas_target_rel_error and replicas_max), by
+// Stein's two-stage rule (driver/point_error.hpp): every point of a group with a target starts
+// with `replicas` (at least 3); once those have results, their scatter fixes how many replicas the
+// point needs to meet the target with an error that covers ~68 %, at most replicas_max, and the
+// next round adds them all. Seeds are deterministic, so a rerun of `study run` finds the replicas
+// of earlier rounds done and ends where the first run ended.
 #include <vector>
 
 #include "driver/database.hpp"
@@ -14,8 +14,8 @@ namespace boycott::driver {
 
 struct ReplicaRound {
   std::vector<StudyCase> added;  ///< the next round's new replicas
-  int precise = 0;               ///< points whose between-replica error meets the target
-  int at_max = 0;                ///< points above the target that have replicas_max replicas
+  int precise = 0;               ///< points that have the replicas the target needs
+  int at_max = 0;                ///< points that would need more than replicas_max
   int waiting = 0;               ///< points with a replica without a result (failed, or not run)
 };
 

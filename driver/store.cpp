@@ -294,13 +294,34 @@ std::vector<SweptValue> case_swept_values(Database& db, const std::string& case_
   return out;
 }
 
+namespace {
+
+// Group -> the replicas its adaptive plan starts with, from the study file as last run (a study
+// file an older build stored and this one refuses: none, the plain between-replica rule).
+std::map<std::string, int> adaptive_stage_one(Database& db, const std::string& study) {
+  std::map<std::string, int> out;
+  auto st = db.prepare("SELECT source_toml FROM studies WHERE name = ?1");
+  st.bind(1, study);
+  if (!st.step()) return out;
+  try {
+    const Study s = expand_study_string(st.text(0), study);
+    for (const auto& [grp, plan] : s.replica_plans)
+      if (plan.target_rel_error) out[grp] = plan.replicas;
+  } catch (const std::exception&) {
+  }
+  return out;
+}
+
+}  // namespace
+
 std::vector<CurvePoint> query_curve(Database& db, const std::string& study, const std::string& group) {
   // Runs whose summary names no error method predate the autocorrelation estimate: batch means.
   auto st = db.prepare(
       "SELECT sc.group_name, c.id, c.angle_deg, r.mean_settling_velocity_m_s, "
       "r.settling_velocity_stderr_m_s, "
       " MIN(sc.position) AS pos, "
-      " COALESCE(json_extract(r.summary_json, '$.settling_velocity_error_method'), 'batch_means') "
+      " COALESCE(json_extract(r.summary_json, '$.settling_velocity_error_method'), 'batch_means'), "
+      " json_extract(r.summary_json, '$.settling_velocity_error_dof') "
       "FROM study_cases sc JOIN cases c ON c.id = sc.case_id "
       "JOIN results r ON r.case_id = c.id WHERE sc.study = ?1 AND (?2 = '' OR sc.group_name = ?2) "
       "AND r.mean_settling_velocity_m_s IS NOT NULL GROUP BY sc.group_name, c.id");
@@ -316,6 +337,7 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
     p.w_m_s = st.real(3);
     if (!st.is_null(4)) p.w_err_m_s = st.real(4);
     p.error_method = st.text(6);
+    if (!st.is_null(7)) p.run_dof = st.real(7);
     auto& gp = group_pos.try_emplace(p.group, st.integer(5)).first->second;
     gp = std::min(gp, st.integer(5));
     setting_pos.emplace_back(st.integer(5));
@@ -358,6 +380,8 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
     if (a.angle_deg != b.angle_deg) return a.angle_deg < b.angle_deg;
     return setting_pos[i] < setting_pos[j];  // replicas in study order
   });
+  // The replicas an adaptive group starts with, for Stein's two-stage error (driver/point_error.hpp).
+  const std::map<std::string, int> stage_one = adaptive_stage_one(db, study);
   // Replicas of one point (adjacent now) become one point.
   std::vector<CurvePoint> merged;
   for (std::size_t k = 0; k < order.size();) {
@@ -383,6 +407,13 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
     }
     const double n = static_cast<double>(p.n_replicas);
     p.w_m_s = p.n_replicas == 1 ? first.w_m_s : sum / n;
+    std::vector<RunEstimate> runs;
+    for (std::size_t m = k; m < end; ++m) {
+      const CurvePoint& r = pts[order[m]];
+      runs.push_back({r.w_m_s, r.w_err_m_s, r.run_dof});
+    }
+    const auto stage = stage_one.find(p.group);
+    p.error = point_error(runs, stage == stage_one.end() ? 0 : stage->second);
     if (all_errors) p.mean_within_run_stderr_m_s = p.n_replicas == 1 ? *first.w_err_m_s : err_sum / n;
     if (p.n_replicas >= 2) {
       double ss = 0.0;
@@ -394,8 +425,7 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
     k = end;
   }
   pts = std::move(merged);
-  // r_acc = w / w90 with first-order error propagation of independent standard errors (the
-  // replicas' scatter where there are replicas).
+  // r_acc = w / w90 with its covering error from the two points' (driver/point_error.hpp).
   for (auto& p : pts) {
     const CurvePoint* ref = nullptr;
     for (const auto& q : pts)
@@ -406,10 +436,8 @@ std::vector<CurvePoint> query_curve(Database& db, const std::string& study, cons
     // At 90 deg itself the ratio is exactly 1 (the same number over itself).
     if (&p == ref || p.case_id == ref->case_id) {
       p.r_acc_err = 0.0;
-    } else if (p.w_err_m_s && ref->w_err_m_s) {
-      const double rel_p = p.w_m_s != 0.0 ? *p.w_err_m_s / p.w_m_s : 0.0;
-      const double rel_ref = *ref->w_err_m_s / ref->w_m_s;
-      p.r_acc_err = std::abs(r) * std::hypot(rel_p, rel_ref);
+    } else {
+      p.r_acc_err = ratio_error(p.w_m_s, p.error, ref->w_m_s, ref->error);
     }
   }
   return pts;

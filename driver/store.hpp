@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "driver/database.hpp"
+#include "driver/point_error.hpp"
 #include "driver/study.hpp"
 
 namespace boycott::driver {
@@ -72,8 +73,13 @@ struct CurvePoint {
   /// How the runs estimated their own errors (summary.json's settling_velocity_error_method;
   /// "batch_means" for runs that predate it), "mixed" when the replicas differ.
   std::string error_method;
-  /// <<w_p>>/<<w_p>>(90 deg), unset without a 90 deg case; its error unset when an error it
-  /// depends on is.
+  /// The covering error of w_m_s (error_m_s, about 68 % for any number of replicas) and what it
+  /// rests on (error_basis); driver/point_error.hpp.
+  PointError error;
+  /// A single run's degrees of freedom of its error (summary.json settling_velocity_error_dof).
+  std::optional<double> run_dof;
+  /// <<w_p>>/<<w_p>>(90 deg), unset without a 90 deg case; its covering error, from the two
+  /// points' errors, unset when an error it depends on is.
   std::optional<double> r_acc, r_acc_err;
 };
 

@@ -160,8 +160,9 @@ ReplicaPlan resolve_replicas(const ReplicaKeys& study, const ReplicaKeys& group,
     plan.max = plan.replicas;
     return plan;
   }
-  // A between-replica error needs two replicas.
-  plan.replicas = std::max(plan.replicas, 2);
+  // Stein's first stage: a scatter from fewer than 3 numbers leaves the t factor at 1.84 and
+  // its own size so uncertain that the stage would decide little (driver/point_error.hpp).
+  plan.replicas = std::max(plan.replicas, ReplicaPlan::kStageOneMin);
   plan.max = static_cast<int>(max.value_or(std::max(ReplicaPlan::kDefaultReplicasMax, plan.replicas)));
   if (plan.max < plan.replicas)
     throw InputError(fmt::format("{}: replicas_max = {} is below the {} replicas every point starts with",

@@ -33,6 +33,7 @@ struct ReplicaPlan {
   std::optional<double> target_rel_error;
   int max = 1;  ///< replicas_max (default kDefaultReplicasMax with a target, else replicas)
   static constexpr int kDefaultReplicasMax = 10;
+  static constexpr int kStageOneMin = 3;  ///< replicas an adaptive point starts with, at least
 };
 
 struct Study {

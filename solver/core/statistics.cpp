@@ -1,5 +1,7 @@
 #include "core/statistics.hpp"
 
+#include "core/distributions.hpp"
+
 #include <cmath>
 #include <limits>
 
@@ -47,7 +49,8 @@ AutocorrelationError autocorrelation_error(const std::vector<double>& x) {
   double sum = 0.0;
   for (double v : x) sum += v;
   e.mean = n ? sum / static_cast<double>(n) : kNaN;
-  e.stderr_of_mean = e.tau_int = e.tau_int_upper = e.effective_samples = e.correlation_times = kNaN;
+  e.stderr_of_mean = e.tau_int = e.tau_int_upper = e.effective_samples = e.correlation_times = e.dof =
+      e.covering_error = kNaN;
   if (n < 8) return e;
   const double N = static_cast<double>(n);
   std::vector<double> y(n);
@@ -59,7 +62,8 @@ AutocorrelationError autocorrelation_error(const std::vector<double>& x) {
   };
   const double c0 = autocov(0);
   if (!(c0 > 0.0)) {  // a constant series: its mean is exact
-    e.stderr_of_mean = 0.0;
+    e.stderr_of_mean = e.covering_error = 0.0;
+    e.dof = std::numeric_limits<double>::infinity();
     e.tau_int = e.tau_int_upper = 0.5;
     e.effective_samples = N;
     e.correlation_times = std::numeric_limits<double>::infinity();
@@ -87,7 +91,11 @@ AutocorrelationError autocorrelation_error(const std::vector<double>& x) {
   e.tau_int_upper = e.tau_int * (1.0 + std::sqrt(2.0 * (2.0 * static_cast<double>(M) + 1.0) / N));
   e.effective_samples = N / (2.0 * e.tau_int);
   e.correlation_times = N / e.tau_int_upper;
-  if (e.correlation_times >= AE::kMinCorrelationTimes) e.stderr_of_mean = std::sqrt(V);
+  e.dof = N / (2.0 * static_cast<double>(M) + 1.0);
+  if (e.correlation_times >= AE::kMinCorrelationTimes) {
+    e.stderr_of_mean = std::sqrt(V);
+    e.covering_error = e.stderr_of_mean * one_sigma_t_factor(e.dof);
+  }
   return e;
 }
 

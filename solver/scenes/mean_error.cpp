@@ -34,6 +34,8 @@ void report_window_error(nlohmann::json& j, const std::string& prefix, const std
   const auto& e = w.e;
   auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   j[prefix + "stderr_m_s"] = num(e.stderr_of_mean);
+  j[prefix + "error_m_s"] = num(e.covering_error);
+  j[prefix + "error_dof"] = num(e.dof);
   j[prefix + "correlation_time_s"] = num(w.correlation_time_s());
   j[prefix + "correlation_time_upper_s"] = num(w.correlation_time_upper_s());
   j[prefix + "effective_samples"] = num(e.effective_samples);

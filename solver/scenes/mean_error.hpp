@@ -23,7 +23,8 @@ struct WindowError {
 };
 WindowError window_error(const std::vector<double>& series, double window_from_s, double now_s);
 
-/// The summary keys of a time average's error, `prefix` + stderr_m_s, correlation_time_s,
+/// The summary keys of a time average's error, `prefix` + stderr_m_s, error_m_s (the covering
+/// half-width, AutocorrelationError::covering_error), error_dof, correlation_time_s,
 /// correlation_time_upper_s, effective_samples, window_correlation_times, error_method
 /// ("sokal_autocorrelation"); null where not available. With `warn` (a finished run), a warning
 /// goes to j["warnings"] and stderr when the window holds fewer than ~20 correlation times,

@@ -51,6 +51,18 @@ assert len(curve) == 3, curve
 table = {float(r["angle_deg"]): r for r in csv.DictReader(open(work / "curve.csv"))}
 def close(a, b, rel=1e-12):
     assert abs(a - b) <= rel * abs(b), (a, b)
+def t_cdf(t, nu, steps=20000):
+    # Student's t density integrated from 0 to t (Simpson), written out independently of the product.
+    c = math.exp(math.lgamma((nu + 1) / 2) - math.lgamma(nu / 2)) / math.sqrt(nu * math.pi)
+    f = lambda x: c * (1 + x * x / nu) ** (-(nu + 1) / 2)
+    h = t / steps
+    return 0.5 + h / 3 * sum((1 if k in (0, steps) else 4 if k % 2 else 2) * f(k * h) for k in range(steps + 1))
+def t68(nu):
+    lo, hi = 0.0, 10.0
+    for _ in range(60):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if t_cdf(mid, nu, 2000) < (1 + 0.682689492137086) / 2 else (lo, mid)
+    return (lo + hi) / 2
 w90, e90 = stats[90.0]["mean"], stats[90.0]["between"]
 for row in curve:
     s = stats[row["angle_deg"]]
@@ -59,6 +71,13 @@ for row in curve:
     close(row["mean_settling_velocity_m_s"], s["mean"])
     close(row["between_replica_stderr_m_s"], s["between"])
     close(row["stderr_m_s"], s["between"])
+    # The covering error: t at n - 1 = 2 degrees of freedom times sd/sqrt(n), or the larger pooled
+    # within-run error where the replicas' scatter and their own errors disagree (said in the basis).
+    if row["error_basis"] == "between_replicas_t":
+        close(row["error_m_s"], t68(2) * s["between"], 1e-6)
+    else:
+        assert row["error_basis"].startswith(("between_replicas_t; ", "within_runs_pooled; ")), row
+        assert row["error_m_s"] >= t68(2) * s["between"] * (1 - 1e-6), row
     close(row["mean_within_run_stderr_m_s"], s["within"])
     c = table[row["angle_deg"]]
     assert int(c["n_replicas"]) == 3
@@ -66,8 +85,12 @@ for row in curve:
     close(float(c["mean_within_run_stderr_m_s"]), s["within"], 1e-8)
     r = s["mean"] / w90
     close(row["r_acc"], r)
-    if row["angle_deg"] != 90.0:
-        close(row["r_acc_err"], abs(r) * math.hypot(s["between"] / s["mean"], e90 / w90), 1e-9)
+    plain = [x for x in curve if x["angle_deg"] == 90.0][0]["error_basis"] == "between_replicas_t"
+    if row["angle_deg"] != 90.0 and plain and row["error_basis"] == "between_replicas_t":
+        # Welch-Satterthwaite over the two points' sd/sqrt(n) (2 degrees of freedom each), then t.
+        a, b = s["between"] / w90, r * e90 / w90
+        nu = (a * a + b * b) ** 2 / (a ** 4 / 2 + b ** 4 / 2)
+        close(row["r_acc_err"], math.hypot(a, b) * t68(nu), 1e-6)
     print(f"angle {row['angle_deg']:g}: mean {s['mean']:.6g} m/s, between-replica error "
           f"{s['between']:.3g}, mean within-run error {s['within']:.3g}")
 print("curve matches the database rows")

@@ -326,17 +326,17 @@ TEST(StudyReplicas, RefusedWithASweptSeedOrAScenelessSeedOrBadCounts) {
       "set = { seed = 7 }\n"));
 }
 
-TEST(StudyReplicas, ATargetStartsWithTwoReplicasUpToTenByDefault) {
+TEST(StudyReplicas, ATargetStartsWithThreeReplicasUpToTenByDefault) {
   const auto s = bd::expand_study_string(
       "name = \"x\"\nreplicas_target_rel_error = 0.02\n[base.time]\nend = 2.0\naverage_from = 1.0\n"
       "[[group]]\nname = \"a\"\n[[group]]\nname = \"b\"\nreplicas_max = 4\nreplicas = 3\n"
       "set = { \"fluid.viscosity\" = 2e-3 }\n");
-  EXPECT_EQ(s.replica_plans.at("a").replicas, 2);
+  EXPECT_EQ(s.replica_plans.at("a").replicas, 3);
   EXPECT_EQ(s.replica_plans.at("a").max, 10);
   EXPECT_DOUBLE_EQ(*s.replica_plans.at("a").target_rel_error, 0.02);
   EXPECT_EQ(s.replica_plans.at("b").replicas, 3);
   EXPECT_EQ(s.replica_plans.at("b").max, 4);
-  EXPECT_EQ(s.cases.size(), 5u);
+  EXPECT_EQ(s.cases.size(), 6u);
   const auto r = bd::replica_of(s.cases[0], 7);
   EXPECT_EQ(r.params.seed, s.cases[0].params.seed + 7);
   EXPECT_EQ(r.point_id, s.cases[0].id);

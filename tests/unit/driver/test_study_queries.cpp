@@ -10,10 +10,12 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include "core/distributions.hpp"
 #include "core/error.hpp"
 #include "driver/curve.hpp"
 #include "driver/database.hpp"
 #include "driver/plot_cairo.hpp"
+#include "driver/replica_rounds.hpp"
 #include "driver/store.hpp"
 #include "driver/study.hpp"
 #include "driver/validation_query.hpp"
@@ -297,6 +299,8 @@ TEST(CurvePlot, DrawsBothPanelsWithErrorBarsReplicasAndThePaperOverlayAsSvgPdfAn
     p.angle_deg = angle;
     p.w_m_s = angle == 90.0 ? -0.02 : -0.03;
     p.w_err_m_s = 0.001;
+    p.error.error_m_s = 0.0013;
+    p.error.basis = "between_replicas_t";
     p.n_replicas = 3;
     p.replica_w_m_s = {p.w_m_s - 0.001, p.w_m_s, p.w_m_s + 0.001};
     p.r_acc = p.w_m_s / -0.02;
@@ -315,7 +319,9 @@ TEST(CurvePlot, DrawsBothPanelsWithErrorBarsReplicasAndThePaperOverlayAsSvgPdfAn
   EXPECT_EQ(plot.count("legend"), 2);    // the series and the paper
   EXPECT_TRUE(plot.has_text("study <s>"));
   EXPECT_TRUE(plot.has_text("inclination angle θ (deg)"));
-  EXPECT_TRUE(plot.has_text("faint dots: replicas (seeds); error bars: their standard error of the mean"));
+  EXPECT_TRUE(
+      plot.has_text("error bars: the interval that covers the mean ~68 % of the time (Student's t); faint "
+                    "dots: replicas (seeds)"));
 
   const auto pdf = bd::curve_plot(pts, "study <s>", &paper, bd::plot::format_of_path("c.PDF"));
   EXPECT_EQ(pdf.data.rfind("%PDF-", 0), 0u);
@@ -507,4 +513,46 @@ TEST(CurveQuery, CsvQuotesAGroupOrSettingThatHoldsACommaQuoteOrLineBreak) {
   EXPECT_NE(csv.find("\n\"a,b\",65,"), std::string::npos) << csv;
   EXPECT_NE(csv.find("\n\"line\nbreak \"\"quoted\"\"\",65,"), std::string::npos) << csv;
   EXPECT_NE(csv.find(",\"domain.cells=[20, 6, 20]\"\n"), std::string::npos) << csv;
+}
+
+TEST(ReplicaRounds, AdaptivePointsRunWhatSteinsFirstStageAsksForInOneRoundAndReportItsError) {
+  // Target 1 % of |<<w_p>>|; the first three replicas -0.100, -0.102, -0.098 (sd 0.002): Stein
+  // needs t_2 sd / sqrt(n) <= 0.001, n >= (1.3213 * 2)^2 = 6.98, so 7 replicas, 4 added at once.
+  TempDir tmp;
+  bd::Database db((tmp.path / "a.db").string(), bd::OpenMode::kCreate);
+  const std::string text = R"(
+name = "adapt"
+replicas_target_rel_error = 0.01
+[base.time]
+end = 2.0
+average_from = 1.0
+[matrix]
+"gravity.angle_deg" = [90]
+)";
+  auto study = bd::expand_study_string(text);
+  ASSERT_EQ(study.cases.size(), 3u);
+  bd::register_study(db, study);
+  const double first[] = {-0.100, -0.102, -0.098};
+  for (const auto& c : study.cases)
+    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id,
+                      summary_of(c, {first[c.replica], 0.0, 1.0}));
+  auto round = bd::next_replica_round(db, study);
+  ASSERT_EQ(round.added.size(), 4u);
+  EXPECT_EQ(round.added.back().replica, 6);
+  // The added replicas run (any values: the stage-one scatter fixed their number) and are
+  // registered as study run registers them; the next round adds none.
+  for (const auto& c : round.added) study.cases.push_back(c);
+  bd::register_study(db, study);
+  for (const auto& c : round.added)
+    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id,
+                      summary_of(c, {-0.1 + 0.003 * (c.replica - 4), 0.0, 1.0}));
+  round = bd::next_replica_round(db, study);
+  EXPECT_TRUE(round.added.empty());
+  EXPECT_EQ(round.precise, 1);
+  // The curve reports Stein's error: t_2 s0 / sqrt(7), s0 from the first three alone.
+  const auto pts = bd::query_curve(db, "adapt");
+  ASSERT_EQ(pts.size(), 1u);
+  EXPECT_EQ(pts[0].n_replicas, 7);
+  EXPECT_EQ(pts[0].error.basis, "two_stage_stein");
+  EXPECT_NEAR(*pts[0].error.error_m_s, boycott::one_sigma_t_factor(2.0) * 0.002 / std::sqrt(7.0), 1e-12);
 }

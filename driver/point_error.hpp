@@ -1,0 +1,56 @@
+#pragma once
+// The error bar of a curve point and of r_acc: a half-width that covers the true value about 68 %
+// of the time (core/distributions.hpp: kOneSigmaCoverage) however few numbers it rests on.
+//
+// - One run: its own covering error (summary.json settling_velocity_error_m_s: the standard error
+//   from the autocorrelation times Student's t at that estimate's degrees of freedom).
+// - n >= 2 replicas: t_{n-1} s / sqrt(n) (s: the replicas' sample standard deviation); where every
+//   replica states its own error, a chi-square test of the scatter against those errors: when the
+//   two disagree (two-sided, 5 %), the larger of the between-replica and the pooled within-run
+//   error is shown and the basis says so.
+// - Adaptive replicas (replicas_target_rel_error): Stein's two-stage rule (C. Stein, Ann. Math.
+//   Stat. 16, 243 (1945)): the first n0 replicas' s0 fixes how many replicas the point needs, n,
+//   and the error is t_{n0-1} s0 / sqrt(n), which covers exactly whatever n s0 led to; the plain
+//   t_{n-1} s / sqrt(n) after a stop that s itself decided covers less (0.63 at a target that needs
+//   8 replicas).
+// - r_acc = w / w90: first-order propagation of the two points' variances with the
+//   Welch-Satterthwaite degrees of freedom, then Student's t at those.
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace boycott::driver {
+
+/// One run's <<w_p>> and its error, as the database holds it.
+struct RunEstimate {
+  double w_m_s = 0.0;
+  std::optional<double> stderr_m_s;  ///< plain standard error (settling_velocity_stderr_m_s)
+  std::optional<double> dof;         ///< its degrees of freedom (settling_velocity_error_dof)
+};
+
+/// A point's covering error and what it rests on.
+struct PointError {
+  std::optional<double> error_m_s;  ///< half-width covering ~68 %; unset: none available
+  /// between_replicas_t, two_stage_stein, within_runs_pooled, single_run, or for runs of builds
+  /// that recorded no degrees of freedom single_run_plain (the plain standard error); with
+  /// "; ..." when the replicas' scatter and their own errors disagree.
+  std::string basis;
+  /// The plain standard error and its degrees of freedom (for r_acc's propagation).
+  std::optional<double> plain_m_s;
+  double dof = 0.0;
+};
+
+/// The covering error of the mean of `runs` (replicas of one point, in study order).
+/// `stage_one`: the replicas an adaptive plan starts with (0: not adaptive). At least 2 is
+/// needed for Stein's rule; with fewer runs than that the plain between-replica rule applies.
+PointError point_error(const std::vector<RunEstimate>& runs, int stage_one = 0);
+
+/// The covering error of r = w / w90 from the two points' plain errors and degrees of freedom
+/// (independent points). Unset when either has none.
+std::optional<double> ratio_error(double w, const PointError& e, double w90, const PointError& e90);
+
+/// The replicas an adaptive point needs under Stein's rule: the smallest n >= stage-one count
+/// with t_{n0-1} s0 / sqrt(n) <= target |mean0|, at most `max` (from its first replicas).
+int stein_replicas_needed(const std::vector<double>& stage_one_w, double target_rel_error, int max);
+
+}  // namespace boycott::driver

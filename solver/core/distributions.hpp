@@ -1,0 +1,27 @@
+#pragma once
+// The two sampling distributions an error bar needs: Student's t (the mean of a few numbers over
+// their own scatter) and chi-square (a scatter against stated errors). Regularised incomplete beta
+// and gamma functions by their continued fractions and series (Abramowitz & Stegun 26.5.8,
+// 6.5.29, 6.5.31), evaluated with the modified Lentz method (Thompson & Barnett, J. Comput. Phys.
+// 64, 490 (1986)).
+
+namespace boycott {
+
+/// The probability inside +-1 standard deviation of a normal distribution, 0.6827: the coverage
+/// an error bar of one standard error promises.
+inline constexpr double kOneSigmaCoverage = 0.682689492137086;
+
+/// P(T <= t) for Student's t with nu > 0 degrees of freedom (nu need not be whole).
+double student_t_cdf(double t, double nu);
+/// The p-quantile of Student's t with nu > 0 degrees of freedom (p in (0, 1)); infinite nu:
+/// the normal quantile.
+double student_t_quantile(double p, double nu);
+/// The factor turning a standard error with nu degrees of freedom into a half-width that covers
+/// kOneSigmaCoverage: the t quantile at (1 + 0.6827)/2 (1.84 at nu = 1, 1.32 at 2, 1.05 at 10,
+/// 1 as nu grows).
+double one_sigma_t_factor(double nu);
+
+/// P(X <= x) for chi-square with k > 0 degrees of freedom.
+double chi_square_cdf(double x, double k);
+
+}  // namespace boycott

@@ -1,0 +1,213 @@
+// Whether the error bars keep their promise: over many simulated studies with a fixed seed, the
+// stated interval holds the true value about 68 % of the time (binomial standard error of the
+// coverage at 10 000 studies: 0.005). The series are AR(1) with a known integrated
+// autocorrelation time tau_int of 10 steps, started from the stationary distribution (no
+// transient), true mean 0; the product's own rules make the intervals (core/statistics.hpp,
+// core/distributions.hpp, driver/point_error.hpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include "core/distributions.hpp"
+#include "core/statistics.hpp"
+#include "driver/point_error.hpp"
+
+using namespace boycott;
+namespace bd = boycott::driver;
+
+namespace {
+
+constexpr double kTau = 10.0;  // tau_int in steps
+
+// AR(1) with unit stationary variance and tau_int = (1 + phi) / (2 (1 - phi)).
+class Ar1 {
+ public:
+  Ar1(double tau_int, std::uint64_t seed)
+      : phi_((2.0 * tau_int - 1.0) / (2.0 * tau_int + 1.0)), rng_(seed), sd_(std::sqrt(1.0 - phi_ * phi_)) {}
+  std::vector<double> series(std::size_t n) {
+    std::vector<double> x(n);
+    double v = g_(rng_);
+    for (auto& xi : x) xi = v = phi_ * v + sd_ * g_(rng_);
+    return x;
+  }
+  double mean_of(std::size_t n) {
+    double s = 0.0, v = g_(rng_);
+    for (std::size_t i = 0; i < n; ++i) s += v = phi_ * v + sd_ * g_(rng_);
+    return s / static_cast<double>(n);
+  }
+
+ private:
+  double phi_;
+  std::mt19937_64 rng_;
+  double sd_;
+  std::normal_distribution<double> g_{0.0, 1.0};
+};
+
+// The replica means of one point: series of 50 correlation times each, scaled to spread `scale`
+// times 0.2 around `mean`.
+std::vector<bd::RunEstimate> replicas(Ar1& ar, int n, double mean = -1.0, double scale = 1.0) {
+  std::vector<bd::RunEstimate> r(n);
+  for (auto& x : r) x.w_m_s = mean + scale * ar.mean_of(static_cast<std::size_t>(50 * kTau));
+  return r;
+}
+
+}  // namespace
+
+TEST(Distributions, StudentTAndChiSquareMatchTabulatedValues) {
+  // The 68.27 % two-sided points of GUM (JCGM 100:2008) Table G.2, to its two decimals.
+  const std::pair<double, double> gum[] = {{1, 1.84}, {2, 1.32},  {3, 1.20},  {4, 1.14},
+                                           {5, 1.11}, {10, 1.05}, {20, 1.03}, {50, 1.01}};
+  for (const auto& [nu, t] : gum) EXPECT_NEAR(one_sigma_t_factor(nu), t, 0.005) << nu;
+  EXPECT_NEAR(one_sigma_t_factor(INFINITY), 1.0, 1e-9);
+  EXPECT_NEAR(student_t_quantile(0.975, 10.0), 2.2281, 1e-4);
+  EXPECT_NEAR(student_t_quantile(0.025, 4.0), -2.7764, 1e-4);
+  // Degrees of freedom need not be whole (Welch-Satterthwaite): monotone between, and the cdf
+  // inverts the quantile.
+  EXPECT_LT(student_t_quantile(0.975, 3.0), student_t_quantile(0.975, 2.5));
+  EXPECT_LT(student_t_quantile(0.975, 2.5), student_t_quantile(0.975, 2.0));
+  EXPECT_NEAR(student_t_cdf(student_t_quantile(0.9, 2.5), 2.5), 0.9, 1e-12);
+  EXPECT_NEAR(chi_square_cdf(3.8415, 1.0), 0.95, 1e-4);
+  EXPECT_NEAR(chi_square_cdf(18.307, 10.0), 0.95, 1e-4);
+  EXPECT_NEAR(chi_square_cdf(0.0506, 2.0), 0.025, 1e-4);
+  EXPECT_NEAR(chi_square_cdf(60.0, 60.0), 0.5243, 1e-3);
+}
+
+TEST(ErrorCoverage, BetweenReplicaErrorCoversTwoThirdsAtTwoThreeFourAndTenReplicas) {
+  for (int n : {2, 3, 4, 10}) {
+    Ar1 ar(kTau, 1000 + n);
+    const int studies = 10000;
+    int covered = 0;
+    for (int s = 0; s < studies; ++s) {
+      const auto runs = replicas(ar, n);
+      const auto e = bd::point_error(runs);
+      double mean = 0.0;
+      for (const auto& r : runs) mean += r.w_m_s / n;
+      ASSERT_TRUE(e.error_m_s);
+      EXPECT_EQ(e.basis, "between_replicas_t");
+      covered += std::abs(mean + 1.0) <= *e.error_m_s;
+    }
+    const double c = static_cast<double>(covered) / studies;
+    std::printf("coverage, between replicas, %d replicas: %.4f\n", n, c);
+    EXPECT_GE(c, 0.66) << n << " replicas";
+    EXPECT_LE(c, 0.705) << n << " replicas";
+  }
+}
+
+TEST(ErrorCoverage, AdaptiveReplicasCoverTwoThirdsAtTargetsThatNeedThreeFourAndEight) {
+  // The spread of one replica's mean at 50 tau_int: sqrt(2 tau / N) = 0.2 around -1 (the
+  // product's points scatter by 0.5-5 % of |<<w_p>>|; here 20 % keeps the test short). Targets
+  // where Stein's rule needs 3, 4 and 8 replicas for the typical first-stage scatter.
+  const double sd = std::sqrt(2.0 * kTau / (50.0 * kTau));
+  for (int needed : {3, 4, 8}) {
+    const double target = one_sigma_t_factor(2.0) * sd / std::sqrt(static_cast<double>(needed));
+    Ar1 ar(kTau, 2000 + needed);
+    const int studies = 10000;
+    int covered = 0;
+    double replicas_run = 0.0;
+    for (int s = 0; s < studies; ++s) {
+      auto runs = replicas(ar, 3);
+      std::vector<double> stage_one;
+      for (const auto& r : runs) stage_one.push_back(r.w_m_s);
+      const int n = bd::stein_replicas_needed(stage_one, target, 10);
+      const auto more = replicas(ar, n - 3);
+      runs.insert(runs.end(), more.begin(), more.end());
+      const auto e = bd::point_error(runs, 3);
+      ASSERT_TRUE(e.error_m_s);
+      EXPECT_EQ(e.basis, "two_stage_stein");
+      double mean = 0.0;
+      for (const auto& r : runs) mean += r.w_m_s / n;
+      covered += std::abs(mean + 1.0) <= *e.error_m_s;
+      replicas_run += static_cast<double>(n) / studies;
+    }
+    const double c = static_cast<double>(covered) / studies;
+    std::printf("coverage, adaptive replicas, target needing %d: %.4f (mean replicas %.2f)\n", needed, c,
+                replicas_run);
+    EXPECT_GE(c, 0.66) << "target needing " << needed << " (mean replicas " << replicas_run << ")";
+    EXPECT_LE(c, 0.705) << "target needing " << needed << " (mean replicas " << replicas_run << ")";
+  }
+}
+
+TEST(ErrorCoverage, AccelerationRatioOfTwoIndependentPointsCoversTwoThirds) {
+  // r = w / w90 from two points of n replicas each (Welch-Satterthwaite, then t), each replica
+  // 2 % of |w| apart (as the product's points: 0.5-5 %). Welch-Satterthwaite errs on the safe
+  // side at the smallest degrees of freedom: 0.74 at 2 replicas, 0.71 at 3 (docs/validation.md).
+  for (int n : {2, 3, 4, 10}) {
+    Ar1 ar(kTau, 3000 + n);
+    const double w_true = -0.2, w90_true = -0.1;
+    const int studies = 10000;
+    int covered = 0;
+    for (int s = 0; s < studies; ++s) {
+      const auto a = replicas(ar, n, w_true, 0.02), b = replicas(ar, n, w90_true, 0.01);
+      double wa = 0.0, wb = 0.0;
+      for (const auto& r : a) wa += r.w_m_s / n;
+      for (const auto& r : b) wb += r.w_m_s / n;
+      const auto err = bd::ratio_error(wa, bd::point_error(a), wb, bd::point_error(b));
+      ASSERT_TRUE(err);
+      covered += std::abs(wa / wb - w_true / w90_true) <= *err;
+    }
+    const double c = static_cast<double>(covered) / studies;
+    std::printf("coverage, r_acc, %d replicas per point: %.4f\n", n, c);
+    EXPECT_GE(c, 0.66) << n << " replicas";
+    if (n >= 4) {
+      EXPECT_LE(c, 0.705) << n << " replicas";
+    }
+  }
+}
+
+TEST(ErrorCoverage, SingleRunErrorCoversTwoThirdsAt20CorrelationTimesAndAtLeastThatAt100) {
+  // One run's covering error: Sokal's standard error times t at N / (2M + 1) degrees of freedom.
+  // At 20 tau_int it keeps the promise; at 100 it errs on the safe side (0.72-0.73, the plain
+  // standard error covers 0.69 there); at 10 it still falls short (0.58, docs/validation.md).
+  for (double window : {20.0, 100.0}) {
+    Ar1 ar(kTau, 4000 + static_cast<int>(window));
+    const int series = 10000;
+    int covered = 0, reported = 0;
+    for (int s = 0; s < series; ++s) {
+      const auto e = autocorrelation_error(ar.series(static_cast<std::size_t>(window * kTau)));
+      if (!std::isfinite(e.covering_error)) continue;
+      ++reported;
+      covered += std::abs(e.mean) <= e.covering_error;
+    }
+    const double c = static_cast<double>(covered) / reported;
+    std::printf("coverage, one run, %g tau_int: %.4f (reported for %.3f)\n", window, c,
+                static_cast<double>(reported) / series);
+    EXPECT_GE(c, 0.66) << window << " tau";
+    if (window == 20.0) {
+      EXPECT_LE(c, 0.705) << window << " tau";
+    }
+    EXPECT_GT(reported, series * 0.85) << window << " tau";
+  }
+}
+
+TEST(PointError, ReplicasThatScatterMoreThanTheirOwnErrorsShowTheLargerAndSaySo) {
+  // Three replicas 10 apart with own errors of 1: the scatter wins, and the basis says why.
+  std::vector<bd::RunEstimate> wide{{-10.0, 1.0, 50.0}, {0.0, 1.0, 50.0}, {10.0, 1.0, 50.0}};
+  auto e = bd::point_error(wide);
+  ASSERT_TRUE(e.error_m_s);
+  EXPECT_NEAR(*e.error_m_s, one_sigma_t_factor(2.0) * 10.0 / std::sqrt(3.0), 1e-12);
+  EXPECT_NE(e.basis.find("between_replicas_t; the replicas scatter more"), std::string::npos) << e.basis;
+  // Three replicas that agree to 0.01 with own errors of 1: the pooled within-run error.
+  std::vector<bd::RunEstimate> tight{{-1.0, 1.0, 50.0}, {-1.01, 1.0, 50.0}, {-0.99, 1.0, 50.0}};
+  e = bd::point_error(tight);
+  ASSERT_TRUE(e.error_m_s);
+  EXPECT_NEAR(*e.error_m_s, std::sqrt(3.0) / 3.0 * one_sigma_t_factor(150.0), 1e-9);
+  EXPECT_NE(e.basis.find("within_runs_pooled; the replicas agree more closely"), std::string::npos)
+      << e.basis;
+  // Consistent ones: the between-replica rule, plainly.
+  std::vector<bd::RunEstimate> fair{{-1.0, 1.0, 50.0}, {0.2, 1.0, 50.0}, {-2.1, 1.0, 50.0}};
+  EXPECT_EQ(bd::point_error(fair).basis, "between_replicas_t");
+}
+
+TEST(PointError, OneRunUsesItsOwnDegreesOfFreedomOrSaysItHasNone) {
+  auto e = bd::point_error({{-1.0, 0.1, 2.0}});
+  EXPECT_NEAR(*e.error_m_s, 0.1 * one_sigma_t_factor(2.0), 1e-12);
+  EXPECT_EQ(e.basis, "single_run");
+  e = bd::point_error({{-1.0, 0.1, std::nullopt}});  // a run of a build that stored no dof
+  EXPECT_DOUBLE_EQ(*e.error_m_s, 0.1);
+  EXPECT_EQ(e.basis, "single_run_plain");
+  EXPECT_FALSE(bd::point_error({{-1.0, std::nullopt, std::nullopt}}).error_m_s);
+}
