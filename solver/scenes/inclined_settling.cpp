@@ -250,8 +250,10 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   if (target.active()) {
     j["target_rel_error"] = p.time.target_rel_error;
     // Met: it stopped the run, or the whole window meets it at the end.
+    // Judged as the run judged it: on the covering error.
+    const double covering_rel = std::abs(wp_err.e.covering_error / sb.mean_settling_velocity_m_s);
     j["target_met"] = sb.status == kStatusConverged ||
-                      (wp_series_whole && rel < p.time.target_rel_error &&
+                      (wp_series_whole && covering_rel < p.time.target_rel_error &&
                        wp_err.e.correlation_times >= PrecisionTarget::kMinCorrelationTimes);
   }
   j["ranks"] = run.rank_report();

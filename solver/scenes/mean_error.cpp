@@ -69,7 +69,7 @@ bool PrecisionTarget::reached(const std::vector<double>& series, double window_f
   const auto n = static_cast<std::int64_t>(series.size());
   next_check_ = n + std::max<std::int64_t>(25, n / 50);
   const WindowError w = window_error(series, window_from_s, now_s);
-  const double rel = std::abs(w.e.stderr_of_mean / w.e.mean);
+  const double rel = std::abs(w.e.covering_error / w.e.mean);
   last_rel_error_ = rel;
   const bool met = std::isfinite(rel) && rel < target_ && w.e.correlation_times >= kMinCorrelationTimes;
   if (!met) {
@@ -77,7 +77,11 @@ bool PrecisionTarget::reached(const std::vector<double>& series, double window_f
     return false;
   }
   if (met_since_s_ < 0.0) met_since_s_ = now_s;
-  return now_s - met_since_s_ >= kConfirmCorrelationTimes * w.correlation_time_upper_s();
+  // A stop the estimate itself decides comes where the estimate dipped (tau under-estimated): the
+  // target must hold while a good part of the data changes, not only over a few correlation times.
+  const double confirm_s = std::max(kConfirmCorrelationTimes * w.correlation_time_upper_s(),
+                                    kConfirmWindowFraction * (met_since_s_ - window_from_s));
+  return now_s - met_since_s_ >= confirm_s;
 }
 
 }  // namespace boycott::scenes
