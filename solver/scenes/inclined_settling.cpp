@@ -135,18 +135,20 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       resumed.has_value(), next_out);
   auto write_checkpoint = [&] {
     ModelTimers::Scope sc(timers, "checkpoints");
+    // Everything summed over ranks is summed here, on every rank: the writer below runs on rank 0
+    // alone, and a collective inside it would wait for ranks that never enter it.
     const Histogram all_y = over_ranks(run, pdf_y), all_w = over_ranks(run, pdf_w);
+    std::vector<Histogram> all_budget;
+    if (budget)
+      for (const Histogram* h : budget->all()) all_budget.push_back(over_ranks(run, *h));
     checkpoint_coupled(run, ctx.out_dir, wall_before + clock.seconds(), [&](io::CheckpointWriter& w) {
       io::save(w, "stats.wp.", wp_avg);
       io::save(w, "stats.wf.", wf_avg);
       io::save(w, "stats.slurry.", slurry_avg);
       io::save(w, "stats.pdf_y.", all_y);
       io::save(w, "stats.pdf_w.", all_w);
-      if (budget) {
-        const auto h = budget->all();
-        for (std::size_t k = 0; k < h.size(); ++k)
-          io::save(w, fmt::format("stats.budget.{}.", k), over_ranks(run, *h[k]));
-      }
+      for (std::size_t k = 0; k < all_budget.size(); ++k)
+        io::save(w, fmt::format("stats.budget.{}.", k), all_budget[k]);
       w.put("stats.slurry_max", slurry_max);
       w.put("stats.next_out", out.next_out_s());
       w.put("stats.alpha_min_seen", alpha_min_seen);
