@@ -99,6 +99,47 @@ AutocorrelationError autocorrelation_error(const std::vector<double>& x) {
   return e;
 }
 
+TransientEnd transient_end(const std::vector<double>& x) {
+  TransientEnd best;
+  best.effective_samples = std::numeric_limits<double>::quiet_NaN();
+  const auto n = static_cast<std::int64_t>(x.size());
+  if (n < 16) return best;
+  const std::int64_t block = (n + TransientEnd::kMaxBlocks - 1) / TransientEnd::kMaxBlocks;
+  std::vector<double> b(static_cast<std::size_t>(n / block));
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    double s = 0.0;
+    for (std::int64_t k = 0; k < block; ++k) s += x[i * block + k];
+    b[i] = s / static_cast<double>(block);
+  }
+  const auto nb = static_cast<std::int64_t>(b.size());
+  for (int c = 0; c <= TransientEnd::kCandidates; ++c) {
+    const std::int64_t t0 = nb / 2 * c / TransientEnd::kCandidates;
+    const auto e = autocorrelation_error(std::vector<double>(b.begin() + t0, b.end()));
+    const double neff = e.effective_samples;
+    if (std::isfinite(neff) && !(neff <= best.effective_samples)) {
+      best.effective_samples = neff;
+      best.start = t0 * block;
+    }
+  }
+  return best;
+}
+
+bool transient_biases_mean(const std::vector<double>& x, std::int64_t from, std::int64_t start) {
+  if (start <= from) return false;
+  const auto tail = autocorrelation_error(std::vector<double>(x.begin() + start, x.end()));
+  if (!std::isfinite(tail.tau_int)) return false;
+  double head_mean = 0.0, tail_var = 0.0;
+  for (auto i = from; i < start; ++i) head_mean += x[i] / static_cast<double>(start - from);
+  for (auto i = static_cast<std::size_t>(start); i < x.size(); ++i)
+    tail_var += (x[i] - tail.mean) * (x[i] - tail.mean);
+  tail_var /= static_cast<double>(x.size() - static_cast<std::size_t>(start));
+  // Under the hypothesis that the head is more of the stationary part, its mean scatters with the
+  // tail's variance and correlation time (a trend in the head would inflate its own estimate).
+  const double head_samples = std::max(1.0, static_cast<double>(start - from) / (2.0 * tail.tau_int));
+  const double var_diff = tail_var / head_samples + tail.stderr_of_mean * tail.stderr_of_mean;
+  return std::abs(head_mean - tail.mean) > kTransientSignificance * std::sqrt(var_diff);
+}
+
 void Histogram::add(double x, double w) {
   total_ += w;
   if (!(x >= lo_ && x < hi_)) {

@@ -83,6 +83,8 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   // Every <w_p> sample of the window, for its error (20 s of 1 ms steps: 15 000 doubles).
   std::vector<double> wp_series;
   bool wp_series_whole = true;  // false after resuming a checkpoint of a build that kept none
+  // The samples before the window (the transient's detection) and the step lengths (s) of all.
+  StepSeries steps;
   PrecisionTarget target(p.time.target_rel_error);
   double slurry_max = 0.0, next_out = 0.0, wall_before = 0.0;  // next_out: the resumed output's, s
   // Stability record over the whole run (issue 7): alpha_f range and the largest kinetic energy.
@@ -111,6 +113,13 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
           alpha_min_seen = r.scalar("stats.alpha_min_seen");
           alpha_max_seen = r.scalar("stats.alpha_max_seen");
           ke_max_seen = r.scalar("stats.ke_max_seen");
+        }
+        if (r.has("stats.wp_before")) {
+          steps.before = r.doubles("stats.wp_before");
+          steps.before_dt = r.doubles("stats.wp_before_dt");
+          steps.window_dt = r.doubles("stats.wp_dt");
+        } else {
+          steps.before_whole = steps.dt_whole = false;
         }
         if (r.has("stats.wp_series")) {
           wp_series = r.doubles("stats.wp_series");
@@ -155,6 +164,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       w.put("stats.alpha_max_seen", alpha_max_seen);
       w.put("stats.ke_max_seen", ke_max_seen);
       w.put("stats.wp_series", wp_series);
+      w.put("stats.wp_before", steps.before);
+      w.put("stats.wp_before_dt", steps.before_dt);
+      w.put("stats.wp_dt", steps.window_dt);
       w.put("stats.target",
             std::vector<double>{static_cast<double>(target.next_check_), target.met_since_s_});
     });
@@ -175,6 +187,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     if (t > p.time.average_from_s + 1e-12) {
       wp_avg.add(wp);
       wp_series.push_back(wp);
+      steps.window_dt.push_back(st.dt_s);
       wf_avg.add(wf);
       slurry_avg.add(slurry);
       slurry_max = std::max(slurry_max, std::abs(slurry));
@@ -182,6 +195,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
         pdf_y.add(s.y[i]);
         pdf_w.add(s.vz[i]);
       }
+    } else {
+      steps.before.push_back(wp);
+      steps.before_dt.push_back(st.dt_s);
     }
     const auto row = [&]() -> std::vector<double> {
       return {t,
@@ -235,7 +251,11 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   auto j = make_summary(p, sb, timers);
   const bool finished = is_finished_status(sb.status);
   if (wp_series_whole) {
-    report_window_error(j, "settling_velocity_", "<w_p>", wp_err, finished);
+    const double transient_s =
+        report_transient(j, "<w_p>", steps, wp_series, p.time.average_from_s, finished);
+    report_window_error(j, "settling_velocity_", "<w_p>", wp_err, finished, transient_s);
+    report_time_weighted(j, "settling_velocity_", "<<w_p>>", wp_series, steps, wp_err.e.covering_error,
+                         finished);
   } else {
     j["settling_velocity_error_method"] = "batch_means";
     if (finished)

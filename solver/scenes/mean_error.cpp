@@ -15,6 +15,7 @@ namespace boycott::scenes {
 WindowError window_error(const std::vector<double>& series, double window_from_s, double now_s) {
   WindowError w;
   w.e = autocorrelation_error(series);
+  w.from_s = window_from_s;
   w.window_s = std::max(0.0, now_s - window_from_s);
   w.sample_s = series.empty() ? 0.0 : w.window_s / static_cast<double>(series.size());
   return w;
@@ -30,7 +31,7 @@ void add_warning(nlohmann::json& j, const std::string& text) {
 }
 
 void report_window_error(nlohmann::json& j, const std::string& prefix, const std::string& what,
-                         const WindowError& w, bool warn) {
+                         const WindowError& w, bool warn, double transient_end_s) {
   const auto& e = w.e;
   auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   j[prefix + "stderr_m_s"] = num(e.stderr_of_mean);
@@ -51,16 +52,89 @@ void report_window_error(nlohmann::json& j, const std::string& prefix, const std
   }
   if (!e.doubtful()) return;
   const bool na = !std::isfinite(e.stderr_of_mean);
+  std::string advice = "run longer or average from earlier";
+  if (std::isfinite(transient_end_s))
+    advice =
+        transient_end_s < w.from_s - 0.5 * w.sample_s
+            ? fmt::format("run longer, or average from {:.3g} s, where the detected start-up transient ends",
+                          transient_end_s)
+            : fmt::format(
+                  "run longer (the detected start-up transient ends at {:.3g} s: averaging from "
+                  "earlier would take it in)",
+                  transient_end_s);
   add_warning(
       j,
       fmt::format(
           "the averaging window ({:.4g} s) holds only {:.1f} correlation times of {} (tau_int "
-          "{:.3g} s, at most {:.3g} s{}); {}: run longer or average from earlier",
+          "{:.3g} s, at most {:.3g} s{}); {}: {}",
           w.window_s, e.correlation_times, what, w.correlation_time_s(), w.correlation_time_upper_s(),
           e.window_closed ? "" : ", the autocorrelation window did not close",
           na ? fmt::format("below {:g} its error is not reported", AutocorrelationError::kMinCorrelationTimes)
              : fmt::format("below {:g} its error is itself uncertain",
-                           AutocorrelationError::kWarnCorrelationTimes)));
+                           AutocorrelationError::kWarnCorrelationTimes),
+          advice));
+}
+
+double report_transient(nlohmann::json& j, const std::string& what, const StepSeries& s,
+                        const std::vector<double>& window, double window_from_s, bool warn) {
+  j["average_from_s"] = window_from_s;
+  std::vector<double> x(s.before);
+  x.insert(x.end(), window.begin(), window.end());
+  const TransientEnd cut = transient_end(x);
+  if (!std::isfinite(cut.effective_samples)) {
+    j["transient_end_s"] = nullptr;
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  // Sample k's time: counted back from the window's start through the steps before it, or on
+  // through the window's steps (their mean length where a resumed run lacks them).
+  const auto n_before = static_cast<std::int64_t>(s.before.size());
+  double t = window_from_s;
+  if (cut.start < n_before) {
+    for (std::int64_t k = n_before - 1; k >= cut.start; --k) t -= s.before_dt[static_cast<std::size_t>(k)];
+  } else {
+    const double mean_dt = window.empty() ? 0.0
+                                          : (j.value("simulated_time_s", window_from_s) - window_from_s) /
+                                                static_cast<double>(window.size());
+    for (std::int64_t k = n_before; k < cut.start; ++k) {
+      const auto i = static_cast<std::size_t>(k - n_before);
+      t += i < s.window_dt.size() ? s.window_dt[i] : mean_dt;
+    }
+  }
+  j["transient_end_s"] = t;
+  j["transient_detection_from_s"] = s.before_whole ? 0.0 : window_from_s - [&] {
+    double d = 0.0;
+    for (double v : s.before_dt) d += v;
+    return d;
+  }();
+  if (warn && cut.start > n_before && transient_biases_mean(x, n_before, cut.start))
+    add_warning(
+        j, fmt::format("the start-up transient of {} ends at {:.3g} s, after time.average_from = {:g} s, "
+                       "and the samples between shift the mean beyond their noise: average from {:.3g} s "
+                       "or later",
+                       what, t, window_from_s, t));
+  return t;
+}
+
+void report_time_weighted(nlohmann::json& j, const std::string& prefix, const std::string& what,
+                          const std::vector<double>& window, const StepSeries& s, double error, bool warn) {
+  const std::string key = prefix + "time_weighted_m_s";
+  if (!s.dt_whole || s.window_dt.size() != window.size() || window.empty()) {
+    j[key] = nullptr;
+    return;
+  }
+  double sum = 0.0, span = 0.0, plain = 0.0;
+  for (std::size_t i = 0; i < window.size(); ++i) {
+    sum += window[i] * s.window_dt[i];
+    span += s.window_dt[i];
+    plain += window[i] / static_cast<double>(window.size());
+  }
+  const double weighted = sum / span;
+  j[key] = weighted;
+  if (warn && std::isfinite(error) && std::abs(weighted - plain) > error)
+    add_warning(
+        j, fmt::format("the step length varied (CFL limit): the time-weighted mean of {} ({:.6g}) differs "
+                       "from the mean over steps ({:.6g}, Eq. 29) by more than its error ({:.3g})",
+                       what, weighted, plain, error));
 }
 
 bool PrecisionTarget::reached(const std::vector<double>& series, double window_from_s, double now_s) {

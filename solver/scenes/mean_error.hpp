@@ -16,6 +16,7 @@ namespace boycott::scenes {
 /// The error of the mean of `series`, the per-step samples over [window_from_s, now_s].
 struct WindowError {
   AutocorrelationError e;
+  double from_s = 0.0;    ///< window_from_s
   double window_s = 0.0;  ///< now_s - window_from_s
   double sample_s = 0.0;  ///< window_s / samples, the mean step (s)
   double correlation_time_s() const { return e.tau_int * sample_s; }
@@ -29,8 +30,32 @@ WindowError window_error(const std::vector<double>& series, double window_from_s
 /// ("sokal_autocorrelation"); null where not available. With `warn` (a finished run), a warning
 /// goes to j["warnings"] and stderr when the window holds fewer than ~20 correlation times,
 /// saying when the error is not reported at all (fewer than ~5). `what` names the quantity.
+/// `transient_end_s` (NaN: not known) shapes the advice: average from where the detected transient
+/// ends when that is before the window, else run longer.
 void report_window_error(nlohmann::json& j, const std::string& prefix, const std::string& what,
-                         const WindowError& w, bool warn);
+                         const WindowError& w, bool warn,
+                         double transient_end_s = std::numeric_limits<double>::quiet_NaN());
+
+/// The per-step series behind a time average: the samples before the averaging window (kept for
+/// the detection of the start-up transient) and in it, each with its step length (s). Runs
+/// resumed from checkpoints of builds that kept no step lengths or no samples before the window
+/// have them only from the resume on (`before_whole`, `dt_whole` false).
+struct StepSeries {
+  std::vector<double> before, before_dt, window_dt;
+  bool before_whole = true, dt_whole = true;
+};
+
+/// transient_end_s (core/statistics.hpp: transient_end over the whole series) and average_from_s
+/// in `j`; with `warn`, a warning when the transient ends after the window's start and the
+/// samples between shift the mean beyond noise. Returns transient_end_s (NaN: no estimate).
+double report_transient(nlohmann::json& j, const std::string& what, const StepSeries& s,
+                        const std::vector<double>& window, double window_from_s, bool warn);
+
+/// `prefix` + time_weighted_m_s: the window's mean weighted by step length (Eq. 29's mean is over
+/// steps; where the CFL limit varies the step they differ), with a warning when the two differ by
+/// more than `error` (the covering error of the mean over steps). Null without every step length.
+void report_time_weighted(nlohmann::json& j, const std::string& prefix, const std::string& what,
+                          const std::vector<double>& window, const StepSeries& s, double error, bool warn);
 
 /// Appends a warning to j["warnings"] and prints it on stderr (output rank; also under --quiet,
 /// which silences progress, so that a study's solver.log keeps it).

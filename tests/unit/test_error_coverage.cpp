@@ -211,3 +211,55 @@ TEST(PointError, OneRunUsesItsOwnDegreesOfFreedomOrSaysItHasNone) {
   EXPECT_EQ(e.basis, "single_run_plain");
   EXPECT_FALSE(bd::point_error({{-1.0, std::nullopt, std::nullopt}}).error_m_s);
 }
+
+namespace {
+
+// 500 AR(1) series of 200 tau_int (2 000 steps) with a start-up transient A exp(-t / (5 tau_int))
+// whose bias on the whole series' mean is `bias_se` standard errors; per series: where the
+// detection cuts, whether what remains is biased by less than half a standard error, whether
+// the warning fires for a window that starts at 0.
+struct TransientStats {
+  double unbiased = 0.0, warned = 0.0, discarded = 0.0;
+};
+TransientStats transient_stats(double bias_se, std::uint64_t seed) {
+  const std::size_t n = 2000;
+  const double decay = 5.0 * kTau, se = std::sqrt(2.0 * kTau / n);
+  const double amplitude = bias_se * se * n / decay;
+  Ar1 ar(kTau, seed);
+  TransientStats s;
+  const int series = 500;
+  for (int k = 0; k < series; ++k) {
+    auto x = ar.series(n);
+    for (std::size_t t = 0; t < n; ++t) x[t] += amplitude * std::exp(-static_cast<double>(t) / decay);
+    const auto cut = transient_end(x).start;
+    double residual = 0.0;
+    for (auto t = static_cast<std::size_t>(cut); t < n; ++t)
+      residual += amplitude * std::exp(-static_cast<double>(t) / decay);
+    residual /= static_cast<double>(n - cut);
+    s.unbiased += residual < 0.5 * std::sqrt(2.0 * kTau / static_cast<double>(n - cut)) ? 1.0 / series : 0.0;
+    s.warned += transient_biases_mean(x, 0, cut) ? 1.0 / series : 0.0;
+    s.discarded += static_cast<double>(cut) / n / series;
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST(TransientEnd, CutsAStartUpTransientToBelowHalfAStandardErrorAndWarnsOfIt) {
+  // Transients that bias the whole window's mean by 1 and 3 standard errors; their end (where
+  // they fall below 0.1 of the series' spread) at 3.7 and 4.8 tau_int... 18 and 24 tau_int.
+  for (double bias : {1.0, 3.0}) {
+    const auto s = transient_stats(bias, 6000 + static_cast<int>(bias));
+    std::printf("transient of %g standard errors: unbiased after the cut %.3f, warned %.3f, discarded %.3f\n",
+                bias, s.unbiased, s.warned, s.discarded);
+    EXPECT_GE(s.unbiased, 0.9) << bias;
+    EXPECT_GE(s.warned, 0.9) << bias;
+  }
+}
+
+TEST(TransientEnd, StationarySeriesLoseLittleAndRarelyWarn) {
+  const auto s = transient_stats(0.0, 7000);
+  std::printf("stationary: warned %.3f, discarded %.3f\n", s.warned, s.discarded);
+  EXPECT_LE(s.warned, 0.1);
+  EXPECT_LE(s.discarded, 0.1);
+}

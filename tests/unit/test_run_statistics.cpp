@@ -1,0 +1,123 @@
+// What a run reports about its time average (scenes/mean_error.hpp): the early stop's error, the
+// time-weighted mean, the start-up transient.
+//
+// time.target_rel_error stops a run once its covering error is below the target (PrecisionTarget). A stop
+// that the estimate itself decides tends to come where tau was under-estimated; here the error reported at
+// the stop is checked to keep its promise on AR(1) series (tau_int 10 steps, unit variance, true mean -1) at
+// three target levels. Before the stop was confirmed over 30 % of the window it covered 0.65-0.68 with the
+// covering error and 0.61-0.645 with the plain one.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include "core/statistics.hpp"
+#include "scenes/mean_error.hpp"
+
+using namespace boycott;
+
+TEST(ErrorCoverage, EarlyStopErrorCoverageAtThreeTargets) {
+  constexpr double kTau = 10.0;
+  const double phi = (2.0 * kTau - 1.0) / (2.0 * kTau + 1.0), sd = std::sqrt(1.0 - phi * phi);
+  // 2 000 series per level (binomial standard error 0.010): each stop costs ~100 error estimates.
+  const int series = 2000;
+  for (double target : {0.2, 0.12, 0.08}) {
+    std::mt19937_64 rng(5000 + static_cast<int>(target * 1000));
+    std::normal_distribution<double> g(0.0, 1.0);
+    int covered = 0, stopped = 0;
+    double samples = 0.0;
+    for (int s = 0; s < series; ++s) {
+      scenes::PrecisionTarget stop(target);
+      std::vector<double> x;
+      double v = g(rng);
+      // A run that never meets the target ends at 100 000 samples (time.end); not counted.
+      while (x.size() < 100000) {
+        v = phi * v + sd * g(rng);
+        x.push_back(-1.0 + v);
+        if (stop.reached(x, 0.0, static_cast<double>(x.size()))) break;
+      }
+      if (x.size() >= 100000) continue;
+      ++stopped;
+      samples += static_cast<double>(x.size());
+      const auto e = autocorrelation_error(x);
+      covered += std::abs(e.mean + 1.0) <= e.covering_error;
+    }
+    const double c = static_cast<double>(covered) / stopped;
+    std::printf("coverage, early stop at target %g: %.4f (stopped %d of %d, mean %.0f tau_int)\n", target, c,
+                stopped, series, samples / stopped / kTau);
+    EXPECT_EQ(stopped, series);
+    // Not yet the promise everywhere: 0.68, 0.65 and 0.68 here, where the floor is 0.66 (the stop
+    // still comes a little where tau was under-estimated; confirming over the whole window does
+    // not remove it: docs/validation.md). This guards what the rule reaches against regressions.
+    EXPECT_GE(c, 0.64) << "target " << target;
+    EXPECT_LE(c, 0.705) << "target " << target;
+  }
+}
+
+TEST(TimeWeightedMean, StepsOfTwoLengthsWeighTheirSamplesByLength) {
+  // Samples 1, 2, 3, 4 over steps of 1 ms and 3 ms alternately: (1*1 + 2*3 + 3*1 + 4*3) / 8 = 2.75,
+  // where the mean over steps is 2.5; the error 0.1 is exceeded, so it is said.
+  nlohmann::json j;
+  scenes::StepSeries s;
+  s.window_dt = {1e-3, 3e-3, 1e-3, 3e-3};
+  scenes::report_time_weighted(j, "settling_velocity_", "<<w_p>>", {1.0, 2.0, 3.0, 4.0}, s, 0.1, true);
+  EXPECT_DOUBLE_EQ(j["settling_velocity_time_weighted_m_s"].get<double>(), 2.75);
+  ASSERT_EQ(j["warnings"].size(), 1u);
+  EXPECT_NE(j["warnings"][0].get<std::string>().find("time-weighted mean of <<w_p>> (2.75)"),
+            std::string::npos);
+  // Within the error: no warning. Without every step length (a resumed older run): null.
+  nlohmann::json quiet;
+  scenes::report_time_weighted(quiet, "p_", "x", {1.0, 2.0, 3.0, 4.0}, s, 0.5, true);
+  EXPECT_FALSE(quiet.contains("warnings"));
+  s.dt_whole = false;
+  scenes::report_time_weighted(quiet, "p_", "x", {1.0, 2.0, 3.0, 4.0}, s, 0.5, true);
+  EXPECT_TRUE(quiet["p_time_weighted_m_s"].is_null());
+}
+
+TEST(TransientReport, AWindowThatStartsInsideTheTransientIsWarnedWithWhereItEnds) {
+  // 2 000 steps of 10 ms, the window from 0.5 s: a decay of amplitude 5 and time constant 0.5 s
+  // (50 steps) on white noise of unit spread, which lasts well into the window.
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  scenes::StepSeries s;
+  std::vector<double> window;
+  for (int k = 0; k < 2000; ++k) {
+    const double t = 0.01 * (k + 1), x = 5.0 * std::exp(-t / 0.5) + g(rng);
+    if (t <= 0.5 + 1e-12) {
+      s.before.push_back(x);
+      s.before_dt.push_back(0.01);
+    } else {
+      window.push_back(x);
+      s.window_dt.push_back(0.01);
+    }
+  }
+  nlohmann::json j;
+  j["simulated_time_s"] = 20.0;
+  const double end_s = scenes::report_transient(j, "<w_p>", s, window, 0.5, true);
+  EXPECT_DOUBLE_EQ(j["average_from_s"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(j["transient_end_s"].get<double>(), end_s);
+  // Where 5 exp(-t / 0.5) falls to the noise's scale of a few tenths: 1-2.5 s.
+  EXPECT_GT(end_s, 1.0);
+  EXPECT_LT(end_s, 2.5);
+  ASSERT_TRUE(j.contains("warnings"));
+  EXPECT_NE(j["warnings"][0].get<std::string>().find("after time.average_from = 0.5 s"), std::string::npos)
+      << j["warnings"][0];
+  // The same series averaged from 5 s: the transient is over, nothing to say.
+  scenes::StepSeries late;
+  std::vector<double> late_window;
+  for (std::size_t k = 0; k < s.before.size() + window.size(); ++k) {
+    const double x = k < s.before.size() ? s.before[k] : window[k - s.before.size()];
+    if (k < 500) {
+      late.before.push_back(x);
+      late.before_dt.push_back(0.01);
+    } else {
+      late_window.push_back(x);
+      late.window_dt.push_back(0.01);
+    }
+  }
+  nlohmann::json ok;
+  scenes::report_transient(ok, "<w_p>", late, late_window, 5.0, true);
+  EXPECT_FALSE(ok.contains("warnings")) << ok.dump();
+}
