@@ -238,9 +238,9 @@ TEST(StudyLauncher, WrapsTheCaseInMpirunForSeveralRanks) {
                                             "run", "c.toml", "--out", "d", "--quiet"}));
 }
 
-TEST(StudyExpansion, DemoStudyIsValidWithThePaperSolidFraction) {
+TEST(StudyExpansion, DemoStudyIsValidWithThePaperSolidFractionAndThreeReplicasPerAngle) {
   const auto s = bd::expand_study_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/demo.toml");
-  ASSERT_EQ(s.cases.size(), 4u);
+  ASSERT_EQ(s.cases.size(), 12u);  // 4 angles x 3 replicas: an error from their scatter at each
   for (const auto& c : s.cases) EXPECT_NEAR(c.params.solid_fraction(), 0.113, 0.002);
 }
 
