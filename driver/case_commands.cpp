@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -15,9 +16,13 @@
 #include "core/error.hpp"
 #include "core/key_docs.hpp"
 #include "driver/case_progress.hpp"
+#include "driver/database.hpp"
+#include "driver/store.hpp"
 #include "fluid/petsc_session.hpp"
+#include "io/atomic_file.hpp"
 #include "scenes/preflight.hpp"
 #include "scenes/scene.hpp"
+#include "scenes/summarize.hpp"
 
 namespace boycott::driver {
 
@@ -132,6 +137,36 @@ int case_check(const std::string& file, const std::vector<std::string>& sets) {
   if (!pre.errors.empty()) {
     std::fprintf(stderr, "error: %s\n", pre.errors.front().c_str());
     return kExitInputError;
+  }
+  return 0;
+}
+
+int case_summarize(const std::vector<std::string>& run_dirs, const std::string& db_path) {
+  namespace fs = std::filesystem;
+  // Every folder is recomputed before anything is written: a folder that cannot be stops all.
+  std::vector<nlohmann::json> summaries;
+  for (const auto& dir : run_dirs) summaries.push_back(scenes::resummarize_run(dir));
+  std::optional<Database> db;
+  if (!db_path.empty()) db.emplace(db_path, OpenMode::kExisting);
+  for (std::size_t i = 0; i < run_dirs.size(); ++i) {
+    const fs::path dir(run_dirs[i]);
+    const auto& j = summaries[i];
+    fs::copy_file(dir / "summary.json", dir / "summary.previous.json", fs::copy_options::overwrite_existing);
+    io::write_file_atomic(dir / "summary.json", j.dump(2) + "\n");
+    const std::string id = j.value("case_id", "");
+    const bool updated = db && update_result_summary(*db, id, j);
+    auto num = [&](const char* k) {
+      return j.contains(k) && j[k].is_number() ? fmt::format("{:.6g}", j[k].get<double>())
+                                               : std::string("n/a");
+    };
+    std::printf(
+        "%s: <<w_p>> %s m/s +- %s (covering, %s degrees of freedom; plain %s), transient ends at %s s, "
+        "window from %s s%s\n",
+        dir.string().c_str(), num("mean_settling_velocity_m_s").c_str(),
+        num("settling_velocity_error_m_s").c_str(), num("settling_velocity_error_dof").c_str(),
+        num("settling_velocity_stderr_m_s").c_str(), num("transient_end_s").c_str(),
+        num("average_from_s").c_str(),
+        db ? (updated ? "; database row updated" : "; no row of this case in the database") : "");
   }
   return 0;
 }

@@ -19,6 +19,10 @@ struct CaseRunOptions {
 int case_run(const CaseRunOptions& opt, int argc, char** argv);
 /// `boycott case check`: validates and prints the pre-flight report.
 int case_check(const std::string& file, const std::vector<std::string>& sets);
+/// `boycott case summarize`: each run folder's statistics of <<w_p>> recomputed
+/// (scenes/summarize.hpp); summary.json rewritten (the previous kept as summary.previous.json) and,
+/// with `db`, the run's result row updated. Exit 2 naming the folder when one cannot be.
+int case_summarize(const std::vector<std::string>& run_dirs, const std::string& db);
 /// `boycott case keys`: every key with its default.
 /// The case keys with their defaults: every key, or those `scene` reads at its defaults.
 int case_keys(const std::string& scene, const std::string& format = "table");

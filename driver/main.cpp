@@ -122,6 +122,17 @@ int main(int argc, char** argv) {
   std::string keys_format = "table";
   keys->add_option("--format", keys_format, "table or json")->capture_default_str();
 
+  std::vector<std::string> summarize_dirs;
+  std::string summarize_db;
+  auto* summarize = case_cmd->add_subcommand(
+      "summarize",
+      "recompute finished inclined_settling runs' statistics of <<w_p>> from their checkpoints "
+      "with this build's rules; update summary.json and the database row");
+  summarize->add_option("run_dir", summarize_dirs, "run folders (e.g. FILE.runs/<case_id>)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  summarize->add_option("--db", summarize_db, "results database whose rows of these runs to update");
+
   // ---- study ----
   auto* study_cmd = app.add_subcommand("study", "run a study (a matrix of cases) into a database");
   study_cmd->require_subcommand(1);
@@ -333,6 +344,8 @@ int main(int argc, char** argv) {
   }
   if (check->parsed())
     return run_guarded([&] { return boycott::driver::case_check(check_file, check_sets); });
+  if (summarize->parsed())
+    return run_guarded([&] { return boycott::driver::case_summarize(summarize_dirs, summarize_db); });
   if (keys->parsed()) return run_guarded([&] { return boycott::driver::case_keys(keys_scene, keys_format); });
   return 0;
 }

@@ -121,6 +121,21 @@ void finish_attempt(Database& db, std::int64_t attempt, int exit_status, const s
   });
 }
 
+bool update_result_summary(Database& db, const std::string& case_id, const nlohmann::json& summary) {
+  bool updated = false;
+  db.transaction([&] {
+    db.prepare("UPDATE results SET settling_velocity_stderr_m_s = ?2, summary_json = ?3 WHERE case_id = ?1")
+        .bind(1, case_id)
+        .bind(2, json_number(summary, "settling_velocity_stderr_m_s"))
+        .bind(3, summary.dump())
+        .run();
+    auto st = db.prepare("SELECT changes()");
+    st.step();
+    updated = st.integer(0) > 0;
+  });
+  return updated;
+}
+
 void record_result(Database& db, std::int64_t attempt, const std::string& case_id,
                    const nlohmann::json& summary) {
   nlohmann::json errors = nlohmann::json::object();

@@ -22,6 +22,9 @@ std::int64_t begin_attempt(Database& db, const std::string& case_id, int ranks, 
 /// Closes an attempt that produced no result (failure or interruption).
 void finish_attempt(Database& db, std::int64_t attempt, int exit_status, const std::string& error_text);
 /// Closes the attempt and stores the result from the solver's summary.json, in one transaction.
+/// A recorded result's statistics replaced by a recomputed summary (`case summarize`): its error
+/// column and summary_json. False when the database holds no result of the case.
+bool update_result_summary(Database& db, const std::string& case_id, const nlohmann::json& summary);
 void record_result(Database& db, std::int64_t attempt, const std::string& case_id,
                    const nlohmann::json& summary);
 /// Whether the case has a result (recorded by any driver on this database).

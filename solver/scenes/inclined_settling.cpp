@@ -251,11 +251,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   auto j = make_summary(p, sb, timers);
   const bool finished = is_finished_status(sb.status);
   if (wp_series_whole) {
-    const double transient_s =
-        report_transient(j, "<w_p>", steps, wp_series, p.time.average_from_s, finished);
-    report_window_error(j, "settling_velocity_", "<w_p>", wp_err, finished, transient_s);
-    report_time_weighted(j, "settling_velocity_", "<<w_p>>", wp_series, steps, wp_err.e.covering_error,
-                         finished);
+    report_settling_statistics(j, steps, wp_series, p.time.average_from_s, run.time_s(), finished);
   } else {
     j["settling_velocity_error_method"] = "batch_means";
     if (finished)
@@ -268,7 +264,8 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
                                                       ? nlohmann::json(wp_avg.stderr_of_mean())
                                                       : nlohmann::json(nullptr);
   const double rel = std::abs(sb.settling_velocity_stderr_m_s / sb.mean_settling_velocity_m_s);
-  j["settling_velocity_rel_stderr"] = std::isfinite(rel) ? nlohmann::json(rel) : nlohmann::json(nullptr);
+  if (!wp_series_whole)
+    j["settling_velocity_rel_stderr"] = std::isfinite(rel) ? nlohmann::json(rel) : nlohmann::json(nullptr);
   if (target.active()) {
     j["target_rel_error"] = p.time.target_rel_error;
     // Met: it stopped the run, or the whole window meets it at the end.

@@ -137,6 +137,23 @@ void report_time_weighted(nlohmann::json& j, const std::string& prefix, const st
                        what, weighted, plain, error));
 }
 
+void report_settling_statistics(nlohmann::json& j, const StepSeries& s, const std::vector<double>& window,
+                                double window_from_s, double now_s, bool warn) {
+  const WindowError w = window_error(window, window_from_s, now_s);
+  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  const double transient_s = report_transient(j, "<w_p>", s, window, window_from_s, warn);
+  report_window_error(j, "settling_velocity_", "<w_p>", w, warn, transient_s);
+  report_time_weighted(j, "settling_velocity_", "<<w_p>>", window, s, w.e.covering_error, warn);
+  j["settling_velocity_rel_stderr"] = num(std::abs(w.e.stderr_of_mean / w.e.mean));
+}
+
+bool is_settling_statistics_warning(const std::string& text) {
+  for (const char* opening :
+       {"the averaging window (", "the start-up transient of ", "the step length varied"})
+    if (text.rfind(opening, 0) == 0) return true;
+  return false;
+}
+
 bool PrecisionTarget::reached(const std::vector<double>& series, double window_from_s, double now_s) {
   if (!active() || static_cast<std::int64_t>(series.size()) < next_check_) return false;
   // Checks every 2 % of the samples (at least 25): their cost grows with the window.

@@ -57,6 +57,17 @@ double report_transient(nlohmann::json& j, const std::string& what, const StepSe
 void report_time_weighted(nlohmann::json& j, const std::string& prefix, const std::string& what,
                           const std::vector<double>& window, const StepSeries& s, double error, bool warn);
 
+/// Everything a finished (or stopped) window reports about <<w_p>> from its per-step series:
+/// settling_velocity_stderr_m_s and the keys of report_window_error, transient_end_s,
+/// average_from_s, the time-weighted mean, settling_velocity_rel_stderr, and their warnings
+/// (with `warn`). One place for the scene at its end and for `case summarize` afterwards.
+void report_settling_statistics(nlohmann::json& j, const StepSeries& s, const std::vector<double>& window,
+                                double window_from_s, double now_s, bool warn);
+
+/// The texts of the warnings report_settling_statistics may give (their openings), so that a
+/// recomputation can replace them.
+bool is_settling_statistics_warning(const std::string& text);
+
 /// Appends a warning to j["warnings"] and prints it on stderr (output rank; also under --quiet,
 /// which silences progress, so that a study's solver.log keeps it).
 void add_warning(nlohmann::json& j, const std::string& text);

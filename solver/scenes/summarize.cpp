@@ -1,0 +1,61 @@
+#include "scenes/summarize.hpp"
+
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "core/case_params.hpp"
+#include "core/error.hpp"
+#include "core/version.hpp"
+#include "io/checkpoint_file.hpp"
+#include "scenes/mean_error.hpp"
+
+namespace boycott::scenes {
+
+nlohmann::json resummarize_run(const std::filesystem::path& run_dir) {
+  const auto summary_path = run_dir / "summary.json";
+  std::ifstream in(summary_path);
+  if (!in)
+    throw InputError(
+        fmt::format("{}: no summary.json (the run has not ended; `case run` resumes it)", run_dir.string()));
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: summary.json is not JSON ({})", summary_path.string(), e.what()));
+  }
+  const std::string scene = j.value("scene", "");
+  if (scene != "inclined_settling")
+    throw InputError(fmt::format("{}: a {} run; case summarize recomputes <<w_p>> of inclined_settling runs",
+                                 run_dir.string(), scene.empty() ? "(no scene named)" : scene));
+  const auto ckpt = io::latest_checkpoint(run_dir);
+  if (!ckpt) throw InputError(fmt::format("{}: no checkpoint to recompute from", run_dir.string()));
+  const io::CheckpointReader r(*ckpt);
+  if (!r.has("stats.wp_series"))
+    throw InputError(
+        fmt::format("{}: its checkpoint {} keeps no <w_p> series (an earlier build): nothing to "
+                    "recompute from",
+                    run_dir.string(), ckpt->filename().string()));
+  const CaseParams p = case_from_json(nlohmann::json::parse(r.string("case_json")));
+  StepSeries steps;
+  if (r.has("stats.wp_before")) {
+    steps.before = r.doubles("stats.wp_before");
+    steps.before_dt = r.doubles("stats.wp_before_dt");
+    steps.window_dt = r.doubles("stats.wp_dt");
+  } else {
+    steps.before_whole = steps.dt_whole = false;
+  }
+  const auto window = r.doubles("stats.wp_series");
+  const double now_s = r.scalar("run.time_s");
+  if (j.contains("warnings")) {
+    nlohmann::json kept = nlohmann::json::array();
+    for (const auto& w : j["warnings"])
+      if (!w.is_string() || !is_settling_statistics_warning(w.get<std::string>())) kept.push_back(w);
+    j["warnings"] = kept;
+  }
+  report_settling_statistics(j, steps, window, p.time.average_from_s, now_s, true);
+  j["summarized_by_version"] = kVersion;
+  return j;
+}
+
+}  // namespace boycott::scenes

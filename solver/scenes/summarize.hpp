@@ -1,0 +1,16 @@
+#pragma once
+// `boycott case summarize`: a finished inclined_settling run's statistics of <<w_p>> recomputed
+// from the per-step series its last checkpoint keeps, with the rules of this build (errors that
+// cover, the transient, the time-weighted mean), so runs finished by an older build get them.
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+namespace boycott::scenes {
+
+/// The run's summary.json with the statistics of <<w_p>> recomputed and their warnings replaced
+/// (not written). Throws InputError when the folder holds no finished inclined_settling run or
+/// its last checkpoint keeps no <w_p> series (builds before the autocorrelation error).
+nlohmann::json resummarize_run(const std::filesystem::path& run_dir);
+
+}  // namespace boycott::scenes
