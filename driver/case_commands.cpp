@@ -5,6 +5,7 @@
 
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -17,6 +18,7 @@
 #include "core/key_docs.hpp"
 #include "driver/case_progress.hpp"
 #include "driver/database.hpp"
+#include "driver/run_folder_lock.hpp"
 #include "driver/store.hpp"
 #include "fluid/petsc_session.hpp"
 #include "io/atomic_file.hpp"
@@ -69,6 +71,46 @@ void print_outcome(const std::filesystem::path& dir) {
   }
 }
 
+// The run folder's lock (the one `study run` holds for its solvers), taken by rank 0 before
+// anything is written, unless the parent holds it for this process (kRunFolderLockedEnv); all
+// ranks learn the outcome. Kept until the process exits. Returns whether it made the folder (a
+// run refused before writing removes it again: see forget_unused_run_folder).
+bool hold_run_folder(const std::string& out_dir, int rank) {
+  namespace fs = std::filesystem;
+  int held = 1;
+  std::string holder;
+  bool made = false;
+  if (rank == 0) {
+    made = !fs::exists(out_dir);
+    fs::create_directories(out_dir);
+    std::error_code ec;
+    const auto dir = fs::weakly_canonical(out_dir, ec);
+    const char* parent = std::getenv(kRunFolderLockedEnv);
+    if (!(parent && !ec && fs::path(parent) == dir)) {
+      held = lock_run_folder(out_dir).has_value() ? 1 : 0;
+      if (!held) holder = run_folder_holder(out_dir);
+    }
+  }
+  MPI_Bcast(&held, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (!held)
+    throw CheckpointError(fmt::format(
+        "run folder '{}' is in use: {} holds its .lock (a `case run` or `study run` still running); "
+        "nothing was written",
+        out_dir, holder.empty() ? std::string("another process") : "process " + holder));
+  return made;
+}
+
+// A folder this run made for its lock and then wrote nothing into (the case was refused): gone,
+// so that a refused run leaves nothing behind.
+void forget_unused_run_folder(const std::string& out_dir, bool made) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!made) return;
+  for (const auto& e : fs::directory_iterator(out_dir, ec))
+    if (e.path().filename() != ".lock") return;
+  fs::remove_all(out_dir, ec);
+}
+
 }  // namespace
 
 int case_run(const CaseRunOptions& opt, int argc, char** argv) {
@@ -87,6 +129,7 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv) {
   if (opt.at_s >= 0.0) ctx.branch_at_s = opt.at_s;
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  const bool made_folder = hold_run_folder(opt.out_dir, rank);
   CaseProgress progress(p.time.end_s, isatty(STDERR_FILENO) != 0, opt.progress_every_s);
   if (rank == 0 && !opt.quiet) {
     ctx.progress = [&](double t) { progress.at(t); };
@@ -105,6 +148,7 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv) {
                      o.c_str());
     return rc;
   } catch (const std::exception& e) {
+    if (rank == 0) forget_unused_run_folder(opt.out_dir, made_folder);
     // On several ranks an error is most often met by one rank (the writer, or the one whose
     // particles went wrong) while the others wait in the run's next collective: finalizing, or
     // returning to main, would wait for them forever (seen under srun --mpi=pmix). Say why, on

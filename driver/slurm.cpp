@@ -202,6 +202,8 @@ if [ $? -eq 99 ]; then
   echo "case $case_id: $dir/.lock is held by another process (a study run?); not started" >&2
   exit 1
 fi
+# The solver's `case run` takes the lock itself unless told that this folder's is held for it.
+export BOYCOTT_RUN_FOLDER_LOCKED="$(cd "$dir" && pwd -P)"
 mkdir -p "$dir/attempts"
 
 pid=

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -42,29 +43,6 @@ std::vector<std::string> solver_argv(const std::string& configured) {
   return {fs::read_symlink("/proc/self/exe").string()};
 }
 
-std::optional<int> lock_run_folder(const fs::path& dir) {
-  const int fd = ::open((dir / ".lock").c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
-  if (fd < 0) throw std::runtime_error(fmt::format("cannot create '{}'", (dir / ".lock").string()));
-  // Held by the solver as long as it lives: a solver orphaned by a killed driver is still
-  // checkpointing, and a second driver must not start the case twice.
-  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-    ::close(fd);
-    return std::nullopt;
-  }
-  return fd;
-}
-
-void unlock_run_folder(int lock_fd) {
-  ::close(lock_fd);
-}
-
-bool run_folder_unheld(const fs::path& dir) {
-  const int fd = ::open((dir / ".lock").c_str(), O_RDWR | O_CLOEXEC);
-  const bool unheld = fd >= 0 && ::flock(fd, LOCK_EX | LOCK_NB) == 0;
-  if (fd >= 0) ::close(fd);
-  return unheld;
-}
-
 pid_t start_solver(const std::vector<std::string>& argv, const fs::path& log, int lock_fd) {
   const pid_t parent = getpid();
   const pid_t pid = fork();
@@ -74,6 +52,10 @@ pid_t start_solver(const std::vector<std::string>& argv, const fs::path& log, in
     prctl(PR_SET_PDEATHSIG, SIGTERM);  // driver killed with -9: the case checkpoints and stops
     if (getppid() != parent) _exit(75);
     fcntl(lock_fd, F_SETFD, 0);  // the solver inherits the run folder's lock
+    // ... and is told so: `case run` takes the lock itself unless its folder is the one named here.
+    std::error_code ec;
+    const auto dir = fs::weakly_canonical(log.parent_path(), ec);
+    setenv(kRunFolderLockedEnv, (ec ? log.parent_path() : dir).c_str(), 1);
     const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
     if (fd >= 0) {
       dup2(fd, 1);

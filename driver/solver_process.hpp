@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "driver/run_folder_lock.hpp"
+
 #include "driver/study.hpp"
 
 namespace boycott::driver {
@@ -36,13 +38,6 @@ struct RunningCase {
 /// The solver command line: `configured` split at spaces; empty: $BOYCOTT_SOLVER_COMMAND, else
 /// this program.
 std::vector<std::string> solver_argv(const std::string& configured);
-
-/// Takes <dir>/.lock (created when missing) without waiting and returns its descriptor; nullopt
-/// while another process (an orphaned solver, another driver) holds it.
-std::optional<int> lock_run_folder(const std::filesystem::path& dir);
-void unlock_run_folder(int lock_fd);
-/// Whether <dir>/.lock exists and no process holds it: the solver that held it has exited.
-bool run_folder_unheld(const std::filesystem::path& dir);
 
 /// Starts argv in a process group of its own with stdout and stderr appended to `log`; the
 /// solver inherits `lock_fd` and holds the run folder as long as it lives.

@@ -125,6 +125,20 @@ struct ReplicaKeys {
   std::optional<double> target_rel_error;
 };
 
+// Study and group names become folder names under FILE.names/ and are printed to terminals:
+// no "." or "..", no path separator, no NUL or other control character.
+void check_name(const std::string& what, const std::string& name) {
+  std::string why;
+  if (name == "." || name == "..")
+    why = "is a folder of its own ('.' or '..')";
+  else if (name.find_first_of("/\\") != std::string::npos)
+    why = "holds a path separator";
+  for (unsigned char c : name)
+    if (c < 0x20 || c == 0x7f) why = fmt::format("holds the control character {:#04x}", c);
+  if (!why.empty())
+    throw InputError(fmt::format("{} {:?} {}; names become folder names and terminal text", what, name, why));
+}
+
 ReplicaKeys read_replica_keys(const toml::table& t, const std::string& where) {
   ReplicaKeys r;
   auto integer = [&](const char* key, std::int64_t lo) -> std::optional<std::int64_t> {
@@ -203,6 +217,7 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
   auto name = root["name"].value<std::string>();
   if (!name || name->empty())
     throw InputError(fmt::format("{}: the study needs a non-empty string 'name'", origin));
+  check_name(origin + ": the study's name", *name);
   s.name = *name;
 
   std::string base_text;
@@ -236,6 +251,7 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
       auto gname = (*gt)["name"].value<std::string>();
       if (!gname || gname->empty())
         throw InputError("[[group]]: every group needs a non-empty string 'name'");
+      check_name(origin + ": a group's name", *gname);
       g.name = *gname;
       static const std::set<std::string> kGroupKeys = {
           "name", "set", "matrix", "zip", "replicas", "replicas_max", "replicas_target_rel_error"};

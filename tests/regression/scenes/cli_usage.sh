@@ -33,7 +33,7 @@ grep -q 'radians' "$work/out.txt" && fail "a whole-number angle warned of radian
 # status only reads: on a database that does not exist it lists the cases as pending, creates none.
 demo=$(dirname "$case_file")/../demo.toml
 "$bin" study status "$demo" --db "$work/new.db" > "$work/out.txt" 2>&1 || fail "status on no database: $(cat "$work/out.txt")"
-grep -q ' 4 pending' "$work/out.txt" || fail "status does not list the pending cases: $(cat "$work/out.txt")"
+grep -q ' 12 pending' "$work/out.txt" || fail "status does not list the pending cases: $(cat "$work/out.txt")"
 [ ! -e "$work/new.db" ] || fail "status created a database"
 
 # Not a terminal (stderr is a file): plain progress lines, the outcome, the unused PETSc option.

@@ -3,8 +3,8 @@
 # non-finite values in any key, steps so small a run would never end or a fluid step never stop,
 # repeated output times, case and study files that are FIFOs, devices or folders, sizes beyond this
 # machine's memory (refused by case run, a warning of case check), a settling case without
-# particles, an --out folder holding the user's own files, and a run folder whose params.json is
-# damaged (unusable, exit 4, not bad input).
+# particles, an --out folder holding the user's own files, a folder another run holds, and a run
+# folder whose params.json is damaged (unusable, exit 4, not bad input).
 #   refusals.sh BOYCOTT_BIN CASE.toml
 set -uo pipefail
 bin=$1; case_file=$2
@@ -57,4 +57,18 @@ import json, sys
 p = json.load(open(sys.argv[1])); p["fluid"]["viscosity"] = "thick"; json.dump(p, open(sys.argv[1], "w"))
 PY
 expect 4 "a run folder with a mistyped params.json" "$bin" case run "$case_file" --out "$work/ok" --set time.end=0.02 --set time.average_from=0.01
+# Two `case run` into one folder: the second is refused at once (4) naming the holder's pid, and
+# writes nothing; the first runs on (stopped here by SIGTERM after its first checkpoint, exit 75).
+"$bin" case run "$case_file" --out "$work/busy" --set time.end=5 --set time.average_from=1 \
+  --set time.checkpoint_every=0.01 --quiet > /dev/null 2>&1 &
+first=$!
+until compgen -G "$work/busy/checkpoints/ckpt_*.h5" > /dev/null; do
+  kill -0 "$first" 2> /dev/null || { echo "FAIL: the first run ended before its first checkpoint"; exit 1; }
+  sleep 0.05
+done
+expect 4 "a second case run into a running folder" "$bin" case run "$case_file" --out "$work/busy" --set time.end=5 --set time.average_from=1
+grep -q "is in use: process $first holds its .lock" "$work/out.txt" || { echo "FAIL: the holder is not named"; cat "$work/out.txt"; fails=$((fails + 1)); }
+kill -TERM "$first"; wait "$first"; rc=$?
+[ "$rc" -eq 75 ] || { echo "FAIL: the first run, stopped, exit $rc (expected 75)"; fails=$((fails + 1)); }
+grep -q '"interrupted"' "$work/busy/summary.json" || { echo "FAIL: the first run's summary"; fails=$((fails + 1)); }
 [ "$fails" -eq 0 ] && echo "[ report ] every refusal as expected" || exit 1

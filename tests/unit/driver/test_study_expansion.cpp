@@ -352,3 +352,21 @@ TEST(StudyExpansion, SweptDoublesReadAsTheShortestTextThatReadsBackTheSame) {
   EXPECT_EQ(bd::readable_value("\"kernel\""), "\"kernel\"");
   EXPECT_EQ(bd::readable_value("[20, 6, 40]"), "[20, 6, 40]");
 }
+
+TEST(StudyExpansion, NamesThatWouldLeaveTheirFolderOrReachTheTerminalRawAreRefused) {
+  auto error_of = [](const std::string& text) {
+    try {
+      bd::expand_study_string(text);
+    } catch (const boycott::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(error_of("name = \"..\"\n").find("('.' or '..')"), std::string::npos);
+  EXPECT_NE(error_of("name = \"a/b\"\n").find("path separator"), std::string::npos);
+  EXPECT_NE(error_of("name = \"ok\"\n[[group]]\nname = \"x\\u0000y\"\n").find("control character 0x00"),
+            std::string::npos);
+  EXPECT_NE(error_of("name = \"ok\"\n[[group]]\nname = \"\\u001b[31mred\"\n").find("control character 0x1b"),
+            std::string::npos);
+  EXPECT_EQ(error_of("name = \"a b,c\"\n[[group]]\nname = \"Ga145.6\"\n"), "accepted");
+}

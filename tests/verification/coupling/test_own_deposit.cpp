@@ -76,7 +76,9 @@ TEST(OwnDeposit, AParticleHeldAtItsTerminalSlipIsNotPushedSidewaysByItsOwnDeposi
           "[ report ] %s sampling, lift %s: largest |F_y| / F_drag %.4f at y = %.2f mm (F_y / F_drag "
           "%+.4f)\n",
           sampling.c_str(), lift.c_str(), f.worst_ratio, f.at_y_mm, f.signed_ratio);
-      if (lift != "saffman") EXPECT_LT(f.worst_ratio, 0.01) << sampling << ", " << lift;
+      if (lift != "saffman") {
+        EXPECT_LT(f.worst_ratio, 0.01) << sampling << ", " << lift;
+      }
     }
 }
 
