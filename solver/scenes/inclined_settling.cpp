@@ -25,6 +25,7 @@
 #include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scenes_list.hpp"
+#include "scenes/summarize.hpp"
 
 namespace boycott::scenes {
 
@@ -114,13 +115,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
           alpha_max_seen = r.scalar("stats.alpha_max_seen");
           ke_max_seen = r.scalar("stats.ke_max_seen");
         }
-        if (r.has("stats.wp_before")) {
-          steps.before = r.doubles("stats.wp_before");
-          steps.before_dt = r.doubles("stats.wp_before_dt");
-          steps.window_dt = r.doubles("stats.wp_dt");
-        } else {
-          steps.before_whole = steps.dt_whole = false;
-        }
+        steps = read_step_series(r);
         if (r.has("stats.wp_series")) {
           wp_series = r.doubles("stats.wp_series");
           const auto t = r.doubles("stats.target");
@@ -164,9 +159,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       w.put("stats.alpha_max_seen", alpha_max_seen);
       w.put("stats.ke_max_seen", ke_max_seen);
       w.put("stats.wp_series", wp_series);
-      w.put("stats.wp_before", steps.before);
-      w.put("stats.wp_before_dt", steps.before_dt);
-      w.put("stats.wp_dt", steps.window_dt);
+      write_step_series(w, steps);
       w.put("stats.target",
             std::vector<double>{static_cast<double>(target.next_check_), target.met_since_s_});
     });

@@ -7,10 +7,27 @@
 #include "core/case_params.hpp"
 #include "core/error.hpp"
 #include "core/version.hpp"
-#include "io/checkpoint_file.hpp"
 #include "scenes/mean_error.hpp"
 
 namespace boycott::scenes {
+
+StepSeries read_step_series(const io::CheckpointReader& r) {
+  StepSeries s;
+  if (r.has("stats.wp_before")) {
+    s.before = r.doubles("stats.wp_before");
+    s.before_dt = r.doubles("stats.wp_before_dt");
+    s.window_dt = r.doubles("stats.wp_dt");
+  } else {
+    s.before_whole = s.dt_whole = false;
+  }
+  return s;
+}
+
+void write_step_series(io::CheckpointWriter& w, const StepSeries& s) {
+  w.put("stats.wp_before", s.before);
+  w.put("stats.wp_before_dt", s.before_dt);
+  w.put("stats.wp_dt", s.window_dt);
+}
 
 nlohmann::json resummarize_run(const std::filesystem::path& run_dir) {
   const auto summary_path = run_dir / "summary.json";
@@ -37,14 +54,7 @@ nlohmann::json resummarize_run(const std::filesystem::path& run_dir) {
                     "recompute from",
                     run_dir.string(), ckpt->filename().string()));
   const CaseParams p = case_from_json(nlohmann::json::parse(r.string("case_json")));
-  StepSeries steps;
-  if (r.has("stats.wp_before")) {
-    steps.before = r.doubles("stats.wp_before");
-    steps.before_dt = r.doubles("stats.wp_before_dt");
-    steps.window_dt = r.doubles("stats.wp_dt");
-  } else {
-    steps.before_whole = steps.dt_whole = false;
-  }
+  const StepSeries steps = read_step_series(r);
   const auto window = r.doubles("stats.wp_series");
   const double now_s = r.scalar("run.time_s");
   if (j.contains("warnings")) {
