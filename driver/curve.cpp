@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -118,7 +119,20 @@ plot::Plot curve_plot(const std::vector<CurvePoint>& pts, const std::string& tit
     return "#777";
   };
 
-  return plot::render(1000, 440, format, [&](plot::Canvas& c) {
+  // The paper's values of the groups this study has; none of another group's.
+  std::vector<PaperValue> overlay;
+  std::string paper_groups;
+  if (paper)
+    for (const auto& v : *paper)
+      if (std::any_of(pts.begin(), pts.end(), [&](const CurvePoint& p) { return p.group == v.group; })) {
+        overlay.push_back(v);
+        if (paper_groups.find(v.group) == std::string::npos)
+          paper_groups += (paper_groups.empty() ? "" : ", ") + v.group;
+      }
+  const bool any_without_error = std::any_of(pts.begin(), pts.end(), [](const CurvePoint& p) {
+    return !p.error.error_m_s || (p.r_acc && !p.r_acc_err);
+  });
+  return plot::render(1000, 470, format, [&](plot::Canvas& c) {
     c.text(500, 22, title, Anchor::kMiddle, 15);
     for (int panel = 0; panel < 2; ++panel) {
       // Left: <<w_p>> in mm/s; right: r_acc (dimensionless).
@@ -150,9 +164,8 @@ plot::Plot curve_plot(const std::vector<CurvePoint>& pts, const std::string& tit
         }
         for (double r : replica_values(p)) lo = std::min(lo, r), hi = std::max(hi, r);
       }
-      if (paper)
-        for (const auto& v : *paper)
-          if (v.quantity == quantity) lo = std::min(lo, v.value * scale), hi = std::max(hi, v.value * scale);
+      for (const auto& v : overlay)
+        if (v.quantity == quantity) lo = std::min(lo, v.value * scale), hi = std::max(hi, v.value * scale);
       if (!std::isfinite(lo)) lo = 0, hi = 1;
       if (panel == 1) lo = std::min(lo, 1.0), hi = std::max(hi, 1.0);
       if (hi - lo < 1e-12) lo -= 0.5, hi += 0.5;
@@ -168,8 +181,9 @@ plot::Plot curve_plot(const std::vector<CurvePoint>& pts, const std::string& tit
         c.text(pn.px(a), pn.y0 + pn.h + 18, fmt::format("{:g}", a), Anchor::kMiddle);
       }
       c.text(pn.x0 + pn.w / 2, pn.y0 + pn.h + 40, "inclination angle θ (deg)", Anchor::kMiddle);
-      c.text(pn.x0 - 55, pn.y0 + pn.h / 2, panel == 0 ? "⟨⟨w_p⟩⟩ (mm/s)" : "r_acc = ⟨⟨w_p⟩⟩ / ⟨⟨w_p⟩⟩(90°)",
-             Anchor::kMiddle, 13, "#000", true);
+      c.label(pn.x0 - 55, pn.y0 + pn.h / 2,
+              panel == 0 ? "⟨⟨w_{p}⟩⟩ (mm/s)" : "r_{acc} = ⟨⟨w_{p}⟩⟩ / ⟨⟨w_{p}⟩⟩(90°)", Anchor::kMiddle, 13,
+              true);
       for (std::size_t g = 0; g < groups.size(); ++g) {
         const char* color = report::color(g);
         std::vector<std::pair<double, double>> line;
@@ -189,15 +203,13 @@ plot::Plot curve_plot(const std::vector<CurvePoint>& pts, const std::string& tit
             c.line(x - 5, y_lo, x + 5, y_lo, color, 1.5);
             c.line(x - 5, y_hi, x + 5, y_hi, color, 1.5);
           }
-          c.marker(report::marker_kind(g), x, y, color);
-        }
-        if (panel == 1) {
-          c.marker(report::marker_kind(g), pn.x0 + 18, pn.y0 + 18 + 18.0 * g, color);
-          c.text(pn.x0 + 28, pn.y0 + 22 + 18.0 * g, groups[g], Anchor::kStart, 13, "#000", false, "legend");
+          // A point without an error is drawn open (named in the caption), not as one with a tiny bar.
+          const bool no_error = panel == 0 ? !p.error.error_m_s : !p.r_acc_err;
+          c.marker(report::marker_kind(g), x, y, color, no_error);
         }
       }
-      if (paper) {
-        for (const auto& v : *paper) {
+      if (!overlay.empty()) {
+        for (const auto& v : overlay) {
           if (v.quantity != quantity) continue;
           const double y = pn.py(v.value * scale);
           const char* color = paper_color(v);
@@ -208,19 +220,32 @@ plot::Plot curve_plot(const std::vector<CurvePoint>& pts, const std::string& tit
             c.line(pn.px(kPeakFrom), y, pn.px(kPeakTo), y, color, 1.5, {5, 3}, "paper");
           }
         }
-        if (panel == 1) {
-          const double ly = pn.y0 + 22 + 18.0 * static_cast<double>(groups.size());
-          c.marker("diamond", pn.x0 + 18, ly - 4, "#333", true);
-          c.text(pn.x0 + 28, ly, "Zeng et al. 2021 (stated values; dashed: peak, angle not stated)",
-                 Anchor::kStart, 13, "#000", false, "legend");
-        }
       }
     }
-    c.text(500, 436,
-           std::any_of(pts.begin(), pts.end(), [](const CurvePoint& p) { return p.n_replicas > 1; })
-               ? "error bars: the interval that covers the mean ~68 % of the time (Student's t); faint dots: "
-                 "replicas (seeds)"
-               : "error bars: the interval that covers the mean ~68 % of the time (Student's t)",
+    // The legend: one row under the panels, centred, where it covers no data.
+    {
+      std::vector<std::pair<std::string, std::string>> entries;  // marker kind (or "paper"), text
+      for (std::size_t g = 0; g < groups.size(); ++g) entries.emplace_back(report::marker_kind(g), groups[g]);
+      if (!overlay.empty())
+        entries.emplace_back("paper", "Zeng et al. 2021, group " + paper_groups +
+                                          ": stated values (dashed: a peak whose angle is not stated)");
+      double width = 0.0;
+      for (const auto& e : entries) width += 16.0 + c.text_width(e.second) + 24.0;
+      double x = 500.0 - (width - 24.0) / 2.0;
+      for (std::size_t k = 0; k < entries.size(); ++k) {
+        const bool is_paper = entries[k].first == "paper";
+        c.marker(is_paper ? "diamond" : entries[k].first.c_str(), x + 5, 436 - 4,
+                 is_paper ? "#333" : report::color(k), is_paper);
+        c.text(x + 16, 436, entries[k].second, Anchor::kStart, 13, "#000", false, "legend");
+        x += 16.0 + c.text_width(entries[k].second) + 24.0;
+      }
+    }
+    c.text(500, 462,
+           std::string("error bars: the interval that covers the mean ~68 % of the time (Student's t)") +
+               (std::any_of(pts.begin(), pts.end(), [](const CurvePoint& p) { return p.n_replicas > 1; })
+                    ? "; faint dots: replicas (seeds)"
+                    : "") +
+               (any_without_error ? "; open markers: no error available" : ""),
            Anchor::kMiddle, 11, "#555");
   });
 }

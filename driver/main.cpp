@@ -292,12 +292,14 @@ int main(int argc, char** argv) {
       if (pts.empty())
         throw boycott::InputError(fmt::format("no finished cases of study '{}'{} in '{}'", q_study,
                                               q_group.empty() ? "" : " group '" + q_group + "'", q_db));
+      // A plot name with an extension of no format is refused before anything is printed.
+      const auto plot_format = q_plot.empty() ? boycott::driver::plot::Format::kSvg
+                                              : boycott::driver::plot::format_of_path(q_plot);
       std::fputs(boycott::driver::format_curve(pts, fmt_kind).c_str(), stdout);
       if (!q_plot.empty()) {
         const auto paper = boycott::driver::parse_paper_values(boycott::driver::paper_reference_csv());
         const auto plot = boycott::driver::curve_plot(pts, fmt::format("study {}", q_study),
-                                                      q_overlay_paper ? &paper : nullptr,
-                                                      boycott::driver::plot::format_of_path(q_plot));
+                                                      q_overlay_paper ? &paper : nullptr, plot_format);
         std::ofstream out(q_plot, std::ios::binary);
         out << plot.data;
         if (!out) throw std::runtime_error(fmt::format("cannot write '{}'", q_plot));

@@ -11,12 +11,21 @@
 #include <cairo.h>
 #include <fmt/format.h>
 
+#include "core/error.hpp"
+
 namespace boycott::driver::plot {
 
 Format format_of_path(const std::string& path) {
   std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext == ".pdf" ? Format::kPdf : ext == ".png" ? Format::kPng : Format::kSvg;
+  if (ext == ".pdf") return Format::kPdf;
+  if (ext == ".png") return Format::kPng;
+  if (ext == ".svg") return Format::kSvg;
+  // Another extension would get a file whose content is not what its name says.
+  throw InputError(
+      fmt::format("--plot {}: the plot's format comes from its extension, which must be .svg, "
+                  ".png or .pdf",
+                  path));
 }
 
 int Plot::count(const std::string& kind) const {
@@ -140,6 +149,60 @@ void Canvas::text(double x, double y, const std::string& s, Anchor anchor, doubl
   cairo_restore(cr_);
   plot_.texts.push_back(s);
   tally(kind);
+}
+
+void Canvas::label(double x, double y, const std::string& s, Anchor anchor, double size, bool rotated) {
+  // Runs of normal and subscript text: "_{" opens a subscript, "}" closes it.
+  struct Run {
+    std::string text;
+    bool sub;
+  };
+  std::vector<Run> runs;
+  std::string plain;
+  for (std::size_t i = 0; i < s.size();) {
+    const bool sub = s.compare(i, 2, "_{") == 0;
+    const std::size_t from = sub ? i + 2 : i;
+    const std::size_t to = sub ? s.find('}', from) : s.find("_{", from);
+    const std::size_t end = to == std::string::npos ? s.size() : to;
+    runs.push_back({s.substr(from, end - from), sub});
+    plain += runs.back().text;
+    i = sub && to != std::string::npos ? end + 1 : end;
+  }
+  const double sub_size = 0.72 * size, drop = 0.28 * size;
+  cairo_save(cr_);
+  cairo_select_font_face(cr_, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+  source("#000");
+  double width = 0.0;
+  for (const auto& r : runs) {
+    cairo_set_font_size(cr_, r.sub ? sub_size : size);
+    cairo_text_extents_t e;
+    cairo_text_extents(cr_, r.text.c_str(), &e);
+    width += e.x_advance;
+  }
+  const double shift = anchor == Anchor::kStart ? 0.0 : anchor == Anchor::kMiddle ? width / 2 : width;
+  cairo_translate(cr_, x, y);
+  if (rotated) cairo_rotate(cr_, -std::numbers::pi / 2);
+  double at = -shift;
+  for (const auto& r : runs) {
+    cairo_set_font_size(cr_, r.sub ? sub_size : size);
+    cairo_move_to(cr_, at, r.sub ? drop : 0.0);
+    cairo_show_text(cr_, r.text.c_str());
+    cairo_text_extents_t e;
+    cairo_text_extents(cr_, r.text.c_str(), &e);
+    at += e.x_advance;
+  }
+  cairo_restore(cr_);
+  plot_.texts.push_back(plain);
+}
+
+double Canvas::text_width(const std::string& s, double size) {
+  cairo_save(cr_);
+  cairo_select_font_face(cr_, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr_, size);
+  cairo_text_extents_t e;
+  cairo_text_extents(cr_, s.c_str(), &e);
+  cairo_restore(cr_);
+  return e.x_advance;
 }
 
 void Canvas::clip(double x, double y, double w, double h) {

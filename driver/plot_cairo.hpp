@@ -51,6 +51,12 @@ class Canvas {
   /// Text with its baseline at y; rotated: read bottom to top, anchored around (x, y).
   void text(double x, double y, const std::string& s, Anchor anchor = Anchor::kStart, double size = 13.0,
             const char* color = "#000", bool rotated = false, const std::string& kind = "");
+  /// A label the program composes, typeset: "_{...}" is drawn as a subscript ("⟨⟨w_{p}⟩⟩",
+  /// "r_{acc}"); recorded in texts without the markup. User text (names) goes through text().
+  void label(double x, double y, const std::string& s, Anchor anchor = Anchor::kStart, double size = 13.0,
+             bool rotated = false);
+  /// The advance of `s` at `size` (px), for laying out a row of legend entries.
+  double text_width(const std::string& s, double size = 13.0);
   /// Restricts drawing to a rectangle until unclip().
   void clip(double x, double y, double w, double h);
   void unclip();

@@ -178,7 +178,7 @@ TEST(StudyRun, RunsEveryCaseOnceAndQueryCurveMatchesTheCaseSummaries) {
   ASSERT_NE(root, std::string::npos) << svg.substr(0, 200);
   const auto head = svg.substr(root, svg.find('>', root) - root);
   EXPECT_NE(head.find("width=\"1000px\""), std::string::npos) << head;
-  EXPECT_NE(head.find("height=\"440px\""), std::string::npos) << head;
+  EXPECT_NE(head.find("height=\"470px\""), std::string::npos) << head;
   EXPECT_NE(svg.rfind("</svg>"), std::string::npos);
   std::size_t paths = 0;
   for (auto pos = svg.find("<path"); pos != std::string::npos; pos = svg.find("<path", pos + 1)) ++paths;

@@ -310,7 +310,7 @@ TEST(CurvePlot, DrawsBothPanelsWithErrorBarsReplicasAndThePaperOverlayAsSvgPdfAn
   const std::vector<bd::PaperValue> paper = {{"Ga", 60.0, "r_acc", 1.4, "Fig. 14"},
                                              {"Ga", std::nullopt, "r_acc", 1.6, "text"}};
   const auto plot = bd::curve_plot(pts, "study <s>", &paper);
-  expect_svg(plot.data, 1000, 440);
+  expect_svg(plot.data, 1000, 470);
   EXPECT_EQ(plot.count("panel"), 2);
   EXPECT_EQ(plot.count("group"), 2);     // one line per series in each panel
   EXPECT_EQ(plot.count("errorbar"), 4);  // each point in each panel
@@ -331,7 +331,37 @@ TEST(CurvePlot, DrawsBothPanelsWithErrorBarsReplicasAndThePaperOverlayAsSvgPdfAn
   EXPECT_EQ(png.data.rfind("\x89PNG\r\n\x1a\n", 0), 0u);
   EXPECT_GT(png.data.size(), 2000u);
   EXPECT_EQ(bd::plot::format_of_path("c.svg"), bd::plot::Format::kSvg);
-  EXPECT_EQ(bd::plot::format_of_path("pdf"), bd::plot::Format::kSvg);
+  // Any other extension is refused (a .jpg holding SVG would mislead).
+  EXPECT_THROW(bd::plot::format_of_path("pdf"), boycott::InputError);
+  EXPECT_THROW(bd::plot::format_of_path("c.jpg"), boycott::InputError);
+}
+
+TEST(CurvePlot, OverlaysOnlyTheStudysGroupsDrawsPointsWithoutAnErrorOpenAndTypesetsItsLabels) {
+  std::vector<bd::CurvePoint> pts;
+  for (const double angle : {45.0, 90.0}) {
+    bd::CurvePoint p;
+    p.group = "base";
+    p.angle_deg = angle;
+    p.w_m_s = angle == 90.0 ? -0.08 : -0.15;
+    if (angle == 90.0) p.error.error_m_s = 0.001;  // 45 deg: none
+    p.r_acc = p.w_m_s / -0.08;
+    if (angle == 90.0) p.r_acc_err = 0.0;
+    pts.push_back(p);
+  }
+  const std::vector<bd::PaperValue> paper = {{"base", 65.0, "mean_settling_velocity_m_s", -0.1816, "Table"},
+                                             {"Sg1.5", 65.0, "mean_settling_velocity_m_s", -0.05, "Fig. 14"},
+                                             {"Ga145.6", std::nullopt, "r_acc", 1.6, "text"}};
+  const auto plot = bd::curve_plot(pts, "s", &paper);
+  EXPECT_EQ(plot.count("paper"), 1);  // the base value; not Sg1.5's nor Ga145.6's
+  EXPECT_TRUE(plot.has_text(
+      "Zeng et al. 2021, group base: stated values (dashed: a peak whose angle is not stated)"));
+  EXPECT_EQ(plot.count("errorbar"), 1);         // 90 deg's <<w_p>>; the 45 deg point is open, barless
+  EXPECT_TRUE(plot.has_text("⟨⟨wp⟩⟩ (mm/s)"));  // w_{p}: p drawn as a subscript
+  EXPECT_TRUE(plot.has_text("racc = ⟨⟨wp⟩⟩ / ⟨⟨wp⟩⟩(90°)"));
+  EXPECT_TRUE(plot.has_text(
+      "error bars: the interval that covers the mean ~68 % of the time (Student's t); open markers: no error "
+      "available"));
+  EXPECT_EQ(plot.data.find("w_p"), std::string::npos);
 }
 
 TEST(ValidationQuery, RowsListExactlyTheStoredErrorKeysWithTheirValues) {
