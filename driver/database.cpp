@@ -1,5 +1,7 @@
 #include "driver/database.hpp"
 
+#include <unistd.h>
+
 #include <sqlite3.h>
 #include <sys/stat.h>
 
@@ -102,10 +104,19 @@ Database::Database(const std::string& path, OpenMode mode, int target_version) :
   struct stat sb {};
   const bool exists = ::stat(path.c_str(), &sb) == 0;
   if (!exists && mode != OpenMode::kCreate) throw DatabaseError(fmt::format("no database at '{}'", path));
+  // A query on a database it may write is opened read-write but query-only: SQLite's last
+  // connection then folds the write-ahead log back and removes the -wal and -shm files it made,
+  // which a read-only connection cannot (and would leave beside the user's database). Where the
+  // file or its folder is not writable it is opened read-only (below, the read-only mount).
+  const bool query_writable =
+      mode == OpenMode::kReadOnly && ::access(path.c_str(), W_OK) == 0 &&
+      ::access((fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path()).c_str(),
+               W_OK) == 0;
   const int flags = mode == OpenMode::kReadOnly
-                        ? SQLITE_OPEN_READONLY
+                        ? (query_writable ? SQLITE_OPEN_READWRITE : SQLITE_OPEN_READONLY)
                         : SQLITE_OPEN_READWRITE | (mode == OpenMode::kCreate ? SQLITE_OPEN_CREATE : 0);
   open(path, flags);
+  if (query_writable) sqlite3_exec(db_, "PRAGMA query_only = 1", nullptr, nullptr, nullptr);
   if (mode == OpenMode::kReadOnly &&
       (sqlite3_exec(db_, "SELECT 1 FROM sqlite_master LIMIT 1", nullptr, nullptr, nullptr) & 0xff) ==
           SQLITE_CANTOPEN) {

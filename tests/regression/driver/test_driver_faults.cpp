@@ -349,6 +349,28 @@ TEST(Queries, ReadOnlyDatabaseIsQueriedWithoutWritingToIt) {
   }
 }
 
+TEST(Queries, ReadOnlyCommandsLeaveNoWalOrShmFilesBehind) {
+  // A finished study's database (WAL mode, its writer gone: no -wal, no -shm): every read-only
+  // command leaves it so, and the data it reads are the same. A query cannot write through its
+  // handle either.
+  TempDir d;
+  const auto db = fake_study_db(d);
+  auto beside = [&] { return fs::exists(db.string() + "-wal") || fs::exists(db.string() + "-shm"); };
+  ASSERT_FALSE(beside());
+  for (const std::vector<std::string>& q : std::vector<std::vector<std::string>>{
+           {"query", "curve", "--db", db.string(), "--study", "small"},
+           {"query", "cases", "--db", db.string()},
+           {"study", "status", (d.path / "s.toml").string(), "--db", db.string()},
+           {"study", "plan", (d.path / "s.toml").string(), "--db", db.string()}}) {
+    const auto r = run(q, d.path);
+    EXPECT_EQ(r.rc, 0) << q[0] << " " << q[1] << ": " << r.err;
+    EXPECT_FALSE(beside()) << q[0] << " " << q[1] << " left a -wal or -shm file";
+  }
+  bd::Database c(db.string(), bd::OpenMode::kReadOnly);
+  EXPECT_THROW(c.exec("DELETE FROM results"), std::exception);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 2);
+}
+
 TEST(Queries, QueryLeavesARollbackJournalDatabaseAsItWas) {
   TempDir d;
   const auto db = fake_study_db(d);
