@@ -3,6 +3,7 @@
 #include <mpi.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -77,22 +78,37 @@ void print_outcome(const std::filesystem::path& dir) {
 // run refused before writing removes it again: see forget_unused_run_folder).
 bool hold_run_folder(const std::string& out_dir, int rank) {
   namespace fs = std::filesystem;
-  int held = 1;
-  std::string holder;
+  enum : int { kHeld = 1, kLocked = 0, kCannotCreate = -1, kStorage = -2 };
+  int state = kHeld;
+  std::string holder, why;
   bool made = false;
   if (rank == 0) {
-    made = !fs::exists(out_dir);
-    fs::create_directories(out_dir);
     std::error_code ec;
-    const auto dir = fs::weakly_canonical(out_dir, ec);
-    const char* parent = std::getenv(kRunFolderLockedEnv);
-    if (!(parent && !ec && fs::path(parent) == dir)) {
-      held = lock_run_folder(out_dir).has_value() ? 1 : 0;
-      if (!held) holder = run_folder_holder(out_dir);
+    made = !fs::exists(out_dir, ec);
+    fs::create_directories(out_dir, ec);
+    if (ec || !fs::is_directory(out_dir)) {
+      // A place the user chose that cannot hold a folder is bad input; a full or failing disk is
+      // a storage error (74), which a study retries.
+      const int e = ec.value();
+      state = e == ENOSPC || e == EIO || e == EDQUOT ? kStorage : kCannotCreate;
+      why = ec ? ec.message() : std::string("it is not a folder");
+    } else {
+      const auto dir = fs::weakly_canonical(out_dir, ec);
+      const char* parent = std::getenv(kRunFolderLockedEnv);
+      if (!(parent && !ec && fs::path(parent) == dir)) {
+        state = lock_run_folder(out_dir).has_value() ? kHeld : kLocked;
+        if (state == kLocked) holder = run_folder_holder(out_dir);
+      }
     }
   }
-  MPI_Bcast(&held, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  if (!held)
+  MPI_Bcast(&state, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (state == kCannotCreate)
+    throw InputError(
+        fmt::format("--out '{}': cannot make the run folder there ({}): choose a folder you can write",
+                    out_dir, why.empty() ? "see rank 0" : why));
+  if (state == kStorage)
+    throw StorageError(fmt::format("--out '{}': cannot make the run folder ({})", out_dir, why));
+  if (state == kLocked)
     throw CheckpointError(fmt::format(
         "run folder '{}' is in use: {} holds its .lock (a `case run` or `study run` still running); "
         "nothing was written",

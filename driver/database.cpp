@@ -104,6 +104,9 @@ Database::Database(const std::string& path, OpenMode mode, int target_version) :
   struct stat sb {};
   const bool exists = ::stat(path.c_str(), &sb) == 0;
   if (!exists && mode != OpenMode::kCreate) throw DatabaseError(fmt::format("no database at '{}'", path));
+  if (exists && S_ISDIR(sb.st_mode))
+    throw DatabaseError(fmt::format("--db '{}' is a folder: name the database file in it (e.g. '{}')", path,
+                                    (fs::path(path) / "study.sqlite").string()));
   // A query on a database it may write is opened read-write but query-only: SQLite's last
   // connection then folds the write-ahead log back and removes the -wal and -shm files it made,
   // which a read-only connection cannot (and would leave beside the user's database). Where the

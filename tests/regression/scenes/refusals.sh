@@ -57,6 +57,12 @@ import json, sys
 p = json.load(open(sys.argv[1])); p["fluid"]["viscosity"] = "thick"; json.dump(p, open(sys.argv[1], "w"))
 PY
 expect 4 "a run folder with a mistyped params.json" "$bin" case run "$case_file" --out "$work/ok" --set time.end=0.02 --set time.average_from=0.01
+# An --out where no folder can be made, a --db that is a folder: a sentence and exit 2.
+expect 2 "--out under /proc" "$bin" case run "$case_file" --out /proc/boycott_x --set time.end=0.02 --set time.average_from=0.01
+grep -q "cannot make the run folder there" "$work/out.txt" || { echo "FAIL: no sentence for --out"; cat "$work/out.txt"; fails=$((fails + 1)); }
+mkdir -p "$work/dbdir"
+expect 2 "--db a folder" "$bin" query curve --db "$work/dbdir" --study x
+grep -q "is a folder: name the database file in it" "$work/out.txt" || { echo "FAIL: no sentence for --db"; cat "$work/out.txt"; fails=$((fails + 1)); }
 # Two `case run` into one folder: the second is refused at once (4) naming the holder's pid, and
 # writes nothing; the first runs on (stopped here by SIGTERM after its first checkpoint, exit 75).
 "$bin" case run "$case_file" --out "$work/busy" --set time.end=5 --set time.average_from=1 \
