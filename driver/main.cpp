@@ -25,6 +25,10 @@
 
 namespace {
 
+// Counts a user gives (jobs, ranks, retries): whole numbers in a range CLI11 names in its message.
+const CLI::Range kCountRange(1, 100000);
+const CLI::Range kRetriesRange(0, 1000);
+
 int run_guarded(const std::function<int()>& fn) {
   try {
     return fn();
@@ -139,11 +143,15 @@ int main(int argc, char** argv) {
   boycott::driver::StudyRunOptions sopt;
   auto* srun =
       study_cmd->add_subcommand("run", "run what is missing, resume interrupted cases, retry failed ones");
-  srun->add_option("study", sopt.study_file, "study file (TOML)")->required();
+  srun->add_option("study", sopt.study_file, "study file (TOML)")->required()->check(CLI::ExistingFile);
   srun->add_option("--db", sopt.db_path, "results database (SQLite)")->required();
-  srun->add_option("--jobs", sopt.jobs, "cases run at once")->capture_default_str();
-  srun->add_option("--retries", sopt.retries, "failed attempts retried per case")->capture_default_str();
-  srun->add_option("--ranks", sopt.ranks, "MPI ranks per case (mpirun -n K)")->capture_default_str();
+  srun->add_option("--jobs", sopt.jobs, "cases run at once")->capture_default_str()->check(kCountRange);
+  srun->add_option("--retries", sopt.retries, "failed attempts retried per case")
+      ->capture_default_str()
+      ->check(kRetriesRange);
+  srun->add_option("--ranks", sopt.ranks, "MPI ranks per case (mpirun -n K)")
+      ->capture_default_str()
+      ->check(kCountRange);
   // For tests and for other solver builds: the command that runs one case.
   bool study_quiet = false;
   srun->add_option("--progress-every", sopt.progress_every_s,
@@ -155,21 +163,21 @@ int main(int argc, char** argv) {
   std::string status_file, status_db;
   int status_retries = 2;
   auto* sstatus = study_cmd->add_subcommand("status", "report the cases of a study and their status");
-  sstatus->add_option("study", status_file, "study file (TOML)")->required();
+  sstatus->add_option("study", status_file, "study file (TOML)")->required()->check(CLI::ExistingFile);
   sstatus->add_option("--db", status_db, "results database (SQLite)")->required();
-  sstatus->add_option("--retries", status_retries, "as given to study run")->capture_default_str();
+  sstatus->add_option("--retries", status_retries, "as given to study run")
+      ->capture_default_str()
+      ->check(kRetriesRange);
   boycott::driver::PlanOptions plan_opt;
   auto* splan = study_cmd->add_subcommand(
       "plan", "list the cases with their state and estimated cost, and the study's wall time; runs nothing");
   splan->add_option("study", plan_opt.study_file, "study file (TOML)")->required()->check(CLI::ExistingFile);
   splan->add_option("--db", plan_opt.db_path,
                     "results database (read if it exists: states and the cost model)");
-  splan->add_option("--jobs", plan_opt.jobs, "cases run at once")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+  splan->add_option("--jobs", plan_opt.jobs, "cases run at once")->capture_default_str()->check(kCountRange);
   splan->add_option("--ranks", plan_opt.ranks, "MPI ranks per case")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kCountRange);
   splan->add_option("--format", plan_opt.format, "table or json")->capture_default_str();
   splan->add_flag("--check-model", plan_opt.check_model,
                   "also predict each finished case from the other finished runs only (leave one out)");
@@ -177,10 +185,12 @@ int main(int argc, char** argv) {
   auto* ssubmit = study_cmd->add_subcommand(
       "submit",
       "submit the pending cases as a Slurm job array (one case per task); the tasks write only run folders");
-  ssubmit->add_option("study", subopt.study_file, "study file (TOML)")->required();
+  ssubmit->add_option("study", subopt.study_file, "study file (TOML)")->required()->check(CLI::ExistingFile);
   ssubmit->add_option("--db", subopt.db_path, "results database (SQLite)")->required();
-  ssubmit->add_option("--scheduler", subopt.scheduler, "the batch system")->required();
-  ssubmit->add_option("--ranks", subopt.ranks, "MPI ranks per case")->capture_default_str();
+  ssubmit->add_option("--scheduler", subopt.scheduler, "the batch system: slurm (the only one)")->required();
+  ssubmit->add_option("--ranks", subopt.ranks, "MPI ranks per case")
+      ->capture_default_str()
+      ->check(kCountRange);
   ssubmit
       ->add_option("--launcher", subopt.launcher, "how a case starts its ranks: srun (--mpi=pmix) or mpirun")
       ->capture_default_str();
@@ -188,7 +198,9 @@ int main(int argc, char** argv) {
   ssubmit->add_option("--partition", subopt.partition, "Slurm partition");
   ssubmit->add_option("--max-running", subopt.max_running, "array tasks at once (%K; 0: no limit)")
       ->capture_default_str();
-  ssubmit->add_option("--retries", subopt.retries, "failed attempts retried per case")->capture_default_str();
+  ssubmit->add_option("--retries", subopt.retries, "failed attempts retried per case")
+      ->capture_default_str()
+      ->check(kRetriesRange);
   ssubmit
       ->add_option("--sbatch-arg", subopt.sbatch_args,
                    "an extra sbatch option (repeatable), e.g. --sbatch-arg=--account=X")
@@ -199,9 +211,11 @@ int main(int argc, char** argv) {
   int collect_retries = 2;
   auto* scollect = study_cmd->add_subcommand(
       "collect", "record the run folders that tasks finished (study submit) in the database; safe to repeat");
-  scollect->add_option("study", collect_file, "study file (TOML)")->required();
+  scollect->add_option("study", collect_file, "study file (TOML)")->required()->check(CLI::ExistingFile);
   scollect->add_option("--db", collect_db, "results database (SQLite)")->required();
-  scollect->add_option("--retries", collect_retries, "as given to study run")->capture_default_str();
+  scollect->add_option("--retries", collect_retries, "as given to study run")
+      ->capture_default_str()
+      ->check(kRetriesRange);
 
   // ---- query ----
   auto* query_cmd = app.add_subcommand("query", "read results from a study database");

@@ -21,7 +21,7 @@ expect_usage --bogus case run "$case_file" --out "$work/never" --bogus
 expect_usage --sideways case run "$case_file" --out "$work/never" --at 0.1 --sideways
 expect_usage nofile.toml case run "$work/nofile.toml" --out "$work/never"
 expect_usage xml query curve --db "$work/none.db" --study s --format xml
-expect_usage "only \`case run\`" study status s.toml --db "$work/none.db" -- -ksp_view
+expect_usage "only \`case run\`" study status "$(dirname "$case_file")/../demo.toml" --db "$work/none.db" -- -ksp_view
 "$bin" --help > /dev/null || fail "--help did not exit 0"
 # case check shows the case's geometry, and an angle that looks like radians gets a warning.
 "$bin" case check "$case_file" --set gravity.angle_deg=1.2 > "$work/out.txt" 2>&1 || fail "case check failed: $(cat "$work/out.txt")"
