@@ -244,7 +244,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   auto j = make_summary(p, sb, timers);
   const bool finished = is_finished_status(sb.status);
   if (wp_series_whole) {
-    report_settling_statistics(j, steps, wp_series, p.time.average_from_s, run.time_s(), finished);
+    report_settling_statistics(j, steps, wp_series, wp_err, finished);
   } else {
     j["settling_velocity_error_method"] = "batch_means";
     if (finished)

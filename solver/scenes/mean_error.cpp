@@ -138,8 +138,8 @@ void report_time_weighted(nlohmann::json& j, const std::string& prefix, const st
 }
 
 void report_settling_statistics(nlohmann::json& j, const StepSeries& s, const std::vector<double>& window,
-                                double window_from_s, double now_s, bool warn) {
-  const WindowError w = window_error(window, window_from_s, now_s);
+                                const WindowError& w, bool warn) {
+  const double window_from_s = w.from_s;
   auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   const double transient_s = report_transient(j, "<w_p>", s, window, window_from_s, warn);
   report_window_error(j, "settling_velocity_", "<w_p>", w, warn, transient_s);

@@ -61,8 +61,9 @@ void report_time_weighted(nlohmann::json& j, const std::string& prefix, const st
 /// settling_velocity_stderr_m_s and the keys of report_window_error, transient_end_s,
 /// average_from_s, the time-weighted mean, settling_velocity_rel_stderr, and their warnings
 /// (with `warn`). One place for the scene at its end and for `case summarize` afterwards.
+/// `w`: window_error of `window` (computed once by the caller, which needs it too).
 void report_settling_statistics(nlohmann::json& j, const StepSeries& s, const std::vector<double>& window,
-                                double window_from_s, double now_s, bool warn);
+                                const WindowError& w, bool warn);
 
 /// The texts of the warnings report_settling_statistics may give (their openings), so that a
 /// recomputation can replace them.

@@ -63,7 +63,7 @@ nlohmann::json resummarize_run(const std::filesystem::path& run_dir) {
       if (!w.is_string() || !is_settling_statistics_warning(w.get<std::string>())) kept.push_back(w);
     j["warnings"] = kept;
   }
-  report_settling_statistics(j, steps, window, p.time.average_from_s, now_s, true);
+  report_settling_statistics(j, steps, window, window_error(window, p.time.average_from_s, now_s), true);
   j["summarized_by_version"] = kVersion;
   return j;
 }
