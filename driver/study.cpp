@@ -15,6 +15,7 @@
 #include "core/input_file.hpp"
 #include "core/key_docs.hpp"
 #include "core/scene_specs.hpp"
+#include "core/toml_lookup.hpp"
 
 namespace boycott::driver {
 namespace {
@@ -54,7 +55,25 @@ void check_known_key(const std::string& key, const std::string& where) {
   for (const auto& n : names)
     if (n == key) return;
   throw InputError(
-      fmt::format("{}: unknown key '{}'{} (see `boycott case keys`)", where, key, did_you_mean(key)));
+      fmt::format("{}: unknown key '{}'{} (see `boycott case keys`)", where, key, did_you_mean(key)), key);
+}
+
+/// "origin:line: " of the line that gives `key` its value in the case being expanded: the study's
+/// [zip] or [matrix], then the group's, then its [group.set], then [base] (the order they are
+/// applied in, latest first); "" where none does (a scene's default, a derived value).
+std::string study_key_location(const toml::table& root, const std::string& origin,
+                               std::optional<std::size_t> group, const std::string& key) {
+  if (key.empty()) return "";
+  const toml::table* gt = nullptr;
+  if (const auto* ga = root["group"].as_array(); ga && group && *group < ga->size())
+    gt = ga->get(*group)->as_table();
+  for (const toml::table* t : {&root, gt})
+    for (const char* part : {"zip", "matrix", "set"})
+      if (const auto* sub = t ? t->get_as<toml::table>(part) : nullptr)
+        if (const auto* n = find_dotted(*sub, key)) return line_prefix(n, origin);
+  if (const auto* base = root.get_as<toml::table>("base"))
+    return line_prefix(find_dotted(*base, key), origin);
+  return "";
 }
 
 /// One axis of the expansion: the keys it sets, and for each point their TOML values.
@@ -188,20 +207,18 @@ void apply_named(CaseParams& p, const std::string& key, const std::string& value
   try {
     apply_override(p, key + "=" + value);
   } catch (const InputError& e) {
-    throw InputError(fmt::format("{}: {}", where, e.what()));
+    throw InputError(fmt::format("{}: {}", where, e.what()), e.key());
   }
 }
 
 }  // namespace
 
-Study expand_study_string(const std::string& text, const std::string& origin) {
-  toml::table root;
-  try {
-    root = toml::parse(text, origin);
-  } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}:{}:{}: malformed TOML: {}", origin, e.source().begin.line,
-                                 e.source().begin.column, e.description()));
-  }
+namespace {
+
+/// The expansion of a parsed study; `at_group` follows the [[group]] being read or expanded, so
+/// that an error in a key's value can be traced to its line.
+Study expand_study(const toml::table& root, const std::string& text, const std::string& origin,
+                   std::optional<std::size_t>& at_group) {
   static const std::set<std::string> kTopKeys = {
       "name", "base", "group", "matrix", "zip", "replicas", "replicas_max", "replicas_target_rel_error"};
   for (const auto& [k, node] : root)
@@ -230,9 +247,9 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
   }
   const CaseParams base = [&] {
     try {
-      return parse_case_string(base_text, origin + " [base]");
+      return parse_case_string(base_text, origin + " [base]", false);
     } catch (const InputError& e) {
-      throw InputError(fmt::format("[base]: {}", e.what()));
+      throw InputError(fmt::format("[base]: {}", e.what()), e.key());
     }
   }();
 
@@ -241,6 +258,7 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
     std::vector<std::pair<std::string, std::string>> sets;
     std::vector<Axis> axes;  ///< the group's own [group.matrix] / [group.zip], before the study's
     ReplicaKeys replicas;
+    std::optional<std::size_t> index;  ///< in the file's [[group]] array; none for the implicit one
   };
   std::vector<Group> groups;
   if (const auto* ga = root["group"].as_array()) {
@@ -248,6 +266,8 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
       const auto* gt = gn.as_table();
       if (!gt) throw InputError("[[group]] entries must be tables");
       Group g;
+      g.index = groups.size();
+      at_group = g.index;
       auto gname = (*gt)["name"].value<std::string>();
       if (!gname || gname->empty())
         throw InputError("[[group]]: every group needs a non-empty string 'name'");
@@ -268,7 +288,7 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
       try {
         g.axes = read_axes(*gt);
       } catch (const InputError& e) {
-        throw InputError(fmt::format("group '{}': {}", g.name, e.what()));
+        throw InputError(fmt::format("group '{}': {}", g.name, e.what()), e.key());
       }
       if (const auto* set = (*gt)["set"].as_table()) {
         std::vector<std::pair<std::string, const toml::node*>> entries;
@@ -287,11 +307,13 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
   } else if (root.contains("group")) {
     throw InputError("'group' must be an array of tables: [[group]]");
   }
-  if (groups.empty()) groups.push_back(Group{"base", {}, {}, {}});
+  if (groups.empty()) groups.push_back(Group{"base", {}, {}, {}, std::nullopt});
+  at_group.reset();
 
   const auto axes = read_axes(root);
   std::map<std::string, std::string> seen;  // id -> "group (values)"
   for (const auto& g : groups) {
+    at_group = g.index;
     s.groups.push_back(g.name);
     std::vector<Axis> all = g.axes;
     all.insert(all.end(), axes.begin(), axes.end());
@@ -328,7 +350,7 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
       try {
         validate(c.params);
       } catch (const InputError& e) {
-        throw InputError(fmt::format("{}: {}", label, e.what()));
+        throw InputError(fmt::format("{}: {}", label, e.what()), e.key());
       }
       c.id = case_id(c.params);
       c.point_id = c.id;
@@ -358,6 +380,24 @@ Study expand_study_string(const std::string& text, const std::string& origin) {
       }
   }
   return s;
+}
+
+}  // namespace
+
+Study expand_study_string(const std::string& text, const std::string& origin) {
+  toml::table root;
+  try {
+    root = toml::parse(text, origin);
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}:{}:{}: malformed TOML: {}", origin, e.source().begin.line,
+                                 e.source().begin.column, e.description()));
+  }
+  std::optional<std::size_t> at_group;
+  try {
+    return expand_study(root, text, origin, at_group);
+  } catch (const InputError& e) {
+    throw InputError(study_key_location(root, origin, at_group, e.key()) + e.what(), e.key());
+  }
 }
 
 StudyCase replica_of(const StudyCase& replica0, int k) {

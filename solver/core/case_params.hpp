@@ -200,7 +200,16 @@ struct CaseParams {
 /// Parses a case file. Unknown keys, wrong types and out-of-range values are InputErrors naming
 /// the key, the value and the limit.
 CaseParams parse_case_file(const std::string& path);
-CaseParams parse_case_string(const std::string& toml_text, const std::string& origin = "<string>");
+/// `name_lines`: an error in a key's value begins "origin:line: " (off where the text is not
+/// the user's own, as a study's [base] written back as TOML).
+CaseParams parse_case_string(const std::string& toml_text, const std::string& origin = "<string>",
+                             bool name_lines = true);
+/// A case file with its --set overrides, validated; an error in a value the file sets names the
+/// file and line ("case.toml:12: fluid.viscosity = -1 is out of range: ...").
+CaseParams load_case_file(const std::string& path, const std::vector<std::string>& overrides);
+/// "origin:line: " of the line of `toml_text` that sets the dotted `key`; "" where none does.
+std::string case_key_location(const std::string& toml_text, const std::string& origin,
+                              const std::string& key);
 /// Parses from JSON (the canonical form written beside every run).
 CaseParams case_from_json(const nlohmann::json& j);
 

@@ -15,6 +15,7 @@
 #include "core/input_file.hpp"
 #include "core/key_docs.hpp"
 #include "core/scene_specs.hpp"
+#include "core/toml_lookup.hpp"
 
 namespace boycott {
 
@@ -35,7 +36,7 @@ namespace {
 // ---- conversions from a generic node (TOML or JSON, through a small adaptor) ----
 
 [[noreturn]] void type_error(const char* key, const char* want, const std::string& got) {
-  throw InputError(fmt::format("{} must be {}, got {}", key, want, got));
+  throw InputError(fmt::format("{} must be {}, got {}", key, want, got), key);
 }
 
 std::string toml_repr(const toml::node& n) {
@@ -164,9 +165,15 @@ CaseParams from_toml_table(const toml::table& tbl) {
   collect_toml_keys(tbl, "", present);
   for (const auto& k : present) {
     if (!known.count(k))
-      throw InputError(fmt::format("unknown key '{}'{} (see `boycott case keys`)", k, did_you_mean(k)));
+      throw InputError(fmt::format("unknown key '{}'{} (see `boycott case keys`)", k, did_you_mean(k)), k);
   }
   return p;
+}
+
+/// The line of `origin` that sets `key` in `tbl` ("origin:line: "), or "" where no node of the
+/// table holds it (a default, a --set, a key written with quoted dots).
+std::string location_in(const toml::table& tbl, const std::string& origin, const std::string& key) {
+  return line_prefix(find_dotted(tbl, key), origin);
 }
 
 }  // namespace
@@ -196,20 +203,55 @@ bool is_set_key(const CaseParams& p, const std::string& key) {
 }
 }  // namespace case_keys
 
-CaseParams parse_case_string(const std::string& text, const std::string& origin) {
-  toml::table tbl;
+namespace {
+toml::table parse_toml(const std::string& text, const std::string& origin) {
   try {
-    tbl = toml::parse(text, origin);
+    return toml::parse(text, origin);
   } catch (const toml::parse_error& e) {
     const auto& src = e.source();
     throw InputError(fmt::format("{}:{}:{}: malformed TOML: {}", origin, src.begin.line, src.begin.column,
                                  e.description()));
   }
-  return from_toml_table(tbl);
+}
+}  // namespace
+
+CaseParams parse_case_string(const std::string& text, const std::string& origin, bool name_lines) {
+  const toml::table tbl = parse_toml(text, origin);
+  try {
+    return from_toml_table(tbl);
+  } catch (const InputError& e) {
+    if (e.key().empty() || !name_lines) throw;
+    throw InputError(location_in(tbl, origin, e.key()) + e.what(), e.key());
+  }
+}
+
+std::string case_key_location(const std::string& text, const std::string& origin, const std::string& key) {
+  try {
+    return location_in(toml::parse(text, origin), origin, key);
+  } catch (const toml::parse_error&) {
+    return "";
+  }
 }
 
 CaseParams parse_case_file(const std::string& path) {
   return parse_case_string(read_input_file(path, "case file"), path);
+}
+
+CaseParams load_case_file(const std::string& path, const std::vector<std::string>& overrides) {
+  const std::string text = read_input_file(path, "case file");
+  CaseParams p = parse_case_string(text, path);
+  for (const auto& s : overrides) apply_override(p, s);
+  try {
+    validate(p);
+  } catch (const InputError& e) {
+    // The line is named where the file set the value at fault, not where --set did.
+    const bool from_set = std::any_of(overrides.begin(), overrides.end(), [&](const std::string& s) {
+      return s.rfind(e.key() + "=", 0) == 0 || s.rfind(e.key() + " ", 0) == 0;
+    });
+    if (e.key().empty() || from_set) throw;
+    throw InputError(case_key_location(text, path, e.key()) + e.what(), e.key());
+  }
+  return p;
 }
 
 CaseParams case_from_json(const nlohmann::json& j) {

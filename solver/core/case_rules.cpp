@@ -103,7 +103,8 @@ void resolve_defaults(CaseParams& p, const SceneSpec& sc) {
 
 }  // namespace
 
-void validate(CaseParams& p) {
+namespace {
+void check_case(CaseParams& p) {
   visit_keys(p, [&](const char* key, auto& ref, const Rule& r) {
     check_value(key, ref, r);
     // An optional key's NaN means "not set"; set by the user, it is a value, and not a finite one.
@@ -174,13 +175,14 @@ void validate(CaseParams& p) {
     if (std::abs(ratio - std::round(ratio)) > 1e-6 * ratio)
       throw InputError(
           fmt::format("time.dt_cfd / time.dt_dem = {} must be a whole number of DEM sub-steps", ratio));
-    // A run stops (signal, Slurm's warning) between fluid steps: a fluid step of more sub-steps
-    // than this could not be stopped in any reasonable time (the paper's cases take 50).
+    // The paper's cases take 50 sub-steps per fluid step. A long step is stoppable inside its
+    // sub-steps (CoupledSystem::set_interrupt), but a stop drops the whole step: beyond this
+    // many, one step is more work than a run should risk losing, and no case needs it.
     constexpr double kMaxSubsteps = 1e5;
     if (ratio > kMaxSubsteps * (1.0 + 1e-9))
       throw InputError(
           fmt::format("time.dt_cfd / time.dt_dem = {:.6g} DEM sub-steps per fluid step: must be at "
-                      "most {:g} (a run stops only between fluid steps)",
+                      "most {:g} (a stop drops the unfinished fluid step; the paper's cases take 50)",
                       ratio, kMaxSubsteps));
   }
   // A step so small that the run would not end in any time a machine has.
@@ -228,6 +230,25 @@ void validate(CaseParams& p) {
   if (reads("numerics.neighbor_skin") && p.numerics.neighbor_skin_m > d)
     throw InputError(fmt::format("numerics.neighbor_skin = {} m must be <= particles.diameter = {} m",
                                  fmt_num(p.numerics.neighbor_skin_m), fmt_num(d)));
+}
+
+}  // namespace
+
+void validate(CaseParams& p) {
+  try {
+    check_case(p);
+  } catch (const InputError& e) {
+    if (!e.key().empty()) throw;
+    // Every message of check_case begins with the key at fault ("time.dt_dem = ..."): named as the
+    // error's key, a caller holding the file can say which line set it.
+    std::string key;
+    const std::string what = e.what();
+    for (const auto& k : case_key_names())
+      if (what.rfind(k, 0) == 0 && what.size() > k.size() &&
+          (what[k.size()] == ' ' || what[k.size()] == ':') && k.size() > key.size())
+        key = k;
+    throw InputError(what, key);
+  }
 }
 
 }  // namespace boycott

@@ -3,6 +3,7 @@
 // bad input (never retried) from a run that went unstable (retry may help after a change).
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace boycott {
 
@@ -17,10 +18,16 @@ enum ExitCode : int {
   kExitInterrupted = 75,  ///< stopped by SIGINT/SIGTERM after writing a checkpoint (EX_TEMPFAIL)
 };
 
-/// Bad input: names the field, the value and the limit.
+/// Bad input: names the field, the value and the limit. `key()` is the case key at fault where
+/// there is one, so that a caller holding the file can add the line that sets it.
 class InputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+  InputError(const std::string& what, std::string key) : std::runtime_error(what), key_(std::move(key)) {}
+  const std::string& key() const { return key_; }
+
+ private:
+  std::string key_;
 };
 
 /// A run that left the physically admissible state; raised before anything is checkpointed.

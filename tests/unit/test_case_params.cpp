@@ -1,3 +1,6 @@
+#include <filesystem>
+#include <fstream>
+
 #include <gtest/gtest.h>
 
 #include "core/case_params.hpp"
@@ -43,6 +46,38 @@ TEST(CaseParams, ParsesTomlAndRejectsUnknownKeys) {
   }
   EXPECT_THROW(parse_case_string("[fluid\nviscosity = 1"), InputError);
   EXPECT_THROW(parse_case_string("[fluid]\nviscosity = \"thick\""), InputError);
+}
+
+TEST(CaseParams, AnErrorInAFileNamesTheFileAndLine) {
+  const auto dir = std::filesystem::temp_directory_path() / "boycott_case_lines";
+  std::filesystem::create_directories(dir);
+  auto message = [&](const std::string& text, const std::vector<std::string>& sets = {}) {
+    const auto file = (dir / "c.toml").string();
+    std::ofstream(file) << text;
+    try {
+      load_case_file(file, sets);
+    } catch (const InputError& e) {
+      // The path's folder varies with the machine: compared from the file's name on.
+      const std::string what = e.what();
+      const auto at = what.find("c.toml");
+      return at == std::string::npos ? what : what.substr(at);
+    }
+    return std::string("accepted");
+  };
+  const std::string head = "scene = \"single_particle\"\n# a comment\n[fluid]\n";
+  EXPECT_EQ(message(head + "viscosty = 1e-3\n").rfind("c.toml:4: unknown key 'fluid.viscosty'", 0), 0u);
+  EXPECT_EQ(message(head + "viscosity = \"abc\"\n").rfind("c.toml:4: fluid.viscosity must be a number", 0),
+            0u);
+  EXPECT_EQ(message(head + "density = 1000\nviscosity = -1\n").rfind("c.toml:5: fluid.viscosity = -1", 0),
+            0u);
+  // Limits between keys name the line of the key the message begins with.
+  EXPECT_EQ(message("scene = \"inclined_settling\"\n[time]\nend = 1\naverage_from = 2\n")
+                .rfind("c.toml:4: time.average_from = 2 s must be < time.end", 0),
+            0u);
+  // A value given by --set is not the file's: no line of the file is named.
+  const std::string from_set = message(head + "density = 1000\n", {"fluid.viscosity=-1"});
+  EXPECT_EQ(from_set.find("c.toml:"), std::string::npos) << from_set;
+  std::filesystem::remove_all(dir);
 }
 
 TEST(CaseParams, ValidationNamesFieldValueAndLimit) {

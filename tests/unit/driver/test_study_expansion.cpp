@@ -230,6 +230,38 @@ TEST(StudyExpansionErrors, NameTheOffendingKey) {
     EXPECT_EQ(error_of(bad).find('\n'), std::string::npos) << "errors are one line";
 }
 
+TEST(StudyExpansionErrors, NameTheFileAndTheLineThatSetTheValue) {
+  auto message = [](const std::string& text) {
+    try {
+      bd::expand_study_string(text, "s.toml");
+    } catch (const boycott::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  // [base] (as a sub-table), a group's set (inline and as a table), the study's [matrix] with a
+  // quoted dotted key, and an unknown key: each names the line that wrote it.
+  EXPECT_EQ(message("name = \"x\"\n[base.fluid]\nviscosity = \"thick\"\n").rfind("s.toml:3: ", 0), 0u)
+      << message("name = \"x\"\n[base.fluid]\nviscosity = \"thick\"\n");
+  const std::string group_set =
+      "name = \"x\"\n[base]\ntime.end = 1\ntime.average_from = 0.5\n[[group]]\nname = \"a\"\n[[group]]\n"
+      "name = \"b\"\n[group.set]\nfluid.viscosity = -2e-3\n";
+  EXPECT_EQ(message(group_set).rfind("s.toml:10: group 'b'", 0), 0u) << message(group_set);
+  const std::string matrix =
+      "name = \"x\"\n[base]\ntime.end = 1\ntime.average_from = 0.5\n[matrix]\n\"gravity.angle_deg\" = [30, "
+      "600]\n";
+  EXPECT_EQ(message(matrix).rfind("s.toml:6: ", 0), 0u) << message(matrix);
+  EXPECT_NE(message(matrix).find("gravity.angle_deg = 600 is out of range"), std::string::npos);
+  // The study's [matrix] is applied after [base]: the line named is the value that was used.
+  const std::string both =
+      "name = \"x\"\n[base]\ngravity.angle_deg = 95\ntime.end = 1\n"
+      "time.average_from = 0.5\n[matrix]\ngravity.angle_deg = [95]\n";
+  EXPECT_EQ(message(both).rfind("s.toml:7: ", 0), 0u) << message(both);
+  EXPECT_EQ(message("name = \"x\"\n\n[matrix]\n\"gravity.angel_deg\" = [10]\n").rfind("s.toml:4: ", 0), 0u);
+  // A value no line sets (a scene's default against a key the file sets) names no line.
+  EXPECT_EQ(message("name = \"x\"\n[base]\ntime.end = 0.1\n").find("s.toml:"), std::string::npos);
+}
+
 TEST(StudyLauncher, WrapsTheCaseInMpirunForSeveralRanks) {
   const auto one = bd::case_command({"boycott"}, 1, "c.toml", "d");
   EXPECT_EQ(one, (std::vector<std::string>{"boycott", "case", "run", "c.toml", "--out", "d", "--quiet"}));
