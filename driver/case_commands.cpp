@@ -19,6 +19,8 @@
 #include "core/key_docs.hpp"
 #include "driver/case_progress.hpp"
 #include "driver/database.hpp"
+#include "driver/listing_format.hpp"
+#include "driver/report_util.hpp"
 #include "driver/run_folder_lock.hpp"
 #include "driver/store.hpp"
 #include "fluid/petsc_session.hpp"
@@ -44,12 +46,6 @@ void install_stop_handlers() {
   sigaction(SIGUSR1, &sa, nullptr);  // a Slurm task's wall-time warning (study submit)
 }
 
-CaseParams load(const std::string& file, const std::vector<std::string>& sets) {
-  CaseParams p = parse_case_file(file);
-  for (const auto& s : sets) apply_override(p, s);
-  validate(p);
-  return p;
-}
 /// One line at the end of a run: its status, how far, how long, and its main result.
 void print_outcome(const std::filesystem::path& dir) {
   try {
@@ -130,7 +126,7 @@ void forget_unused_run_folder(const std::string& out_dir, bool made) {
 }  // namespace
 
 int case_run(const CaseRunOptions& opt, int argc, char** argv) {
-  CaseParams p = load(opt.case_file, opt.overrides);
+  CaseParams p = load_case_file(opt.case_file, opt.overrides);
   std::string petsc_opts = "-no_signal_handler";
   for (const auto& o : opt.petsc_options) petsc_opts += " " + o;
   int pargc = 1;
@@ -180,7 +176,7 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv) {
 }
 
 int case_check(const std::string& file, const std::vector<std::string>& sets) {
-  CaseParams p = load(file, sets);
+  CaseParams p = load_case_file(file, sets);
   const scenes::Preflight pre = scenes::preflight(p);
   std::printf("case %s (scene %s): %s\n", case_id(p).c_str(), p.scene.c_str(),
               pre.errors.empty()
@@ -232,8 +228,7 @@ int case_summarize(const std::vector<std::string>& run_dirs, const std::string& 
 }
 
 int case_keys(const std::string& scene, const std::string& format) {
-  if (format != "table" && format != "json")
-    throw InputError(fmt::format("--format '{}': expected table or json", format));
+  const ListingFormat listing = parse_listing_format(format);
   // A scene's keys at its own defaults (resolved for Table III's box), or every key.
   CaseParams p;
   if (!scene.empty()) {
@@ -253,8 +248,19 @@ int case_keys(const std::string& scene, const std::string& format) {
     out.push_back({{"key", k}, {"default", value}, {"unit", unit}, {"meaning", meaning}});
     table += fmt::format("{:<38} {:<22} {:<7} {}\n", k, value.dump(), unit, meaning);
   }
-  if (format == "json") {
+  if (listing == ListingFormat::kJson) {
     std::printf("%s\n", out.dump(1).c_str());
+    return 0;
+  }
+  if (listing == ListingFormat::kCsv) {
+    // The default as its JSON text (a string quoted, an array bracketed), as the table shows it.
+    std::string csv = "key,default,unit,meaning\n";
+    for (const auto& r : out)
+      csv +=
+          fmt::format("{},{},{},{}\n", report::csv_field(r["key"].get<std::string>()),
+                      report::csv_field(r["default"].dump()), report::csv_field(r["unit"].get<std::string>()),
+                      report::csv_field(r["meaning"].get<std::string>()));
+    std::fputs(csv.c_str(), stdout);
     return 0;
   }
   if (!scene.empty()) std::printf("scene %s: %s\n", scene.c_str(), scene_spec(scene).measures.c_str());

@@ -14,21 +14,14 @@ namespace boycott::driver {
 
 using report::ticks;
 
-CurveFormat parse_curve_format(const std::string& s) {
-  if (s == "table") return CurveFormat::kTable;
-  if (s == "csv") return CurveFormat::kCsv;
-  if (s == "json") return CurveFormat::kJson;
-  throw InputError(fmt::format("--format {} is not known: must be table, csv or json", s));
-}
-
-std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
+std::string format_curve(const std::vector<CurvePoint>& pts, ListingFormat f) {
   std::string s;
   auto opt = [](const std::optional<double>& v) { return v ? fmt::format("{:.6g}", *v) : std::string(); };
   auto opt9 = [](const std::optional<double>& v) { return v ? fmt::format("{:.9g}", *v) : std::string(); };
   auto opt_json = [](const std::optional<double>& v) {
     return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
   };
-  if (f == CurveFormat::kCsv) {
+  if (f == ListingFormat::kCsv) {
     s = "group,angle_deg,mean_settling_velocity_m_s,error_m_s,error_basis,stderr_m_s,n_replicas,"
         "between_replica_stderr_m_s,mean_within_run_stderr_m_s,r_acc,r_acc_err,error_method,case_id,"
         "setting\n";
@@ -38,7 +31,7 @@ std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f) {
                        opt9(p.w_err_m_s), p.n_replicas, opt9(p.between_replica_stderr_m_s),
                        opt9(p.mean_within_run_stderr_m_s), opt(p.r_acc), opt(p.r_acc_err), p.error_method,
                        p.case_id, report::csv_field(p.setting));
-  } else if (f == CurveFormat::kJson) {
+  } else if (f == ListingFormat::kJson) {
     nlohmann::json j = nlohmann::json::array();
     for (const auto& p : pts) {
       nlohmann::json e = {{"group", p.group},
@@ -250,13 +243,15 @@ plot::Plot curve_plot(const std::vector<CurvePoint>& pts, const std::string& tit
   });
 }
 
-std::string format_cases(const std::vector<CaseState>& cases) {
-  std::string s = fmt::format("{:<12} {:<12} {:<16} {:>6} {:<12} {:>8}  {}\n", "study", "group", "case",
-                              "angle", "status", "failures", "last error");
+std::string format_cases(const std::vector<CaseState>& cases, ListingFormat f) {
+  report::TextTable t({"study", "group", "case", "angle_deg", "status", "failures", "last_error"},
+                      {false, false, false, true, false, true, false});
   for (const auto& c : cases)
-    s += fmt::format("{:<12} {:<12} {:<16} {:>6g} {:<12} {:>8}  {}\n", c.study, c.group, c.id, c.angle_deg,
-                     to_string(c.status), c.failures, c.status == CaseStatus::kDone ? "" : c.last_error);
-  return s;
+    t.add({c.study, c.group, c.id, fmt::format("{:g}", c.angle_deg), to_string(c.status),
+           std::to_string(c.failures), c.status == CaseStatus::kDone ? "" : c.last_error});
+  if (f == ListingFormat::kCsv) return t.csv();
+  if (f == ListingFormat::kJson) return t.json().dump(2) + "\n";
+  return t.str();
 }
 
 }  // namespace boycott::driver

@@ -4,16 +4,14 @@
 #include <string>
 #include <vector>
 
+#include "driver/listing_format.hpp"
 #include "driver/paper_reference.hpp"
 #include "driver/plot_cairo.hpp"
 #include "driver/store.hpp"
 
 namespace boycott::driver {
 
-enum class CurveFormat { kTable, kCsv, kJson };
-CurveFormat parse_curve_format(const std::string& s);
-
-std::string format_curve(const std::vector<CurvePoint>& pts, CurveFormat f);
+std::string format_curve(const std::vector<CurvePoint>& pts, ListingFormat f);
 /// Both panels, one line per group with error bars (capped), each replica as a faint dot; with
 /// `paper`, the values Zeng et al. (2021) state (driver/paper_reference.hpp) as hollow diamonds.
 /// Drawn with Cairo as SVG, PDF or PNG (driver/plot_cairo.hpp).
@@ -21,6 +19,7 @@ plot::Plot curve_plot(const std::vector<CurvePoint>& pts, const std::string& tit
                       const std::vector<PaperValue>* paper = nullptr,
                       plot::Format format = plot::Format::kSvg);
 
-std::string format_cases(const std::vector<CaseState>& cases);
+/// `query cases`: one row per case with its status and, unless done, its last error.
+std::string format_cases(const std::vector<CaseState>& cases, ListingFormat f);
 
 }  // namespace boycott::driver

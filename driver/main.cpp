@@ -28,6 +28,14 @@ namespace {
 // Counts a user gives (jobs, ranks, retries): whole numbers in a range CLI11 names in its message.
 const CLI::Range kCountRange(1, 100000);
 const CLI::Range kRetriesRange(0, 1000);
+// Every listing command's --format: the same choices, listed in help, refused alike.
+const CLI::IsMember kFormatChoices({"table", "csv", "json"});
+
+CLI::Option* add_format(CLI::App* cmd, std::string& format) {
+  return cmd->add_option("--format", format, "table, csv or json")
+      ->capture_default_str()
+      ->check(kFormatChoices);
+}
 
 int run_guarded(const std::function<int()>& fn) {
   try {
@@ -124,7 +132,7 @@ int main(int argc, char** argv) {
   auto* keys = case_cmd->add_subcommand("keys", "list every case key and its default (or a scene's)");
   keys->add_option("--scene", keys_scene, "only the keys this scene reads, at its defaults");
   std::string keys_format = "table";
-  keys->add_option("--format", keys_format, "table or json")->capture_default_str();
+  add_format(keys, keys_format);
 
   std::vector<std::string> summarize_dirs;
   std::string summarize_db;
@@ -160,7 +168,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   srun->add_flag("--quiet", study_quiet, "no progress output");
   srun->add_option("--solver-command", sopt.solver_command, "")->group("");
-  std::string status_file, status_db;
+  std::string status_file, status_db, status_format = "table";
   int status_retries = 2;
   auto* sstatus = study_cmd->add_subcommand("status", "report the cases of a study and their status");
   sstatus->add_option("study", status_file, "study file (TOML)")->required()->check(CLI::ExistingFile);
@@ -168,6 +176,7 @@ int main(int argc, char** argv) {
   sstatus->add_option("--retries", status_retries, "as given to study run")
       ->capture_default_str()
       ->check(kRetriesRange);
+  add_format(sstatus, status_format);
   boycott::driver::PlanOptions plan_opt;
   auto* splan = study_cmd->add_subcommand(
       "plan", "list the cases with their state and estimated cost, and the study's wall time; runs nothing");
@@ -178,7 +187,7 @@ int main(int argc, char** argv) {
   splan->add_option("--ranks", plan_opt.ranks, "MPI ranks per case")
       ->capture_default_str()
       ->check(kCountRange);
-  splan->add_option("--format", plan_opt.format, "table or json")->capture_default_str();
+  add_format(splan, plan_opt.format);
   splan->add_flag("--check-model", plan_opt.check_model,
                   "also predict each finished case from the other finished runs only (leave one out)");
   boycott::driver::SlurmSubmitOptions subopt;
@@ -225,7 +234,7 @@ int main(int argc, char** argv) {
   qcurve->add_option("--db", q_db, "results database")->required();
   qcurve->add_option("--study", q_study, "study name")->required();
   qcurve->add_option("--group", q_group, "only this group");
-  qcurve->add_option("--format", q_format, "table, csv or json")->capture_default_str();
+  add_format(qcurve, q_format);
   qcurve->add_option(
       "--plot", q_plot,
       "also draw the curves (like Fig. 14 of the paper): PDF for FILE.pdf, PNG for FILE.png, SVG otherwise");
@@ -237,7 +246,7 @@ int main(int argc, char** argv) {
       "per finished case: the scene's measured errors against its reference, and the wall time");
   qvalid->add_option("--db", q_db, "results database")->required();
   qvalid->add_option("--study", q_study, "only this study");
-  qvalid->add_option("--format", q_format, "table, csv or json")->capture_default_str();
+  add_format(qvalid, q_format);
   std::string q_reference = "reference";
   auto* qwork = query_cmd->add_subcommand(
       "work-precision", "error of <<w_p>> and r_acc against the reference group, and the run time it cost");
@@ -245,13 +254,14 @@ int main(int argc, char** argv) {
   qwork->add_option("--study", q_study, "study name")->required();
   qwork->add_option("--reference", q_reference, "group holding the reference runs, one per angle")
       ->capture_default_str();
-  qwork->add_option("--format", q_format, "table, csv or json")->capture_default_str();
+  add_format(qwork, q_format);
   qwork->add_option(
       "--plot", q_plot,
       "also draw |error| against wall time (log-log): PDF for FILE.pdf, PNG for FILE.png, SVG otherwise");
   auto* qcases = query_cmd->add_subcommand("cases", "list cases and their status");
   qcases->add_option("--db", q_db, "results database")->required();
   qcases->add_option("--study", q_study, "only this study");
+  add_format(qcases, q_format);
 
   // Everything after the first `--` is for PETSc; before it, a word the program does not know is
   // a usage error (exit 2), never handed on.
@@ -294,11 +304,12 @@ int main(int argc, char** argv) {
   if (sstatus->parsed())
     return run_guarded([&] {
       require_db_path(status_db);
-      return boycott::driver::study_status(status_file, status_db, status_retries);
+      return boycott::driver::study_status(status_file, status_db, status_retries,
+                                           boycott::driver::parse_listing_format(status_format));
     });
   if (qcurve->parsed())
     return run_guarded([&] {
-      const auto fmt_kind = boycott::driver::parse_curve_format(q_format);
+      const auto fmt_kind = boycott::driver::parse_listing_format(q_format);
       if (q_overlay_paper && q_plot.empty())
         throw boycott::InputError("--overlay-paper draws on the plot: give --plot FILE.svg (or .pdf) too");
       auto db = open_for_query(q_db);
@@ -322,7 +333,7 @@ int main(int argc, char** argv) {
     });
   if (qvalid->parsed())
     return run_guarded([&] {
-      const auto fmt_kind = boycott::driver::parse_curve_format(q_format);
+      const auto fmt_kind = boycott::driver::parse_listing_format(q_format);
       auto db = open_for_query(q_db);
       const auto rows = boycott::driver::query_validation(db, q_study);
       std::fputs(boycott::driver::format_validation(rows, fmt_kind).c_str(), stdout);
@@ -330,7 +341,7 @@ int main(int argc, char** argv) {
     });
   if (qwork->parsed())
     return run_guarded([&] {
-      const auto fmt_kind = boycott::driver::parse_curve_format(q_format);
+      const auto fmt_kind = boycott::driver::parse_listing_format(q_format);
       auto db = open_for_query(q_db);
       const auto wp = boycott::driver::query_work_precision(db, q_study, q_reference);
       if (wp.rows.empty())
@@ -351,7 +362,10 @@ int main(int argc, char** argv) {
   if (qcases->parsed())
     return run_guarded([&] {
       auto db = open_for_query(q_db);
-      std::fputs(boycott::driver::format_cases(boycott::driver::case_states(db, q_study, 2)).c_str(), stdout);
+      std::fputs(boycott::driver::format_cases(boycott::driver::case_states(db, q_study, 2),
+                                               boycott::driver::parse_listing_format(q_format))
+                     .c_str(),
+                 stdout);
       return 0;
     });
 

@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "driver/cost_model.hpp"
+#include "driver/listing_format.hpp"
 #include "driver/progress.hpp"
 #include "driver/report_util.hpp"
 #include "driver/store.hpp"
@@ -72,8 +73,7 @@ std::string plan_summary_line(Database& db, const Study& study, const std::vecto
 }
 
 int study_plan(const PlanOptions& opt) {
-  if (opt.format != "table" && opt.format != "json")
-    throw InputError(fmt::format("--format '{}': expected table or json", opt.format));
+  const ListingFormat format = parse_listing_format(opt.format);
   if (opt.jobs < 1 || opt.ranks < 1) throw InputError("--jobs and --ranks must be at least 1");
   const Study study = expand_study_file(opt.study_file);
   // The plan reads an existing database and creates none.
@@ -127,7 +127,31 @@ int study_plan(const PlanOptions& opt) {
     rows.push_back(row);
   }
   const double wall = study_wall_s(pending_costs, opt.jobs, opt.ranks);
-  if (opt.format == "json") {
+  if (format == ListingFormat::kCsv) {
+    // The rows with their numbers in seconds (the table shows them for people).
+    const char* cols[] = {"group",           "swept",
+                          "case_id",         "state",
+                          "scene",           "estimated_core_s",
+                          "measured_core_s", "predicted_by_others_core_s",
+                          "cost_basis"};
+    std::string out;
+    for (const char* c : cols) out += fmt::format("{}{}", out.empty() ? "" : ",", c);
+    out += "\n";
+    for (const auto& r : rows) {
+      std::string line;
+      for (const char* c : cols) {
+        const auto v = r.value(c, nlohmann::json());
+        const std::string cell = v.is_string() ? v.get<std::string>()
+                                 : v.is_null() ? ""
+                                               : fmt::format("{:.6g}", v.get<double>());
+        line += (c == cols[0] ? "" : ",") + report::csv_field(cell);
+      }
+      out += line + "\n";
+    }
+    std::fputs(out.c_str(), stdout);
+    return 0;
+  }
+  if (format == ListingFormat::kJson) {
     std::printf("%s\n", nlohmann::json{{"study", study.name},
                                        {"cases", rows},
                                        {"jobs", opt.jobs},

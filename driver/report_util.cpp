@@ -2,8 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "driver/listing_format.hpp"
+
+namespace boycott::driver {
+
+ListingFormat parse_listing_format(const std::string& s) {
+  if (s == "table") return ListingFormat::kTable;
+  if (s == "csv") return ListingFormat::kCsv;
+  if (s == "json") return ListingFormat::kJson;
+  throw InputError(fmt::format("--format {} is not known: must be table, csv or json", s));
+}
+
+}  // namespace boycott::driver
 
 namespace boycott::driver::report {
 
@@ -113,11 +128,42 @@ std::string TextTable::str() const {
       if (c) s += "  ";
       s += right_[c] ? pad + cells[c] : (last ? cells[c] : cells[c] + pad);
     }
+    // An empty last cell leaves no padding at the end of the line.
+    s.erase(s.find_last_not_of(' ') + 1);
     return s + "\n";
   };
   std::string s = line(header_);
   for (const auto& r : rows_) s += line(r);
   return s;
+}
+
+std::string TextTable::csv() const {
+  auto line = [](const std::vector<std::string>& cells) {
+    std::string s;
+    for (std::size_t c = 0; c < cells.size(); ++c) s += (c ? "," : "") + csv_field(cells[c]);
+    return s + "\n";
+  };
+  std::string s = line(header_);
+  for (const auto& r : rows_) s += line(r);
+  return s;
+}
+
+nlohmann::json TextTable::json() const {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& r : rows_) {
+    nlohmann::json o = nlohmann::json::object();
+    for (std::size_t c = 0; c < header_.size(); ++c) {
+      if (!right_[c]) {
+        o[header_[c]] = r[c];
+        continue;
+      }
+      char* end = nullptr;
+      const double v = std::strtod(r[c].c_str(), &end);
+      o[header_[c]] = !r[c].empty() && end && *end == '\0' ? nlohmann::json(v) : nlohmann::json(nullptr);
+    }
+    out.push_back(std::move(o));
+  }
+  return out;
 }
 
 }  // namespace boycott::driver::report

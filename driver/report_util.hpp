@@ -41,6 +41,11 @@ class TextTable {
   TextTable(std::vector<std::string> header, std::vector<bool> right_aligned);
   void add(std::vector<std::string> row);
   std::string str() const;
+  /// The same rows as CSV (header first).
+  std::string csv() const;
+  /// The same rows as an array of objects keyed by the header; a number column's cell is a JSON
+  /// number, and null where it holds none ("-" or empty).
+  nlohmann::json json() const;
 
  private:
   std::vector<std::string> header_;

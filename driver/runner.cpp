@@ -17,6 +17,7 @@
 #include "driver/plan.hpp"
 #include "driver/progress.hpp"
 #include "driver/replica_rounds.hpp"
+#include "driver/report_util.hpp"
 #include "driver/run_tree.hpp"
 #include "driver/scheduler.hpp"
 #include "driver/slurm.hpp"
@@ -121,13 +122,14 @@ int study_run(const StudyRunOptions& opt) {
   // sediment_transport) each finished case's validation errors against their tolerances.
   const auto curve = query_curve(db, study.name);
   if (!curve.empty() || done == 0)
-    std::fputs(format_curve(curve, CurveFormat::kTable).c_str(), stdout);
+    std::fputs(format_curve(curve, ListingFormat::kTable).c_str(), stdout);
   else
-    std::fputs(format_validation(query_validation(db, study.name), CurveFormat::kTable).c_str(), stdout);
+    std::fputs(format_validation(query_validation(db, study.name), ListingFormat::kTable).c_str(), stdout);
   return failed > 0 ? kExitFailure : kExitOk;
 }
 
-int study_status(const std::string& study_file, const std::string& db_path, int retries) {
+int study_status(const std::string& study_file, const std::string& db_path, int retries,
+                 ListingFormat format) {
   const Study study = expand_study_file(study_file);
   // No database yet: every case is pending, and status (which only reads) creates none.
   std::optional<Database> db;
@@ -151,7 +153,15 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
   }
   int uncollected = 0;
   std::map<std::string, int> counts;
-  std::string lines;
+  std::vector<std::string> header = {"case", "group", "angle_deg", "status", "ranks"};
+  std::vector<bool> numeric = {false, false, true, false, true};
+  if (!jobs.empty()) {
+    header.push_back("slurm_job");
+    numeric.push_back(false);
+  }
+  header.push_back("last_error");
+  numeric.push_back(false);
+  report::TextTable table(header, numeric);
   for (const auto& c : study.cases) {
     auto it = known.find(c.id);
     const char* st = it == known.end() ? "pending" : to_string(it->second.status);
@@ -164,13 +174,27 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
     if ((it == known.end() || it->second.status != CaseStatus::kDone) &&
         finished_summary_in(fs::path(runs_root(db_path)) / c.id, c.id))
       ++uncollected;
-    const std::string ranks =
-        it != known.end() && it->second.ranks > 0 ? std::to_string(it->second.ranks) : "-";
-    const std::string job_col =
-        jobs.empty() ? "" : fmt::format(" {:<22}", job == jobs.end() ? "-" : job->second);
-    lines += fmt::format(
-        "{:<16} {:<12} {:6.1f} {:<12} {:>5}{} {}\n", c.id, c.group, c.params.gravity.angle_deg, st, ranks,
-        job_col, it != known.end() && it->second.status != CaseStatus::kDone ? it->second.last_error : "");
+    std::vector<std::string> row = {
+        c.id, c.group, fmt::format("{:.1f}", c.params.gravity.angle_deg), st,
+        it != known.end() && it->second.ranks > 0 ? std::to_string(it->second.ranks) : "-"};
+    if (!jobs.empty()) row.push_back(job == jobs.end() ? "-" : job->second);
+    row.push_back(it != known.end() && it->second.status != CaseStatus::kDone ? it->second.last_error : "");
+    table.add(std::move(row));
+  }
+  const char* kStates[] = {"done", "running", "failed", "interrupted", "pending"};
+  if (format == ListingFormat::kCsv) {
+    std::fputs(table.csv().c_str(), stdout);
+    return 0;
+  }
+  if (format == ListingFormat::kJson) {
+    nlohmann::json j = {{"study", study.name},
+                        {"cases_total", study.cases.size()},
+                        {"uncollected_run_folders", uncollected},
+                        {"slurm_states_unknown", !open_slurm.empty() && !queue ? queue_why : ""},
+                        {"cases", table.json()}};
+    for (const char* st : kStates) j["counts"][st] = counts[st];
+    std::printf("%s\n", j.dump(2).c_str());
+    return 0;
   }
   std::printf("study %s: %s: %d done, %d running, %d failed, %d interrupted, %d pending\n",
               study.name.c_str(), count_of(static_cast<long long>(study.cases.size()), "case").c_str(),
@@ -179,9 +203,7 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
   if (uncollected > 0)
     std::printf("%d finished run folders are not recorded yet: boycott study collect %s --db %s\n",
                 uncollected, study_file.c_str(), db_path.c_str());
-  std::printf("%-16s %-12s %6s %-12s %5s%s %s\n", "case", "group", "angle", "status", "ranks",
-              jobs.empty() ? "" : fmt::format(" {:<22}", "slurm job").c_str(), "last error");
-  std::fputs(lines.c_str(), stdout);
+  std::fputs(table.str().c_str(), stdout);
   return 0;
 }
 

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "driver/listing_format.hpp"
+
 namespace boycott::driver {
 
 struct StudyRunOptions {
@@ -25,7 +27,9 @@ struct StudyRunOptions {
 /// Exit code: 0 all cases done, 75 stopped by a signal, 1 some case failed for good, 74 stopped
 /// after storage errors in a row (Scheduler::kStorageFailuresToStop).
 int study_run(const StudyRunOptions& opt);
-int study_status(const std::string& study_file, const std::string& db_path, int retries);
+/// The study's cases and their states (pending without a database; none is created).
+int study_status(const std::string& study_file, const std::string& db_path, int retries,
+                 ListingFormat format = ListingFormat::kTable);
 
 /// The folder where the cases of the database at db_path run: <db_path>.runs/<case_id>/.
 std::string runs_root(const std::string& db_path);

@@ -85,8 +85,8 @@ std::vector<ValidationRow> query_validation(Database& db, const std::string& stu
   return rows;
 }
 
-std::string format_validation(const std::vector<ValidationRow>& rows, CurveFormat f) {
-  if (f == CurveFormat::kJson) {
+std::string format_validation(const std::vector<ValidationRow>& rows, ListingFormat f) {
+  if (f == ListingFormat::kJson) {
     nlohmann::json j = nlohmann::json::array();
     for (const auto& r : rows) {
       nlohmann::json values = nlohmann::json::object(), errors = nlohmann::json::object();
@@ -113,7 +113,7 @@ std::string format_validation(const std::vector<ValidationRow>& rows, CurveForma
     }
     return j.dump(2) + "\n";
   }
-  if (f == CurveFormat::kCsv) {
+  if (f == ListingFormat::kCsv) {
     // Scenes report different keys: one column per key seen in any row, empty where absent.
     std::set<std::string> keys;
     for (const auto& r : rows)

@@ -31,6 +31,6 @@ std::vector<ValidationRow> query_validation(Database& db, const std::string& stu
 
 /// Table: relative errors (keys containing "rel") as signed percentages, null as "-". CSV: one
 /// column per error key found in any row, raw numbers, nested values as JSON. JSON: raw values.
-std::string format_validation(const std::vector<ValidationRow>& rows, CurveFormat f);
+std::string format_validation(const std::vector<ValidationRow>& rows, ListingFormat f);
 
 }  // namespace boycott::driver

@@ -139,8 +139,8 @@ WorkPrecision query_work_precision(Database& db, const std::string& study,
   return wp;
 }
 
-std::string format_work_precision(const WorkPrecision& wp, CurveFormat f) {
-  if (f == CurveFormat::kJson) {
+std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
+  if (f == ListingFormat::kJson) {
     nlohmann::json refs = nlohmann::json::array(), rows = nlohmann::json::array();
     for (const auto& r : wp.references)
       refs.push_back({{"case_id", r.case_id},
@@ -172,7 +172,7 @@ std::string format_work_precision(const WorkPrecision& wp, CurveFormat f) {
         {"study", wp.study}, {"reference_group", wp.reference_group}, {"references", refs}, {"rows", rows}};
     return j.dump(2) + "\n";
   }
-  if (f == CurveFormat::kCsv) {
+  if (f == ListingFormat::kCsv) {
     std::string s =
         "group,setting,angle_deg,wall_time_s,particle_steps,mean_settling_velocity_m_s,stderr_m_s,reference_"
         "m_s,"

@@ -52,7 +52,7 @@ struct WorkPrecision {
 WorkPrecision query_work_precision(Database& db, const std::string& study,
                                    const std::string& reference_group = "reference");
 
-std::string format_work_precision(const WorkPrecision& wp, CurveFormat f);
+std::string format_work_precision(const WorkPrecision& wp, ListingFormat f);
 
 /// Below this |relative error| a point is drawn on the floor of the log axis, hollow.
 inline constexpr double kWorkPrecisionErrorFloor = 1e-6;

@@ -20,7 +20,27 @@ expect_usage frob case frob
 expect_usage --bogus case run "$case_file" --out "$work/never" --bogus
 expect_usage --sideways case run "$case_file" --out "$work/never" --at 0.1 --sideways
 expect_usage nofile.toml case run "$work/nofile.toml" --out "$work/never"
-expect_usage xml query curve --db "$work/none.db" --study s --format xml
+# Every listing command takes the same --format choices and refuses others alike.
+for cmd in "query curve --study s" "query validation" "query work-precision --study s" "query cases"; do
+  # shellcheck disable=SC2086
+  expect_usage xml $cmd --db "$work/none.db" --format xml
+done
+expect_usage xml study status "$(dirname "$case_file")/../demo.toml" --db "$work/none.db" --format xml
+expect_usage xml study plan "$(dirname "$case_file")/../demo.toml" --format xml
+expect_usage xml case keys --format xml
+"$bin" --help > /dev/null
+# (Through files: with pipefail, grep -q closing the pipe early would fail the writer.)
+"$bin" query cases --help > "$work/help.txt"
+grep -q '{table,csv,json}' "$work/help.txt" || fail "query cases --help does not list the formats"
+"$bin" study status "$(dirname "$case_file")/../demo.toml" --db "$work/none.db" --format json > "$work/status.json" ||
+  fail "study status --format json failed"
+python3 -c "import json,sys; j=json.load(open(sys.argv[1])); assert j['counts']['pending'] == 12 and len(j['cases']) == 12 and j['cases'][0]['angle_deg'] == 30, j" "$work/status.json" ||
+  fail "study status --format json: $(cat "$work/status.json")"
+"$bin" study status "$(dirname "$case_file")/../demo.toml" --db "$work/none.db" --format csv > "$work/status.csv"
+[ "$(head -1 "$work/status.csv")" = 'case,group,angle_deg,status,ranks,last_error' ] ||
+  fail "study status --format csv has no header row: $(head -2 "$work/status.csv")"
+"$bin" case keys --format csv > "$work/keys.csv"
+grep -q '^fluid.viscosity,0.001,Pa s,' "$work/keys.csv" || fail "case keys --format csv"
 expect_usage "only \`case run\`" study status "$(dirname "$case_file")/../demo.toml" --db "$work/none.db" -- -ksp_view
 "$bin" --help > /dev/null || fail "--help did not exit 0"
 # case check shows the case's geometry, and an angle that looks like radians gets a warning.

@@ -172,12 +172,12 @@ TEST(WorkPrecision, RowsAreInStudyGroupOrderThenByWallTime) {
   const std::vector<std::pair<std::string, double>> want = {
       {"dt_dem", 95}, {"dt_dem", 100}, {"cells", 50}, {"cells", 60}};
   EXPECT_EQ(got, want);
-  const auto table = bd::format_work_precision(wp, bd::CurveFormat::kTable);
+  const auto table = bd::format_work_precision(wp, bd::ListingFormat::kTable);
   EXPECT_NE(table.find("+10.00 % +- 2.28 %"), std::string::npos) << table;
   EXPECT_NE(table.find("time.dt_dem=4e-05"), std::string::npos) << table;
-  const auto csv = bd::format_work_precision(wp, bd::CurveFormat::kCsv);
+  const auto csv = bd::format_work_precision(wp, bd::ListingFormat::kCsv);
   EXPECT_NE(csv.find("\"domain.cells=[100, 6, 50]\""), std::string::npos) << csv;  // quoted: it holds commas
-  const auto json = nlohmann::json::parse(bd::format_work_precision(wp, bd::CurveFormat::kJson));
+  const auto json = nlohmann::json::parse(bd::format_work_precision(wp, bd::ListingFormat::kJson));
   EXPECT_EQ(json["rows"].size(), 4u);
   EXPECT_TRUE(json["rows"][0]["rel_error_r_acc"].is_null());
 }
@@ -397,18 +397,18 @@ TEST(ValidationQuery, RowsListExactlyTheStoredErrorKeysWithTheirValues) {
   EXPECT_EQ(r.values[0].key, "gravity.angle_deg");
   EXPECT_EQ(r.values[1].key, "time.dt_dem");
 
-  const auto table = bd::format_validation(rows, bd::CurveFormat::kTable);
+  const auto table = bd::format_validation(rows, bd::ListingFormat::kTable);
   EXPECT_NE(table.find("max_rel_error_vs_analytic=+1.23 %"), std::string::npos) << table;
   EXPECT_NE(table.find("rel_error=-"), std::string::npos) << table;
   EXPECT_NE(table.find("hindered_settling_rel_error=[+1.00 %, -2.00 %, -]"), std::string::npos) << table;
   EXPECT_NE(table.find("gravity.angle_deg=65; time.dt_dem=4e-05"), std::string::npos) << table;
-  const auto csv = bd::format_validation(rows, bd::CurveFormat::kCsv);
+  const auto csv = bd::format_validation(rows, bd::ListingFormat::kCsv);
   EXPECT_EQ(
       csv.substr(0, csv.find('\n')),
       "study,group,case_id,scene,values,mean_settling_velocity_m_s,wall_time_s,hindered_settling_rel_error,"
       "max_rel_error_vs_analytic,rel_error");
   EXPECT_NE(csv.find(",0.0123,\n"), std::string::npos) << csv;  // raw number; null is empty
-  const auto json = nlohmann::json::parse(bd::format_validation(rows, bd::CurveFormat::kJson));
+  const auto json = nlohmann::json::parse(bd::format_validation(rows, bd::ListingFormat::kJson));
   EXPECT_TRUE(json[0]["errors"]["rel_error"].is_null());
   EXPECT_DOUBLE_EQ(json[0]["values"]["time.dt_dem"].get<double>(), 4e-5);
 }
@@ -426,7 +426,7 @@ TEST(ValidationQuery, OnlyFinishedCasesOfTheNamedStudyAreListed) {
   EXPECT_EQ(rows[0].group, "reference");  // study order
   EXPECT_EQ(rows[1].group, "cells");
   EXPECT_TRUE(rows[0].errors.empty());
-  EXPECT_NE(bd::format_validation(rows, bd::CurveFormat::kTable).find("  -\n"), std::string::npos);
+  EXPECT_NE(bd::format_validation(rows, bd::ListingFormat::kTable).find("  -\n"), std::string::npos);
   EXPECT_EQ(bd::query_validation(db).size(), 2u);
   EXPECT_NE(what_of([&] { bd::query_validation(db, "nope"); }).find("no study 'nope'"), std::string::npos);
 }
@@ -513,7 +513,7 @@ scene = "single_particle"
     bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, s);
   }
   const auto rows = bd::query_validation(db, "sp");
-  const auto json = nlohmann::json::parse(bd::format_validation(rows, bd::CurveFormat::kJson));
+  const auto json = nlohmann::json::parse(bd::format_validation(rows, bd::ListingFormat::kJson));
   ASSERT_EQ(json.size(), 2u);
   std::map<double, bool> verdicts;
   for (const auto& r : json) {
@@ -524,7 +524,7 @@ scene = "single_particle"
   }
   EXPECT_TRUE(verdicts.at(0.012));
   EXPECT_FALSE(verdicts.at(-0.031));
-  const auto table = bd::format_validation(rows, bd::CurveFormat::kTable);
+  const auto table = bd::format_validation(rows, bd::ListingFormat::kTable);
   EXPECT_NE(table.find("(|.| <= 2 %: pass)"), std::string::npos) << table;
   EXPECT_NE(table.find("(|.| <= 2 %: FAIL)"), std::string::npos) << table;
 }
@@ -539,7 +539,7 @@ TEST(CurveQuery, CsvQuotesAGroupOrSettingThatHoldsACommaQuoteOrLineBreak) {
   p.error_method = "sokal_autocorrelation";
   bd::CurvePoint q = p;
   q.group = "line\nbreak \"quoted\"";
-  const auto csv = bd::format_curve({p, q}, bd::CurveFormat::kCsv);
+  const auto csv = bd::format_curve({p, q}, bd::ListingFormat::kCsv);
   EXPECT_NE(csv.find("\n\"a,b\",65,"), std::string::npos) << csv;
   EXPECT_NE(csv.find("\n\"line\nbreak \"\"quoted\"\"\",65,"), std::string::npos) << csv;
   EXPECT_NE(csv.find(",\"domain.cells=[20, 6, 20]\"\n"), std::string::npos) << csv;
@@ -585,4 +585,33 @@ average_from = 1.0
   EXPECT_EQ(pts[0].n_replicas, 7);
   EXPECT_EQ(pts[0].error.basis, "two_stage_stein");
   EXPECT_NEAR(*pts[0].error.error_m_s, boycott::one_sigma_t_factor(2.0) * 0.002 / std::sqrt(7.0), 1e-12);
+}
+
+TEST(Listings, CasesAsTableCsvAndJsonHoldTheSameRows) {
+  bd::CaseState done;
+  done.study = "s";
+  done.group = "base";
+  done.id = "00000000000000aa";
+  done.angle_deg = 65.0;
+  done.status = bd::CaseStatus::kDone;
+  bd::CaseState failed = done;
+  failed.id = "00000000000000bb";
+  failed.status = bd::CaseStatus::kFailed;
+  failed.failures = 2;
+  failed.last_error = "error: the run became unphysical, at t = 0.1 s";
+  const std::vector<bd::CaseState> cases = {done, failed};
+  const auto table = bd::format_cases(cases, bd::ListingFormat::kTable);
+  EXPECT_NE(table.find("00000000000000bb"), std::string::npos);
+  EXPECT_EQ(table.find(" \n"), std::string::npos) << "no padding at a line's end:\n" << table;
+  const auto csv = bd::format_cases(cases, bd::ListingFormat::kCsv);
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "study,group,case,angle_deg,status,failures,last_error");
+  // A comma in the error is quoted: the row keeps its 7 fields.
+  EXPECT_NE(csv.find(",\"error: the run became unphysical, at t = 0.1 s\"\n"), std::string::npos) << csv;
+  const auto json = nlohmann::json::parse(bd::format_cases(cases, bd::ListingFormat::kJson));
+  ASSERT_EQ(json.size(), 2u);
+  EXPECT_EQ(json[1]["angle_deg"], 65.0);
+  EXPECT_EQ(json[1]["failures"], 2);
+  EXPECT_EQ(json[1]["status"], "failed");
+  EXPECT_EQ(json[0]["last_error"], "");
+  EXPECT_THROW(bd::parse_listing_format("xml"), boycott::InputError);
 }
