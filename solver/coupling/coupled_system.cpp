@@ -121,9 +121,26 @@ CoupledStep CoupledSystem::step() {
     dt = st.dem_substeps * dt_dem;
   }
   st.dt_s = dt;
+  if (interrupted_) throw std::logic_error("CoupledSystem::step after an interrupted step");
+  const bool long_step = opt_.move_particles && interrupt_ &&
+                         static_cast<double>(st.dem_substeps) *
+                                 std::max(static_cast<double>(dem_->global_count()), kSubstepOverhead) >=
+                             kLongStepParticleSteps;
+  if (long_step) start_of_step_ = {dem_->export_state(), coupler_->export_state()};
   coupler_->prepare(*dem_, *fluid_, dt_prev_);
   if (opt_.move_particles) {
-    dem_->advance(st.dem_substeps);
+    if (long_step) {
+      st.substeps_done = dem_->advance_interruptible(st.dem_substeps, stop_check_substeps(), interrupt_);
+      if (st.substeps_done < st.dem_substeps) {
+        // The particles are part-way through the step and the coupler has sampled for it: only
+        // the state kept above may be checkpointed.
+        interrupted_ = true;
+        st.interrupted = true;
+        return st;
+      }
+    } else {
+      dem_->advance(st.dem_substeps);
+    }
     if (budget_) budget_->commit(dem_->particles(), dt, p_.gravity_vector()[1]);
   } else {
     // A frozen bed takes the whole drag impulse beta (u_f - v) dt (it is held in place).
@@ -177,6 +194,11 @@ CoupledStep CoupledSystem::step() {
     throw PhysicsError(
         fmt::format("particle velocities became NaN at t = {:.6g} s (CFD step {})", time_, steps_));
   return st;
+}
+
+int CoupledSystem::stop_check_substeps() const {
+  const double per_substep = std::max(static_cast<double>(dem_->global_count()), kSubstepOverhead);
+  return std::max(1, static_cast<int>(kStopCheckParticleSteps / per_substep));
 }
 
 double CoupledSystem::mean_particle_velocity(int c) const {

@@ -5,6 +5,7 @@
 // zero-slurry-velocity forcing of Eq. 25, which forces are on. Checkpoints, snapshots and the
 // per-step output are the scenes' (scenes/coupled_checkpoint.hpp, scenes/coupled_output.hpp).
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 
@@ -30,6 +31,11 @@ struct CoupledStep {
   double dt_s = 0.0;
   int dem_substeps = 0;
   fluid::StepReport fluid;
+  /// A stop request ended the step inside its particle sub-steps (set_interrupt): nothing of the
+  /// step counts, the run's time is still the step's start, and a checkpoint written now holds
+  /// the state from before the step (interrupted_state()). The run cannot step again.
+  bool interrupted = false;
+  int substeps_done = 0;  ///< sub-steps run before the stop was seen (interrupted only)
 };
 
 /// The run-level counters a checkpoint carries beside the engines' own states.
@@ -72,6 +78,26 @@ class CoupledSystem {
   static void check_rank_count(const GridSpec& g, int ranks);
   /// One CFD step of at most time.dt_cfd (CFL-limited), a whole number of DEM sub-steps.
   CoupledStep step();
+
+  /// A stop request (collective: the same answer on every rank) that a long step asks during its
+  /// particle sub-steps, every stop_check_substeps() of them. A step is long when its sub-steps
+  /// times max(particles, kSubstepOverhead) reach kLongStepParticleSteps; such a step first keeps
+  /// the particles' and coupler's state, so that a stop inside it can be checkpointed as of the
+  /// step's start (the fluid is not touched before the sub-steps end). Shorter steps are not
+  /// interrupted: they end within about kLongStepParticleSteps particle-steps of work.
+  void set_interrupt(std::function<bool()> stop_requested) { interrupt_ = std::move(stop_requested); }
+  static constexpr double kLongStepParticleSteps = 1e7;
+  static constexpr double kStopCheckParticleSteps = 1e6;
+  static constexpr double kSubstepOverhead = 64;  ///< a sub-step's fixed cost, in particle-steps
+  /// Sub-steps between two stop checks of a long step: about kStopCheckParticleSteps of work.
+  int stop_check_substeps() const;
+  /// After an interrupted step: the particles' and coupler's state at its start (what a
+  /// checkpoint holds); nullptr otherwise.
+  struct StartOfStep {
+    particles::DemState dem;
+    std::vector<std::vector<double>> coupler;
+  };
+  const StartOfStep* interrupted_state() const { return interrupted_ ? &start_of_step_ : nullptr; }
   double time_s() const { return time_; }
   std::int64_t steps() const { return steps_; }
   /// Fluid steps that ended at numerics.simple_max_iterations without meeting simple_tolerance,
@@ -117,6 +143,9 @@ class CoupledSystem {
   std::int64_t unconverged_ = 0, fallbacks_before_ = 0;  // counts before this process: from the checkpoint
   double seconds_fluid_ = 0.0, seconds_wait_ = 0.0;
   ForceBudget* budget_ = nullptr;
+  std::function<bool()> interrupt_;
+  StartOfStep start_of_step_;
+  bool interrupted_ = false;
 };
 
 }  // namespace boycott::coupling

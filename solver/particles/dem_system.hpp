@@ -3,6 +3,7 @@
 // velocity-Verlet integrator with the coupling hook (implicit linear drag, added mass).
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -98,6 +99,11 @@ class DemSystem {
   /// sum of the local particles' v_z (m/s) at the end of step k, added in storage order: the
   /// same bits as summing particles().vz after the k-th of as many step() calls.
   void advance(int count, double* vz_sums = nullptr);
+  /// advance(count) in runs of `check_every` steps (the same bits), asking `stop` after each run
+  /// but the last; returns the steps made: `count`, or fewer when `stop` said yes (the particles
+  /// are then part-way through, for a caller that discards them). `stop` must give every rank
+  /// the same answer.
+  int advance_interruptible(int count, int check_every, const std::function<bool()>& stop);
   /// Rebuilds the neighbour list now (re-sorts and wraps; forces and histories are kept).
   void force_rebuild();
 

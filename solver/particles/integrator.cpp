@@ -282,6 +282,17 @@ void DemSystem::advance(int count, double* vz_sums) {
   }
 }
 
+int DemSystem::advance_interruptible(int count, int check_every, const std::function<bool()>& stop) {
+  int done = 0;
+  while (done < count) {
+    const int run = std::min(std::max(check_every, 1), count - done);
+    advance(run);
+    done += run;
+    if (done < count && stop()) break;
+  }
+  return done;
+}
+
 void DemSystem::advance_to_forces() {
   std::chrono::steady_clock::time_point t0;
   const bool rebuild_now = dd_.parallel() ? needs_rebuild_parallel() : needs_rebuild();

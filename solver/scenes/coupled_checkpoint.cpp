@@ -75,10 +75,13 @@ fluid::FluidState own_part(const fluid::FluidState& whole, const fluid::FluidSol
 
 void save_coupled(io::CheckpointWriter* w, const coupling::CoupledSystem& run) {
   const auto c = run.counters();
-  // Collective: every rank contributes, rank 0 writes.
-  const auto dem = run.dem().export_state();
+  // Collective: every rank contributes, rank 0 writes. After a step interrupted inside its
+  // particle sub-steps, the particles and coupler as they were at its start (the counters and
+  // the fluid have not moved since).
+  const auto* start = run.interrupted_state();
+  const auto dem = start ? start->dem : run.dem().export_state();
   const auto fluid = gather_fluid(run.fluid());
-  const auto coupler = run.coupler().export_state();
+  const auto coupler = start ? start->coupler : run.coupler().export_state();
   if (!w) return;
   w->put("run.time_s", c.time_s);
   w->put("run.dt_prev_s", c.dt_prev_s);

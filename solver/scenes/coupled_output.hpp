@@ -3,6 +3,7 @@
 // timeseries.csv every output.timeseries_every (and at the last step), snapshots at
 // output.snapshot_times, particle images at output.image_times, and a checkpoint on its clock,
 // at the end and on a stop request.
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,25 @@ class CoupledSceneOutput {
     write_pictures(t);
     csv_.flush();
     write_checkpoint();
+  }
+  /// Instead of after_step, after a step a stop request interrupted inside its particle
+  /// sub-steps (CoupledStep::interrupted): no row, a checkpoint as of the step's start, the
+  /// summary marked interrupted; the scene then leaves its loop (exit kExitInterrupted).
+  template <class WriteCheckpoint>
+  void stop_inside_step(const coupling::CoupledStep& st, WriteCheckpoint&& write_checkpoint,
+                        SummaryBase& summary) {
+    csv_.flush();
+    write_checkpoint();
+    summary.status = kStatusInterrupted;
+    // Collective, so asked on every rank before rank 0 prints.
+    const int every = run_.stop_check_substeps();
+    const double particles = static_cast<double>(run_.dem().global_count());
+    if (!ctx_.quiet && output_rank())
+      std::fprintf(stderr,
+                   "stopped inside a fluid step after %d of its %d particle sub-steps (asked every %d, "
+                   "%.3g particle-steps); the step is dropped and the checkpoint holds t = %g s; run "
+                   "again to resume\n",
+                   st.substeps_done, st.dem_substeps, every, every * particles, run_.time_s());
   }
   /// When the next time-series row is due (s): part of a scene's checkpoint.
   double next_out_s() const { return next_out_s_; }

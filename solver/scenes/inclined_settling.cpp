@@ -132,6 +132,8 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     run.start();
   }
   run.activate_models(timers);
+  // A stop request is honoured inside a long fluid step too (thousands of particle sub-steps).
+  run.set_interrupt([&ctx] { return ctx.should_stop(); });
   CoupledSceneOutput out(
       run, ctx, timers,
       {"time_s", "mean_wp_m_s", "mean_wf_m_s", "slurry_velocity_m_s", "mean_up_m_s", "mean_vp_m_s",
@@ -170,6 +172,11 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   while (run.time_s() < end - 1e-12) {
     if (budget) run.set_force_budget(run.time_s() >= p.time.average_from_s - 1e-12 ? &*budget : nullptr);
     const coupling::CoupledStep st = run.step();
+    if (st.interrupted) {
+      out.stop_inside_step(st, write_checkpoint, sb);
+      exit_code = kExitInterrupted;
+      break;
+    }
     const double t = run.time_s();
     const double wp = run.mean_particle_velocity(2);
     const double wf = run.mean_fluid_velocity_z();

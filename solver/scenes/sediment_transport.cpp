@@ -195,6 +195,8 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
     return run.global_sum(q) / A;  // m^2/s
   };
 
+  // A stop request is honoured inside a long fluid step too (thousands of particle sub-steps).
+  run.set_interrupt([&ctx] { return ctx.should_stop(); });
   CoupledSceneOutput out(
       run, ctx, timers,
       {"time_s", "q_m2_s", "q_star", "driving_gradient_pa_m", "mean_flux_z_m_s", "mean_up_z_m_s",
@@ -217,6 +219,11 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   int exit_code = kExitOk;
   while (run.time_s() < p.time.end_s - 1e-12) {
     const coupling::CoupledStep st = run.step();
+    if (st.interrupted) {
+      out.stop_inside_step(st, write_checkpoint, sb);
+      exit_code = kExitInterrupted;
+      break;
+    }
     const double t = run.time_s();
     const double q = transport_rate();
     const double G = run.fluid().mean_pressure_gradient_pa_m();
