@@ -11,6 +11,7 @@
 #include <ctime>
 #include <filesystem>
 #include <thread>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -49,9 +50,71 @@ constexpr const char* kOwnTables[] = {"studies",     "cases",    "study_cases",
 
 }  // namespace
 
+namespace {
+/// The tables a statement names after FROM, JOIN, INTO or UPDATE, each with its alias ("results r"
+/// or "results AS r"; the name itself where there is none).
+std::vector<std::pair<std::string, std::string>> tables_named(const std::string& sql) {
+  std::vector<std::string> words;
+  std::string w;
+  for (char c : sql + " ") {
+    if (std::isalnum(static_cast<unsigned char>(c)) || c == '_') {
+      w += c;
+    } else if (!w.empty()) {
+      words.push_back(w);
+      w.clear();
+    }
+  }
+  auto upper = [](std::string k) {
+    for (auto& c : k) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    return k;
+  };
+  static const char* kNotAlias[] = {"WHERE", "JOIN", "LEFT",   "INNER", "CROSS",   "ON",    "GROUP", "ORDER",
+                                    "LIMIT", "SET",  "VALUES", "USING", "NATURAL", "UNION", "AS"};
+  std::vector<std::pair<std::string, std::string>> out;
+  for (std::size_t i = 0; i + 1 < words.size(); ++i) {
+    const std::string k = upper(words[i]);
+    if (k != "FROM" && k != "JOIN" && k != "INTO" && k != "UPDATE") continue;
+    std::string alias = words[i + 1];
+    std::size_t a = i + 2;
+    if (a < words.size() && upper(words[a]) == "AS") ++a;
+    if (a < words.size() && std::none_of(std::begin(kNotAlias), std::end(kNotAlias),
+                                         [&](const char* n) { return upper(words[a]) == n; }))
+      alias = words[a];
+    out.emplace_back(words[i + 1], alias);
+  }
+  return out;
+}
+}  // namespace
+
 Statement::Statement(sqlite3* db, const std::string& sql) : db_(db) {
-  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &st_, nullptr) != SQLITE_OK)
-    throw DatabaseError(fmt::format("database: cannot prepare '{}': {}", sql, sqlite3_errmsg(db)));
+  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &st_, nullptr) == SQLITE_OK) return;
+  const std::string why = sqlite3_errmsg(db);
+  const char* file = sqlite3_db_filename(db, "main");
+  // A table or column this version reads is missing: the database's tables are not those of the
+  // schema version it records.
+  static constexpr const char* kDrift =
+      "its tables differ from those of the schema version it records (changed by hand or by another "
+      "program?)";
+  const std::string where = file && *file ? file : "(in memory)";
+  if (why.rfind("no such table: ", 0) == 0)
+    throw DatabaseError(fmt::format("database '{}' has no table '{}' that this version reads: {}", where,
+                                    why.substr(15), kDrift));
+  if (why.rfind("no such column: ", 0) == 0) {
+    // "r.mean_settling_velocity_m_s": the table behind the alias; a bare name: the tables read.
+    std::string column = why.substr(16), table;
+    const auto tables = tables_named(sql);
+    if (const auto dot = column.find('.'); dot != std::string::npos) {
+      for (const auto& [name, alias] : tables)
+        if (alias == column.substr(0, dot)) table = name;
+      column = column.substr(dot + 1);
+    }
+    if (table.empty())
+      for (const auto& [name, alias] : tables) table += (table.empty() ? "" : " or ") + name;
+    throw DatabaseError(
+        fmt::format("database '{}' has no column '{}' in table {} that this version reads: {}", where, column,
+                    table, kDrift));
+  }
+  throw DatabaseError(fmt::format("database: cannot prepare '{}': {}", sql, why));
 }
 Statement::~Statement() {
   sqlite3_finalize(st_);

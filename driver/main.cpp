@@ -188,6 +188,8 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(kCountRange);
   add_format(splan, plan_opt.format);
+  splan->add_flag("--all", plan_opt.all,
+                  "list every case in the table even past 10 000 (else one line per group)");
   splan->add_flag("--check-model", plan_opt.check_model,
                   "also predict each finished case from the other finished runs only (leave one out)");
   boycott::driver::SlurmSubmitOptions subopt;
@@ -362,7 +364,7 @@ int main(int argc, char** argv) {
   if (qcases->parsed())
     return run_guarded([&] {
       auto db = open_for_query(q_db);
-      std::fputs(boycott::driver::format_cases(boycott::driver::case_states(db, q_study, 2),
+      std::fputs(boycott::driver::format_cases(boycott::driver::case_states_now(db, q_db, q_study, 2),
                                                boycott::driver::parse_listing_format(q_format))
                      .c_str(),
                  stdout);

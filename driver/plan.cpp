@@ -1,5 +1,6 @@
 #include "driver/plan.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -165,7 +166,25 @@ int study_plan(const PlanOptions& opt) {
   }
   std::printf("study %s: %s, %zu to run\n", study.name.c_str(),
               count_of(static_cast<long long>(study.cases.size()), "case").c_str(), pending_costs.size());
-  std::printf("%s", table.str().c_str());
+  if (study.cases.size() <= kListEveryCaseMax || opt.all) {
+    std::printf("%s", table.str().c_str());
+  } else {
+    // A line per group: a table of a million lines is read by nobody (--all, csv and json list them).
+    std::map<std::string, std::array<double, 3>> groups;  // cases, to run, core-seconds to run
+    for (std::size_t i = 0; i < study.cases.size(); ++i) {
+      auto& g = groups[study.cases[i].group];
+      g[0] += 1;
+      if (rows[i]["state"] != "done") {
+        g[1] += 1;
+        g[2] += rows[i]["estimated_core_s"].get<double>();
+      }
+    }
+    report::TextTable per_group({"group", "cases", "to run", "core time to run"}, {false, true, true, true});
+    for (const auto& [name, g] : groups)
+      per_group.add({name, fmt::format("{:.0f}", g[0]), fmt::format("{:.0f}", g[1]), duration(g[2])});
+    std::printf("%s(more than %zu cases: one line per group; --all lists every case)\n",
+                per_group.str().c_str(), kListEveryCaseMax);
+  }
   std::printf("estimated wall time of the cases to run: %s on %s x %s (parallel efficiency %.2f)\n",
               duration(wall).c_str(), count_of(opt.jobs, "job").c_str(), count_of(opt.ranks, "rank").c_str(),
               ranks_efficiency(opt.ranks));

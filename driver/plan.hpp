@@ -15,10 +15,14 @@ struct PlanOptions {
   std::string db_path;  ///< may not exist
   int jobs = 1;
   int ranks = 1;
-  std::string format = "table";  ///< table or json
+  std::string format = "table";  ///< table, csv or json
   /// Also each finished case of the study predicted by a model fitted to the others only.
   bool check_model = false;
+  /// The table lists every case even past kListEveryCaseMax (otherwise one line per group).
+  bool all = false;
 };
+/// A table of more cases than this is summarised per group unless PlanOptions::all.
+inline constexpr std::size_t kListEveryCaseMax = 10000;
 int study_plan(const PlanOptions& opt);
 
 /// The line `study run` prints before it starts: cases to run and their estimated wall time.

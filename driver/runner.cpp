@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -128,15 +129,35 @@ int study_run(const StudyRunOptions& opt) {
   return failed > 0 ? kExitFailure : kExitOk;
 }
 
+std::vector<CaseState> case_states_now(Database& db, const std::string& db_path, const std::string& study,
+                                       int retries) {
+  auto states = case_states(db, study, retries);
+  std::set<std::string> in_slurm;
+  if (has_slurm_columns(db))
+    for (const auto& a : slurm_attempts(db, study, true)) in_slurm.insert(a.case_id);
+  // An open attempt whose folder nobody holds, and no Slurm task owns: its driver died (kill -9,
+  // power loss). A task not yet started holds no folder, and is running as far as we know.
+  for (auto& c : states)
+    if (c.status == CaseStatus::kRunning && !in_slurm.count(c.id) &&
+        run_folder_unheld(fs::path(runs_root(db_path)) / c.id))
+      c.status = CaseStatus::kInterrupted;
+  return states;
+}
+
 int study_status(const std::string& study_file, const std::string& db_path, int retries,
                  ListingFormat format) {
   const Study study = expand_study_file(study_file);
-  // No database yet: every case is pending, and status (which only reads) creates none.
+  // A status reads a database and creates none: a missing one is most likely a mistyped path
+  // (the cases of a study not yet run are listed by `study plan`).
+  if (!fs::exists(db_path))
+    throw InputError(
+        fmt::format("no database at '{}' (`boycott study plan {}` lists the cases of a study not "
+                    "yet run)",
+                    db_path, study_file));
   std::optional<Database> db;
-  if (fs::exists(db_path)) db.emplace(db_path, OpenMode::kReadOnly);
+  db.emplace(db_path, OpenMode::kReadOnly);
   std::map<std::string, CaseState> known;
-  if (db)
-    for (auto& s : case_states(*db, study.name, retries)) known[s.id] = s;
+  for (auto& s : case_states_now(*db, db_path, study.name, retries)) known[s.id] = s;
   // Cases submitted to Slurm (study submit): their array task and, where squeue answers, its state.
   std::map<std::string, std::string> jobs;
   std::optional<std::vector<SlurmJob>> queue;
@@ -165,11 +186,7 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
   for (const auto& c : study.cases) {
     auto it = known.find(c.id);
     const char* st = it == known.end() ? "pending" : to_string(it->second.status);
-    // An open attempt whose folder nobody holds: its driver died (kill -9, power loss).
     const auto job = jobs.find(c.id);
-    if (it != known.end() && it->second.status == CaseStatus::kRunning && job == jobs.end() &&
-        run_folder_unheld(fs::path(runs_root(db_path)) / c.id))
-      st = "interrupted";
     ++counts[st];
     if ((it == known.end() || it->second.status != CaseStatus::kDone) &&
         finished_summary_in(fs::path(runs_root(db_path)) / c.id, c.id))

@@ -8,7 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "driver/database.hpp"
 #include "driver/listing_format.hpp"
+#include "driver/store.hpp"
 
 namespace boycott::driver {
 
@@ -27,6 +29,10 @@ struct StudyRunOptions {
 /// Exit code: 0 all cases done, 75 stopped by a signal, 1 some case failed for good, 74 stopped
 /// after storage errors in a row (Scheduler::kStorageFailuresToStop).
 int study_run(const StudyRunOptions& opt);
+/// case_states, with an open attempt whose run folder no process holds (and no Slurm task owns)
+/// as interrupted: the one vocabulary of `study status` and `query cases`.
+std::vector<CaseState> case_states_now(Database& db, const std::string& db_path, const std::string& study,
+                                       int retries);
 /// The study's cases and their states (pending without a database; none is created).
 int study_status(const std::string& study_file, const std::string& db_path, int retries,
                  ListingFormat format = ListingFormat::kTable);

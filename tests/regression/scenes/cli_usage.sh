@@ -32,11 +32,15 @@ expect_usage xml case keys --format xml
 # (Through files: with pipefail, grep -q closing the pipe early would fail the writer.)
 "$bin" query cases --help > "$work/help.txt"
 grep -q '{table,csv,json}' "$work/help.txt" || fail "query cases --help does not list the formats"
-"$bin" study status "$(dirname "$case_file")/../demo.toml" --db "$work/none.db" --format json > "$work/status.json" ||
-  fail "study status --format json failed"
-python3 -c "import json,sys; j=json.load(open(sys.argv[1])); assert j['counts']['pending'] == 12 and len(j['cases']) == 12 and j['cases'][0]['angle_deg'] == 30, j" "$work/status.json" ||
+# A database with the demo's 12 cases done (by the test double of the solver, in a second).
+fake="python3 $(cd "$(dirname "$0")/../driver" && pwd)/fake_solver.py"
+"$bin" study run "$(dirname "$case_file")/../demo.toml" --db "$work/empty.db" --solver-command "$fake" --jobs 2 --quiet \
+  > "$work/run.txt" 2>&1 || fail "the study run of the test double failed: $(cat "$work/run.txt")"
+"$bin" study status "$(dirname "$case_file")/../demo.toml" --db "$work/empty.db" --format json > "$work/status.json" ||
+  fail "study status --format json failed: $(cat "$work/status.json")"
+python3 -c "import json,sys; j=json.load(open(sys.argv[1])); assert j['counts']['done'] == 12 and len(j['cases']) == 12 and j['cases'][0]['angle_deg'] == 30, j" "$work/status.json" ||
   fail "study status --format json: $(cat "$work/status.json")"
-"$bin" study status "$(dirname "$case_file")/../demo.toml" --db "$work/none.db" --format csv > "$work/status.csv"
+"$bin" study status "$(dirname "$case_file")/../demo.toml" --db "$work/empty.db" --format csv > "$work/status.csv"
 [ "$(head -1 "$work/status.csv")" = 'case,group,angle_deg,status,ranks,last_error' ] ||
   fail "study status --format csv has no header row: $(head -2 "$work/status.csv")"
 "$bin" case keys --format csv > "$work/keys.csv"
@@ -50,10 +54,22 @@ grep -q 'cells \[' "$work/out.txt" || fail "case check does not print the cells:
 grep -q 'radians it is 68.75 degrees' "$work/out.txt" || fail "no radians warning: $(cat "$work/out.txt")"
 "$bin" case check "$case_file" --set gravity.angle_deg=1 > "$work/out.txt" 2>&1
 grep -q 'radians' "$work/out.txt" && fail "a whole-number angle warned of radians"
-# status only reads: on a database that does not exist it lists the cases as pending, creates none.
+# A plan of more than 10 000 cases is one line per group unless --all.
+{
+  echo 'name = "big"'; echo '[base]'; echo 'scene = "inclined_settling"'; echo '[matrix]'
+  echo '"gravity.angle_deg" = [10, 20, 30, 40, 50, 60, 70, 80, 90, 15, 25]'
+  echo "\"seed\" = [$(seq -s, 1 100)]"
+  echo '"fluid.viscosity" = [1e-3, 2e-3, 3e-3, 4e-3, 5e-3, 6e-3, 7e-3, 8e-3, 9e-3, 1e-2]'
+} > "$work/big.toml"
+"$bin" study plan "$work/big.toml" > "$work/plan.txt" || fail "plan of 11 000 cases failed"
+grep -q 'one line per group' "$work/plan.txt" && [ "$(wc -l < "$work/plan.txt")" -lt 10 ] ||
+  fail "a plan of 11 000 cases is not summarised: $(head -5 "$work/plan.txt")"
+"$bin" study plan "$work/big.toml" --all > "$work/plan.txt"
+[ "$(wc -l < "$work/plan.txt")" -gt 11000 ] || fail "plan --all does not list every case"
+# status only reads: a database that does not exist (a mistyped path) is named, exit 2, none created.
 demo=$(dirname "$case_file")/../demo.toml
-"$bin" study status "$demo" --db "$work/new.db" > "$work/out.txt" 2>&1 || fail "status on no database: $(cat "$work/out.txt")"
-grep -q ' 12 pending' "$work/out.txt" || fail "status does not list the pending cases: $(cat "$work/out.txt")"
+expect_usage "no database at '$work/new.db'" study status "$demo" --db "$work/new.db"
+grep -q 'study plan' "$work/err.txt" || fail "status on no database does not point to study plan: $(cat "$work/err.txt")"
 [ ! -e "$work/new.db" ] || fail "status created a database"
 
 # Not a terminal (stderr is a file): plain progress lines, the outcome, the unused PETSc option.

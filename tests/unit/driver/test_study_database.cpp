@@ -122,6 +122,26 @@ TEST(StudyDatabase, NewerSchemaIsRefusedAndLeftUnchanged) {
   EXPECT_EQ(file_bytes(path), before);
 }
 
+TEST(StudyDatabase, AMissingColumnOrTableIsNamedNotReportedAsRawSql) {
+  TempDir d;
+  const auto path = (d.path / "r.db").string();
+  {
+    bd::Database db(path, bd::OpenMode::kCreate);
+    db.exec("ALTER TABLE results DROP COLUMN mean_settling_velocity_m_s");  // changed by hand
+  }
+  bd::Database db(path, bd::OpenMode::kReadOnly);
+  try {
+    bd::query_curve(db, "any", "");
+    FAIL() << "a results table without mean_settling_velocity_m_s was read";
+  } catch (const bd::DatabaseError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("has no column 'mean_settling_velocity_m_s'"), std::string::npos) << what;
+    EXPECT_NE(what.find("in table results"), std::string::npos) << what;
+    EXPECT_NE(what.find(path), std::string::npos) << what;
+    EXPECT_EQ(what.find("SELECT"), std::string::npos) << "no raw SQL: " << what;
+  }
+}
+
 TEST(StudyDatabase, ConcurrentWritersFromSeveralProcessesLoseNothing) {
   TempDir d;
   const auto path = (d.path / "r.db").string();
