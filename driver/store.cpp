@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <set>
 #include <thread>
@@ -507,8 +508,13 @@ std::vector<SettlingResult> settling_results(Database& db, const std::string& st
   st.bind(1, study);
   std::vector<SettlingResult> out;
   while (st.step()) {
-    SettlingResult r{st.text(0),   st.text(1),  st.real(2), st.real(3), st.is_null(4) ? 0.0 : st.real(4),
-                     std::nullopt, std::nullopt};
+    SettlingResult r{st.text(0),
+                     st.text(1),
+                     st.real(2),
+                     st.real(3),
+                     st.is_null(4) ? std::numeric_limits<double>::quiet_NaN() : st.real(4),
+                     std::nullopt,
+                     std::nullopt};
     if (!st.is_null(5)) r.wall_time_s = st.real(5);
     if (!st.is_null(6)) r.particle_steps = st.integer(6);
     out.push_back(std::move(r));

@@ -126,7 +126,7 @@ std::vector<StoredResult> stored_results(Database& db, const std::string& study)
 struct SettlingResult {
   std::string group, case_id;
   double angle_deg = 0;
-  double w_m_s = 0, w_err_m_s = 0;  ///< <<w_p>> and its standard error (0 when not recorded)
+  double w_m_s = 0, w_err_m_s = 0;  ///< <<w_p>> and its standard error (NaN when the run gave none)
   std::optional<double> wall_time_s;
   std::optional<std::int64_t> particle_steps;
 };

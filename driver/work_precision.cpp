@@ -51,13 +51,15 @@ const SettlingResult& reference_at(const std::vector<SettlingResult>& refs, cons
 }
 
 std::string percent_pm(double e, double u) {
+  // No uncertainty where a run gave no error of its own (a window too short to estimate one).
+  if (std::isnan(u)) return report::percent(e) + " +- n/a";
   const double up = u * 100.0;
   return fmt::format("{} +- {}", report::percent(e),
                      up >= 0.01 || up == 0.0 ? fmt::format("{:.2f} %", up) : fmt::format("{:.2g} %", up));
 }
 
 std::string opt_csv(const std::optional<double>& v) {
-  return v ? fmt::format("{:.9g}", *v) : std::string();
+  return v && !std::isnan(*v) ? fmt::format("{:.9g}", *v) : std::string();
 }
 nlohmann::json opt_json(const std::optional<double>& v) {
   return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
@@ -180,12 +182,12 @@ std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
         "uncertainty,"
         "case_id,reference_case_id\n";
     for (const auto& r : wp.rows)
-      s += fmt::format("{},{},{:g},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{},{}\n",
-                       report::csv_field(r.group), report::csv_field(report::join_values(r.setting)),
-                       r.angle_deg, opt_csv(r.wall_time_s),
-                       r.particle_steps ? std::to_string(*r.particle_steps) : "", r.w_m_s, r.w_err_m_s,
-                       r.w_ref_m_s, r.w_ref_err_m_s, r.rel_error_w, r.rel_error_w_unc,
-                       opt_csv(r.rel_error_r_acc), opt_csv(r.rel_error_r_acc_unc), r.case_id, r.ref_case_id);
+      s += fmt::format(
+          "{},{},{:g},{},{},{:.9g},{},{:.9g},{},{:.9g},{},{},{},{},{}\n", report::csv_field(r.group),
+          report::csv_field(report::join_values(r.setting)), r.angle_deg, opt_csv(r.wall_time_s),
+          r.particle_steps ? std::to_string(*r.particle_steps) : "", r.w_m_s, opt_csv(r.w_err_m_s),
+          r.w_ref_m_s, opt_csv(r.w_ref_err_m_s), r.rel_error_w, opt_csv(r.rel_error_w_unc),
+          opt_csv(r.rel_error_r_acc), opt_csv(r.rel_error_r_acc_unc), r.case_id, r.ref_case_id);
     return s;
   }
   if (wp.rows.empty())
@@ -201,8 +203,9 @@ std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
            r.rel_error_r_acc ? percent_pm(*r.rel_error_r_acc, *r.rel_error_r_acc_unc) : "-"});
   std::string s = t.str();
   for (const auto& r : wp.references)
-    s += fmt::format("reference '{}' at {:g} deg: <<w_p>> {:.4f} +- {:.4f} mm/s, wall {} s, case {}\n",
-                     wp.reference_group, r.angle_deg, r.w_m_s * 1e3, r.w_err_m_s * 1e3,
+    s += fmt::format("reference '{}' at {:g} deg: <<w_p>> {:.4f} +- {} mm/s, wall {} s, case {}\n",
+                     wp.reference_group, r.angle_deg, r.w_m_s * 1e3,
+                     std::isnan(r.w_err_m_s) ? std::string("n/a") : fmt::format("{:.4f}", r.w_err_m_s * 1e3),
                      r.wall_time_s ? report::seconds(*r.wall_time_s) : "-", r.case_id);
   return s;
 }
@@ -295,8 +298,8 @@ plot::Plot work_precision_plot(const WorkPrecision& wp, const std::string& title
       c.text(x0 + w / 2, y0 - 8, fmt::format("θ = {:g}°", angle), Anchor::kMiddle);
       c.text(x0 + w / 2, y0 + h + 40, "wall time (s)", Anchor::kMiddle);
       if (a == 0)
-        c.text(x0 - 62, y0 + h / 2, "|⟨⟨w_p⟩⟩ / ⟨⟨w_p⟩⟩_ref − 1| (dimensionless)", Anchor::kMiddle, 13,
-               "#000", true);
+        c.label(x0 - 62, y0 + h / 2, "|⟨⟨w_{p}⟩⟩ / ⟨⟨w_{p}⟩⟩_{ref} − 1| (dimensionless)", Anchor::kMiddle, 13,
+                true);
       bool any_floor = false;
       for (const auto& r : wp.rows)
         if (r.angle_deg == angle && plotted(r) && std::abs(r.rel_error_w) < kFloor) any_floor = true;
@@ -328,7 +331,7 @@ plot::Plot work_precision_plot(const WorkPrecision& wp, const std::string& title
         // Error bars are clipped to the panel's frame.
         c.clip(x0, y0, w, h);
         for (const auto* r : mine) {
-          if (r->rel_error_w_unc <= 0) continue;
+          if (!(r->rel_error_w_unc > 0)) continue;  // none, or NaN: no bar
           const double e = std::abs(r->rel_error_w), x = at(r).first;
           const double top = e + r->rel_error_w_unc, bottom = std::max(e - r->rel_error_w_unc, kFloor);
           c.line(x, py(bottom), x, py(top), color, 1.0, {}, "errorbar");
@@ -360,6 +363,15 @@ plot::Plot work_precision_plot(const WorkPrecision& wp, const std::string& title
       c.marker("circle", lx + 8, ly, "#555", true);
       c.text(lx + 20, ly + 4, fmt::format("|error| < {:g}, drawn at {:g}", kFloor, kFloor));
     }
+    // What a bar is, and why a point may have none (a window too short for an error of its own).
+    const bool any_without = std::any_of(wp.rows.begin(), wp.rows.end(), [&](const WorkPrecisionRow& r) {
+      return plotted(r) && !(r.rel_error_w_unc > 0);
+    });
+    c.text(90, height - 14,
+           std::string(
+               "bars: 68 % interval of the error from the statistical errors of the run and the reference") +
+               (any_without ? "; no bar: a run gave no error estimate (window too short)" : ""),
+           Anchor::kStart, 11, "#333", false, "caption");
   });
 }
 
