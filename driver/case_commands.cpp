@@ -23,6 +23,7 @@
 #include "driver/report_util.hpp"
 #include "driver/run_folder_lock.hpp"
 #include "driver/store.hpp"
+#include "driver/terminal_text.hpp"
 #include "fluid/petsc_session.hpp"
 #include "io/atomic_file.hpp"
 #include "scenes/preflight.hpp"
@@ -168,7 +169,7 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv) {
     int size = 1;
     MPI_Comm_size(MPI_COMM_WORLD, &size);
     if (size == 1) throw;
-    std::fprintf(stderr, "error (rank %d of %d): %s\n", rank, size, e.what());
+    std::fprintf(stderr, "error (rank %d of %d): %s\n", rank, size, printable(e.what()).c_str());
     std::fflush(stderr);
     MPI_Abort(MPI_COMM_WORLD, exit_code_of(e));
     throw;
@@ -191,7 +192,7 @@ int case_check(const std::string& file, const std::vector<std::string>& sets) {
               p.time.dt_cfd_s * 1e3);
   std::fputs(pre.text().c_str(), stdout);
   if (!pre.errors.empty()) {
-    std::fprintf(stderr, "error: %s\n", pre.errors.front().c_str());
+    std::fprintf(stderr, "error: %s\n", printable(pre.errors.front()).c_str());
     return kExitInputError;
   }
   return 0;

@@ -20,6 +20,7 @@
 #include "driver/runner.hpp"
 #include "driver/slurm.hpp"
 #include "driver/store.hpp"
+#include "driver/terminal_text.hpp"
 #include "driver/validation_query.hpp"
 #include "driver/work_precision.hpp"
 
@@ -42,11 +43,11 @@ int run_guarded(const std::function<int()>& fn) {
     return fn();
   } catch (const boycott::driver::DatabaseError& e) {
     // An unusable database (unwritable path, newer schema) is bad input to the driver.
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", boycott::driver::printable(e.what()).c_str());
     return boycott::kExitInputError;
   } catch (const std::exception& e) {
     // A failed write (disk full, I/O error) keeps the last good checkpoint: StorageError, 74.
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", boycott::driver::printable(e.what()).c_str());
     return boycott::exit_code_of(e);
   }
 }
@@ -82,12 +83,13 @@ int usage_error(CLI::App& app, const CLI::ParseError& e, int argc, char** argv) 
       std::fprintf(
           stderr,
           "error: unknown command '%s' (expected one of: %s)\nRun with --help for more information.\n",
-          word.c_str(), names.c_str());
+          boycott::driver::printable(word).c_str(), names.c_str());
       return boycott::kExitInputError;
     }
     level = next;
   }
-  std::fprintf(stderr, "error: %s\nRun with --help for more information.\n", e.what());
+  std::fprintf(stderr, "error: %s\nRun with --help for more information.\n",
+               boycott::driver::printable(e.what()).c_str());
   return boycott::kExitInputError;
 }
 

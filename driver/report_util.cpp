@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "driver/listing_format.hpp"
+#include "driver/terminal_text.hpp"
 
 namespace boycott::driver {
 
@@ -115,10 +116,14 @@ void TextTable::add(std::vector<std::string> row) {
 }
 
 std::string TextTable::str() const {
+  // For a terminal: no cell's control characters reach it (a last error, a swept value).
+  std::vector<std::vector<std::string>> rows = rows_;
+  for (auto& r : rows)
+    for (auto& cell : r) cell = printable(cell);
   std::vector<std::size_t> width(header_.size());
   for (std::size_t c = 0; c < header_.size(); ++c) {
     width[c] = utf8_length(header_[c]);
-    for (const auto& r : rows_) width[c] = std::max(width[c], utf8_length(r[c]));
+    for (const auto& r : rows) width[c] = std::max(width[c], utf8_length(r[c]));
   }
   auto line = [&](const std::vector<std::string>& cells) {
     std::string s;
@@ -133,7 +138,7 @@ std::string TextTable::str() const {
     return s + "\n";
   };
   std::string s = line(header_);
-  for (const auto& r : rows_) s += line(r);
+  for (const auto& r : rows) s += line(r);
   return s;
 }
 

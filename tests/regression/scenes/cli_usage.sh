@@ -54,6 +54,11 @@ grep -q 'cells \[' "$work/out.txt" || fail "case check does not print the cells:
 grep -q 'radians it is 68.75 degrees' "$work/out.txt" || fail "no radians warning: $(cat "$work/out.txt")"
 "$bin" case check "$case_file" --set gravity.angle_deg=1 > "$work/out.txt" 2>&1
 grep -q 'radians' "$work/out.txt" && fail "a whole-number angle warned of radians"
+# An escape sequence in a value or a file name is printed escaped, never raw to the terminal.
+printf 'scene = "sing\\u001b[31mle"\n' > "$work/esc.toml"
+expect_usage 'sing\x1B[31mle' case check "$work/esc.toml"
+expect_usage 'x\x1B[31m.toml' case check "$work/x$(printf '\033')[31m.toml"
+if grep -q "$(printf '\033')" "$work/err.txt"; then fail "a raw escape reached stderr"; fi
 # A plan of more than 10 000 cases is one line per group unless --all.
 {
   echo 'name = "big"'; echo '[base]'; echo 'scene = "inclined_settling"'; echo '[matrix]'

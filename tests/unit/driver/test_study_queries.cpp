@@ -18,6 +18,7 @@
 #include "driver/replica_rounds.hpp"
 #include "driver/store.hpp"
 #include "driver/study.hpp"
+#include "driver/terminal_text.hpp"
 #include "driver/validation_query.hpp"
 #include "driver/work_precision.hpp"
 
@@ -614,4 +615,14 @@ TEST(Listings, CasesAsTableCsvAndJsonHoldTheSameRows) {
   EXPECT_EQ(json[1]["status"], "failed");
   EXPECT_EQ(json[0]["last_error"], "");
   EXPECT_THROW(bd::parse_listing_format("xml"), boycott::InputError);
+  // An escape sequence in a cell (a solver's last error, say) reaches no terminal raw; CSV keeps
+  // the data as it is.
+  failed.last_error =
+      "error: \x1b]0;owned\x07 \xc2\x9b"
+      "2J";
+  const auto raw = bd::format_cases({failed}, bd::ListingFormat::kTable);
+  EXPECT_EQ(raw.find('\x1b'), std::string::npos) << raw;
+  EXPECT_EQ(raw.find("\xc2\x9b"), std::string::npos) << raw;
+  EXPECT_NE(raw.find("\\x1B]0;owned\\x07 \\u009B2J"), std::string::npos) << raw;
+  EXPECT_NE(bd::printable("⟨⟨w_p⟩⟩ θ").find("⟨⟨w_p⟩⟩ θ"), std::string::npos) << "UTF-8 text passes";
 }
