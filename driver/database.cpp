@@ -259,6 +259,13 @@ void Database::open(const std::string& name, int flags) {
     std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);
     db_ = nullptr;
+    // SQLite's "unable to open database file" for the common case: a folder that is not there
+    // (a new database is made in an existing folder; a mistyped one is not created).
+    const auto folder = std::filesystem::path(path_).parent_path();
+    std::error_code ec;
+    if (!folder.empty() && !std::filesystem::is_directory(folder, ec))
+      msg = fmt::format("its folder '{}' does not exist (make it first: mkdir -p {})", folder.string(),
+                        folder.string());
     throw DatabaseError(fmt::format("cannot open database '{}': {}", path_, msg));
   }
 }

@@ -59,6 +59,9 @@ printf 'scene = "sing\\u001b[31mle"\n' > "$work/esc.toml"
 expect_usage 'sing\x1B[31mle' case check "$work/esc.toml"
 expect_usage 'x\x1B[31m.toml' case check "$work/x$(printf '\033')[31m.toml"
 if grep -q "$(printf '\033')" "$work/err.txt"; then fail "a raw escape reached stderr"; fi
+# A new database in a folder that is not there: named, not created (a mistyped folder).
+expect_usage "its folder '$work/nofolder' does not exist" study run "$(dirname "$case_file")/../demo.toml" --db "$work/nofolder/x.db"
+[ ! -e "$work/nofolder" ] || fail "study run made the mistyped folder"
 # A plan of more than 10 000 cases is one line per group unless --all.
 {
   echo 'name = "big"'; echo '[base]'; echo 'scene = "inclined_settling"'; echo '[matrix]'
