@@ -52,8 +52,8 @@ std::string swept_text(const StudyCase& c) {
 }
 }  // namespace
 
-std::string plan_summary_line(Database& db, const Study& study, const std::vector<std::string>& to_run_ids,
-                              int jobs, int ranks) {
+PlanEstimate plan_estimate(Database& db, const Study& study, const std::vector<std::string>& to_run_ids,
+                           int jobs, int ranks) {
   const CostModel model(measured(db));
   std::map<std::string, const StudyCase*> by_id;
   for (const auto& c : study.cases) by_id[c.id] = &c;
@@ -67,10 +67,15 @@ std::string plan_summary_line(Database& db, const Study& study, const std::vecto
   std::string basis;
   for (const auto& [scene, _] : scenes)
     basis += (basis.empty() ? "" : ", ") + scene + ": " + model.basis(scene);
-  return fmt::format("plan: {} to run, estimated {} on {} x {} (cost model {})",
-                     count_of(static_cast<long long>(costs.size()), "case"),
-                     duration(study_wall_s(costs, jobs, ranks)), count_of(jobs, "job"),
-                     count_of(ranks, "rank"), basis.empty() ? "-" : basis);
+  PlanEstimate e;
+  e.line = fmt::format("plan: {} to run, estimated {} on {} x {} (cost model {})",
+                       count_of(static_cast<long long>(costs.size()), "case"),
+                       duration(study_wall_s(costs, jobs, ranks)), count_of(jobs, "job"),
+                       count_of(ranks, "rank"), basis.empty() ? "-" : basis);
+  double sum = 0.0;
+  for (double c : costs) sum += study_wall_s({c}, 1, ranks);
+  e.mean_case_wall_s = costs.empty() ? 0.0 : sum / static_cast<double>(costs.size());
+  return e;
 }
 
 int study_plan(const PlanOptions& opt) {

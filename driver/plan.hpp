@@ -25,8 +25,13 @@ struct PlanOptions {
 inline constexpr std::size_t kListEveryCaseMax = 10000;
 int study_plan(const PlanOptions& opt);
 
-/// The line `study run` prints before it starts: cases to run and their estimated wall time.
-std::string plan_summary_line(Database& db, const Study& study, const std::vector<std::string>& to_run_ids,
-                              int jobs, int ranks);
+/// What `study run` prints before it starts (cases to run and their estimated wall time), and
+/// the estimated wall time of one of them on average (its progress display's first ETA).
+struct PlanEstimate {
+  std::string line;
+  double mean_case_wall_s = 0.0;
+};
+PlanEstimate plan_estimate(Database& db, const Study& study, const std::vector<std::string>& to_run_ids,
+                           int jobs, int ranks);
 
 }  // namespace boycott::driver

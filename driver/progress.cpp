@@ -87,8 +87,9 @@ void ProgressDisplay::draw(const ProgressCounts& counts, const std::vector<Runni
     rows += fmt::format("  {} {:<12} {:5.1f} deg  t = {:8.3f} / {:g} s  {:8.4f} sim s/s\n", j.c->id,
                         j.c->group, j.c->params.gravity.angle_deg, t_s, end_s, sim_s_per_s);
   }
-  // Mean wall time of the cases finished in this run, else an estimate from the running ones.
-  double per_case_s = estimated > 0 ? estimated_case_s / estimated : NAN;
+  // Mean wall time of the cases finished in this run, else an estimate from the running ones,
+  // else the plan's.
+  double per_case_s = estimated > 0 ? estimated_case_s / estimated : planned_case_wall_s_;
   if (!finished_wall_s_.empty()) {
     per_case_s = 0;
     for (double w : finished_wall_s_) per_case_s += w;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstddef>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,9 @@ class ProgressDisplay {
 
   /// A case finished in this run after `wall_s` seconds: the ETA's time per case from now on.
   void add_finished_case(double wall_s) { finished_wall_s_.push_back(wall_s); }
+  /// The plan's wall time per case (the line `study run` prints first): the ETA's time per case
+  /// until cases report a rate or finish, so that the first ETA is the plan's.
+  void set_planned_case_wall_s(double wall_s) { planned_case_wall_s_ = wall_s; }
 
   /// Replaces the lines drawn last.
   void draw(const ProgressCounts& counts, const std::vector<RunningCase>& running);
@@ -49,6 +53,7 @@ class ProgressDisplay {
   bool live_;
   double plain_every_s_;
   std::vector<double> finished_wall_s_;
+  double planned_case_wall_s_ = std::numeric_limits<double>::quiet_NaN();
   int printed_lines_ = 0;
   std::chrono::steady_clock::time_point last_draw_;
 };

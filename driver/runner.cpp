@@ -79,9 +79,10 @@ int study_run(const StudyRunOptions& opt) {
   std::vector<std::string> to_run;
   for (const auto& s : states)
     if (s.status != CaseStatus::kDone && s.status != CaseStatus::kFailed) to_run.push_back(s.id);
-  if (!to_run.empty())
-    std::fprintf(stderr, "%s\n", plan_summary_line(db, study, to_run, opt.jobs, opt.ranks).c_str());
+  const PlanEstimate plan = plan_estimate(db, study, to_run, opt.jobs, opt.ranks);
+  if (!to_run.empty()) std::fprintf(stderr, "%s\n", plan.line.c_str());
   Scheduler scheduler(db, study, states, opt, root, solver);
+  scheduler.set_planned_case_wall_s(plan.mean_case_wall_s);
   bool stopped = scheduler.run();
   std::string storage_stop = scheduler.storage_stop();
   // replicas_target_rel_error: more replicas, round by round, where the scatter is too large.

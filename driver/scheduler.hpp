@@ -37,6 +37,8 @@ class Scheduler {
   const std::string& storage_stop() const { return storage_stop_; }
 
   static constexpr int kStorageFailuresToStop = 5;
+  /// The plan's wall time per case, for the progress display's first ETA.
+  void set_planned_case_wall_s(double wall_s) { progress_.set_planned_case_wall_s(wall_s); }
 
  private:
   /// Starts the case, or records it without running it when its result is already there; false

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "driver/case_progress.hpp"
+#include "driver/progress.hpp"
 
 namespace bd = boycott::driver;
 using Clock = bd::CaseProgress::Clock;
@@ -66,4 +67,24 @@ TEST(CaseProgress, TheFinishedLiveLineShowsTheWallTimeAndNoEta) {
   EXPECT_EQ(last.find("ETA"), std::string::npos) << last;
   EXPECT_NE(last.find("11s wall"), std::string::npos) << last;
   EXPECT_EQ(last.back(), '\n');
+}
+
+TEST(StudyProgress, TheFirstEtaIsThePlansUntilACaseReportsARate) {
+  // 4 cases pending on 2 jobs at the plan's 100 s each: 200 s, the plan's study estimate.
+  bd::ProgressDisplay display("s", 2, false, 1.0);
+  display.set_planned_case_wall_s(100.0);
+  bd::ProgressCounts counts;
+  counts.pending = 4;
+  testing::internal::CaptureStderr();
+  display.draw(counts, {});
+  std::string line = testing::internal::GetCapturedStderr();
+  EXPECT_NE(line.find("4 pending; ETA 3m20s"), std::string::npos) << line;
+  // A finished case's own time replaces the plan's: 3 left at 60 s on 2 jobs.
+  display.add_finished_case(60.0);
+  counts.pending = 3;
+  counts.done = 1;
+  testing::internal::CaptureStderr();
+  display.draw(counts, {});
+  line = testing::internal::GetCapturedStderr();
+  EXPECT_NE(line.find("3 pending; ETA 1m30s"), std::string::npos) << line;
 }
