@@ -33,13 +33,15 @@ MeasuredCost measured_cost(const std::string& case_id, const std::string& params
 
 class CostModel {
  public:
-  /// Documented defaults, from the full Table III case over its first 1.2 s on one core of this
-  /// 2-core machine (docs/performance.md): 210 ns per particle-step for the particles (contacts
-  /// 123, neighbour lists 31, sampling 23, integration 23, deposition 11) and 74.5 ns per
-  /// particle-step for the fluid, i.e. 3.7 us per fluid cell-step at 50 DEM steps per CFD step
-  /// and one particle per cell (SIMPLE at ~13 iterations); a start-up of 2 s. 20 s of that case:
-  /// about 9 core-hours, as measured (~10).
-  static constexpr double kStartS = 2.0, kParticleStepS = 210e-9, kCellStepS = 3.7e-6;
+  /// Defaults for a database with fewer than 3 finished runs, calibrated on three whole runs of
+  /// the inclined_settling scene on this 2-core machine (docs/performance.md, "Estimates against
+  /// runs"): the demo's 2 s cases (2 400 particles), the reduced base case (15 000, 6 s) and the
+  /// full base case (120 000, 20 s). The particles' and the fluid's shares keep the full case's
+  /// profile (210 : 74.5 ns per particle-step at 50 DEM steps per CFD step and one particle per
+  /// cell), scaled by one factor, the geometric mean of measured / predicted over the three; each
+  /// is then predicted within 1.5x. The cost per particle-step grows with the box (cache) and
+  /// with the sliding bed's contacts, which a model linear in the work cannot follow further.
+  static constexpr double kStartS = 2.0, kParticleStepS = 76e-9, kCellStepS = 1.35e-6;
 
   explicit CostModel(const std::vector<MeasuredCost>& finished);
   /// Core-seconds of this work.

@@ -196,10 +196,13 @@ int study_plan(const PlanOptions& opt) {
   std::map<std::string, bool> scenes;
   for (const auto& c : study.cases) scenes[c.params.scene] = true;
   for (const auto& [scene, _] : scenes)
-    std::printf("cost model %s: %s%s\n", scene.c_str(), model.basis(scene).c_str(),
-                model.basis(scene) == "default"
-                    ? " (2 s + 210 ns per particle-step + 3.7 us per fluid cell-step)"
-                    : "");
+    std::printf(
+        "cost model %s: %s%s\n", scene.c_str(), model.basis(scene).c_str(),
+        model.basis(scene) == "default"
+            ? fmt::format(" ({:g} s + {:g} ns per particle-step + {:g} us per fluid cell-step)",
+                          CostModel::kStartS, CostModel::kParticleStepS * 1e9, CostModel::kCellStepS * 1e6)
+                  .c_str()
+            : "");
   return 0;
 }
 
