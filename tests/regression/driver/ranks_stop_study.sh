@@ -4,7 +4,7 @@
 # `study status` shows the case's 2 ranks, and the same command resumes the case to the end.
 set -euo pipefail
 bin=$1; case_file=$2
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 cat > "$work/s.toml" <<TOML
 name = "ranks_stop"

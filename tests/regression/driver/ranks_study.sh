@@ -4,7 +4,7 @@
 # iteration tolerance (plane Poiseuille; SIMPLE stops at a relative change of 1e-6).
 set -euo pipefail
 bin=$1; study=$2
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 "$bin" study run "$study" --db "$work/two.sqlite" --jobs 1 --ranks 2 > "$work/two.txt"
 "$bin" study run "$study" --db "$work/one.sqlite" --jobs 1 --ranks 1 > "$work/one.txt"

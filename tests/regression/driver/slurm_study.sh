@@ -29,7 +29,7 @@ done
 [ "$(id -u)" = 0 ] || skip "the private slurmd runs jobs as their user and must be started as root"
 [ -r /etc/munge/munge.key ] || skip "no /etc/munge/munge.key (the munge package creates it)"
 
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 work=$(mktemp -d /tmp/boycott-slurm.XXXXXX)
 chmod 755 "$work"  # munged, running as munge, must reach its socket below
 pids=()

@@ -10,7 +10,7 @@
 #   stop_inside_step.sh BOYCOTT_BIN CASE.toml [RANKS]
 set -uo pipefail
 bin=$1; case_file=$2; ranks=${3:-1}
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 launch=()
 [ "$ranks" -gt 1 ] && launch=(mpirun -n "$ranks")
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
