@@ -153,7 +153,7 @@ void record_result(Database& db, std::int64_t attempt, const std::string& case_i
         .bind(1, attempt)
         .bind(2, now)
         .run();
-    // Read the averaging window from the case itself: the summary need not repeat it.
+    // The averaging window from the case itself, where the summary does not say which it used.
     auto pst = db.prepare("SELECT params_json FROM cases WHERE id = ?1");
     pst.bind(1, case_id);
     std::optional<double> from, to;
@@ -164,6 +164,8 @@ void record_result(Database& db, std::int64_t attempt, const std::string& case_i
       if (auto e = json_number(p.value("time", nlohmann::json::object()), "end")) to = e;
     }
     if (auto t = json_number(summary, "simulated_time_s")) to = t;
+    // The window the run used: its own choice where time.average_from = "auto".
+    if (auto f = json_number(summary, "average_from_s")) from = f;
     std::optional<std::int64_t> steps;
     if (summary.contains("particle_steps") && summary["particle_steps"].is_number())
       steps = summary["particle_steps"].get<std::int64_t>();

@@ -92,7 +92,7 @@ void visit_keys(P& p, V&& v) {
   v("time.dt_cfd", p.time.dt_cfd_s, positive("s"));
   v("time.dt_dem", p.time.dt_dem_s, positive("s"));
   v("time.end", p.time.end_s, positive("s"));
-  v("time.average_from", p.time.average_from_s, nonneg("s"));
+  v("time.average_from", p.time.average_from, nonneg("s"));
   v("time.checkpoint_every", p.time.checkpoint_every_s, positive("s"));
   v("time.target_rel_error", p.time.target_rel_error, optional(open_range(0.0, 1.0, true, true)));
 

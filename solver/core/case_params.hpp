@@ -64,11 +64,22 @@ struct GravityParams {
   double magnitude_m_s2 = 9.81;
 };
 
+/// Where <<w_p>>'s averaging window starts: a time, or "auto" (`automatic`): where the run's
+/// start-up transient is detected to end, judged from its whole per-step series when it ends
+/// (inclined_settling alone keeps that series).
+struct WindowStart {
+  double time_s = 5.0;
+  bool automatic = false;
+  /// The time from which a run collects its window's samples: all of the run when automatic.
+  double collect_from_s() const { return automatic ? 0.0 : time_s; }
+  bool operator==(const WindowStart&) const = default;
+};
+
 struct TimeParams {
   double dt_cfd_s = 1.0e-3;  ///< upper bound; the CFL limit may lower it
   double dt_dem_s = 2.0e-5;
   double end_s = 20.0;
-  double average_from_s = 5.0;
+  WindowStart average_from;
   double checkpoint_every_s = 1.0;  ///< simulated seconds
   /// Stop once the relative standard error of <<w_p>> is below this (unset: run to end_s).
   double target_rel_error = kUnset;

@@ -84,6 +84,17 @@ void from_toml(const char* key, const toml::node& n, std::string& out) {
   }
   type_error(key, "a string", toml_repr(n));
 }
+void from_toml(const char* key, const toml::node& n, WindowStart& out) {
+  if (auto v = n.value_exact<std::string>(); v && *v == "auto") {
+    out = WindowStart{0.0, true};
+    return;
+  }
+  if (n.value_exact<double>() || n.value_exact<std::int64_t>()) {
+    out = WindowStart{toml_number(key, n), false};
+    return;
+  }
+  type_error(key, "a number or \"auto\"", toml_repr(n));
+}
 template <class T, std::size_t N>
 void from_toml(const char* key, const toml::node& n, std::array<T, N>& out) {
   const auto* a = n.as_array();
@@ -117,6 +128,14 @@ void from_json(const char* key, const nlohmann::json& j, std::string& out) {
   if (!j.is_string()) type_error(key, "a string", j.dump());
   out = j.get<std::string>();
 }
+void from_json(const char* key, const nlohmann::json& j, WindowStart& out) {
+  if (j.is_string() && j.get<std::string>() == "auto")
+    out = WindowStart{0.0, true};
+  else if (j.is_number())
+    out = WindowStart{j.get<double>(), false};
+  else
+    type_error(key, "a number or \"auto\"", j.dump());
+}
 template <class T, std::size_t N>
 void from_json(const char* key, const nlohmann::json& j, std::array<T, N>& out) {
   if (!j.is_array() || j.size() != N) type_error(key, "an array of 3 numbers", j.dump());
@@ -134,6 +153,10 @@ void from_json(const char* key, const nlohmann::json& j, std::vector<double>& ou
 
 nlohmann::json json_value(double v) {
   return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v);
+}
+// A number stays the number it was, so that a case giving one keeps its id.
+nlohmann::json json_value(const WindowStart& v) {
+  return v.automatic ? nlohmann::json("auto") : json_value(v.time_s);
 }
 template <class T>
 nlohmann::json json_value(const T& v) {

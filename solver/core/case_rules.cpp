@@ -67,6 +67,9 @@ void check_value(const char* key, std::int64_t v, const Rule& r) {
   check_number(key, static_cast<double>(v), r);
 }
 void check_value(const char*, bool, const Rule&) {}
+void check_value(const char* key, const WindowStart& v, const Rule& r) {
+  if (!v.automatic) check_number(key, v.time_s, r);
+}
 template <class T, std::size_t N>
 void check_value(const char* key, const std::array<T, N>& a, const Rule& r) {
   for (const auto& x : a) check_number(key, static_cast<double>(x), r);
@@ -223,9 +226,16 @@ void check_case(CaseParams& p) {
       throw InputError(
           fmt::format("{} lists {} s more than once: each time may appear once", key, fmt_num(*dup)));
   }
-  if (reads("time.average_from") && p.time.average_from_s >= p.time.end_s)
+  if (reads("time.average_from") && p.time.average_from.automatic && !sc.detects_transient)
+    throw InputError(
+        fmt::format("time.average_from = \"auto\" is not taken by scene {}: it keeps no per-step "
+                    "series to find its transient in; give a time in s",
+                    sc.name),
+        "time.average_from");
+  if (reads("time.average_from") && !p.time.average_from.automatic &&
+      p.time.average_from.time_s >= p.time.end_s)
     throw InputError(fmt::format(
-        "time.average_from = {} s{} must be < time.end = {} s", fmt_num(p.time.average_from_s),
+        "time.average_from = {} s{} must be < time.end = {} s", fmt_num(p.time.average_from.time_s),
         is_set_key(p, "time.average_from") ? "" : " (Table III's default)", fmt_num(p.time.end_s)));
   if (reads("numerics.neighbor_skin") && p.numerics.neighbor_skin_m > d)
     throw InputError(fmt::format("numerics.neighbor_skin = {} m must be <= particles.diameter = {} m",

@@ -85,8 +85,10 @@ std::vector<SceneSpec> make_specs() {
        a3});
   // The tolerances of the validation studies (tests/regression/driver/validation_studies.sh).
   for (auto& spec : s) {
-    if (spec.name == "inclined_settling")
+    if (spec.name == "inclined_settling") {
       spec.tolerances = {{"hindered_settling_rel_error", 0.15, "Richardson-Zaki, periodic suspension"}};
+      spec.detects_transient = true;
+    }
     if (spec.name == "single_particle")
       spec.tolerances = {{"rel_error", 0.02, "the drag law's isolated terminal velocity"}};
     if (spec.name == "ergun")

@@ -29,6 +29,9 @@ struct SceneSpec {
     std::string against;  ///< what the error is measured against
   };
   std::vector<Tolerance> tolerances = {};
+  /// Keeps <w_p>'s whole per-step series and finds where its start-up transient ends: it takes
+  /// time.average_from = "auto".
+  bool detects_transient = false;
 };
 
 /// Table III's solid fraction: 120 000 particles of 0.6 mm in the 0.2 x 0.006 x 0.1 m box.

@@ -56,7 +56,7 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
   const double out_every =
       is_set(p.output.timeseries_every_s) ? p.output.timeseries_every_s : p.time.dt_cfd_s;
   const auto out_stride = std::max<std::int64_t>(1, std::llround(out_every / dt));
-  const auto avg_from_step = static_cast<std::int64_t>(std::llround(p.time.average_from_s / dt));
+  const auto avg_from_step = static_cast<std::int64_t>(std::llround(p.time.average_from.time_s / dt));
   CsvWriter csv(ctx.out_dir / "timeseries.csv",
                 {"time_s", "mean_vx_m_s", "mean_vy_m_s", "mean_vz_m_s", "kinetic_energy_j", "contacts",
                  "neighbor_rebuilds"},

@@ -86,7 +86,10 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   bool wp_series_whole = true;  // false after resuming a checkpoint of a build that kept none
   // The samples before the window (the transient's detection) and the step lengths (s) of all.
   StepSeries steps;
-  PrecisionTarget target(p.time.target_rel_error);
+  PrecisionTarget target(p.time.target_rel_error, p.time.average_from.automatic);
+  // With time.average_from = "auto" every step is collected and the window is cut at the end,
+  // where the series shows its start-up transient over (the PDFs and fluid means keep all of it).
+  const double collect_from_s = p.time.average_from.collect_from_s();
   double slurry_max = 0.0, next_out = 0.0, wall_before = 0.0;  // next_out: the resumed output's, s
   // Stability record over the whole run (issue 7): alpha_f range and the largest kinetic energy.
   double alpha_min_seen = 1.0, alpha_max_seen = 0.0, ke_max_seen = 0.0;
@@ -170,7 +173,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   SummaryBase sb;
   const double end = p.time.end_s;
   while (run.time_s() < end - 1e-12) {
-    if (budget) run.set_force_budget(run.time_s() >= p.time.average_from_s - 1e-12 ? &*budget : nullptr);
+    if (budget) run.set_force_budget(run.time_s() >= collect_from_s - 1e-12 ? &*budget : nullptr);
     const coupling::CoupledStep st = run.step();
     if (st.interrupted) {
       out.stop_inside_step(st, write_checkpoint, sb);
@@ -184,7 +187,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     alpha_min_seen = std::min(alpha_min_seen, run.coupler().totals().min_alpha_f);
     alpha_max_seen = std::max(alpha_max_seen, run.coupler().totals().max_alpha_f);
     ke_max_seen = std::max(ke_max_seen, run.dem().kinetic_energy_j());
-    if (t > p.time.average_from_s + 1e-12) {
+    if (t > collect_from_s + 1e-12) {
       wp_avg.add(wp);
       wp_series.push_back(wp);
       steps.window_dt.push_back(st.dt_s);
@@ -213,7 +216,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
               run.dem().kinetic_energy_j()};
     };
     // time.target_rel_error met before time.end: the last row, a checkpoint, status converged.
-    if (wp_series_whole && target.reached(wp_series, p.time.average_from_s, t) && t < end - 1e-12) {
+    if (wp_series_whole && target.reached(wp_series, collect_from_s, t) && t < end - 1e-12) {
       out.end_early(row, write_checkpoint);
       sb.status = kStatusConverged;
       break;
@@ -246,12 +249,17 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   const std::int64_t particles = run.dem().global_count();
   sb.particle_steps = static_cast<double>(particles) * static_cast<double>(run.dem().steps());
   sb.mean_settling_velocity_m_s = wp_avg.count() ? wp_avg.mean() : kUnset;
-  const WindowError wp_err = window_error(wp_series, p.time.average_from_s, run.time_s());
+  ChosenWindow chosen{steps, wp_series, collect_from_s};
+  const bool chose = p.time.average_from.automatic && wp_series_whole;
+  if (chose) chosen = cut_at_transient(steps, wp_series, collect_from_s, run.time_s());
+  const WindowError wp_err = window_error(chosen.window, chosen.from_s, run.time_s());
+  if (chose && !chosen.window.empty()) sb.mean_settling_velocity_m_s = wp_err.e.mean;
   sb.settling_velocity_stderr_m_s = wp_series_whole ? wp_err.e.stderr_of_mean : wp_avg.stderr_of_mean();
   auto j = make_summary(p, sb, timers);
   const bool finished = is_finished_status(sb.status);
   if (wp_series_whole) {
-    report_settling_statistics(j, steps, wp_series, wp_err, finished);
+    report_settling_statistics(j, chosen.steps, chosen.window, wp_err, finished);
+    if (p.time.average_from.automatic) j["pdfs_and_fluid_means_from_s"] = collect_from_s;
   } else {
     j["settling_velocity_error_method"] = "batch_means";
     if (finished)
@@ -292,7 +300,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   // Of this attempt only (the count restarts when a run resumes): with the DEM steps of the
   // attempt it gives how often the neighbour list is rebuilt, which the cost depends on.
   j["neighbor_rebuilds_this_attempt"] = run.dem().rebuilds();
-  j["samples_averaged"] = wp_avg.count();
+  j["samples_averaged"] = chose ? static_cast<std::int64_t>(chosen.window.size()) : wp_avg.count();
   j["resumed_from_checkpoint"] = resumed.has_value();
   j["pdf_outside_fraction"] = {{"y", pdf_y.total_ > 0 ? pdf_y.outside_ / pdf_y.total_ : 0.0},
                                {"wp", pdf_w.total_ > 0 ? pdf_w.outside_ / pdf_w.total_ : 0.0}};

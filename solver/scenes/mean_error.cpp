@@ -75,6 +75,29 @@ void report_window_error(nlohmann::json& j, const std::string& prefix, const std
           advice));
 }
 
+ChosenWindow cut_at_transient(const StepSeries& s, const std::vector<double>& window, double collected_from_s,
+                              double now_s) {
+  ChosenWindow c{s, window, collected_from_s};
+  const TransientEnd cut = transient_end(window);
+  if (!std::isfinite(cut.effective_samples) || cut.start <= 0) return c;
+  const auto k = static_cast<std::size_t>(cut.start);
+  c.steps.before.insert(c.steps.before.end(), window.begin(),
+                        window.begin() + static_cast<std::ptrdiff_t>(k));
+  c.window.erase(c.window.begin(), c.window.begin() + static_cast<std::ptrdiff_t>(k));
+  if (s.dt_whole && s.window_dt.size() == window.size()) {
+    for (std::size_t i = 0; i < k; ++i) c.from_s += s.window_dt[i];
+    c.steps.before_dt.insert(c.steps.before_dt.end(), s.window_dt.begin(),
+                             s.window_dt.begin() + static_cast<std::ptrdiff_t>(k));
+    c.steps.window_dt.erase(c.steps.window_dt.begin(),
+                            c.steps.window_dt.begin() + static_cast<std::ptrdiff_t>(k));
+  } else {  // no step lengths: the cut's time from the mean step
+    c.from_s += (now_s - collected_from_s) * static_cast<double>(k) / static_cast<double>(window.size());
+    c.steps.dt_whole = false;
+    c.steps.window_dt.clear();
+  }
+  return c;
+}
+
 double report_transient(nlohmann::json& j, const std::string& what, const StepSeries& s,
                         const std::vector<double>& window, double window_from_s, bool warn) {
   j["average_from_s"] = window_from_s;
@@ -161,6 +184,19 @@ bool PrecisionTarget::reached(const std::vector<double>& series, double window_f
   // Checks every 2 % of the samples (at least 25): their cost grows with the window.
   const auto n = static_cast<std::int64_t>(series.size());
   next_check_ = n + std::max<std::int64_t>(25, n / 50);
+  if (cut_transient_) {
+    const ChosenWindow c =
+        cut_at_transient(StepSeries{{}, {}, {}, true, false}, series, window_from_s, now_s);
+    if (c.window.size() < series.size()) {
+      PrecisionTarget judge(target_);
+      judge.next_check_ = 0;
+      judge.met_since_s_ = met_since_s_;
+      const bool stop = judge.reached(c.window, c.from_s, now_s);
+      met_since_s_ = judge.met_since_s_;
+      last_rel_error_ = judge.last_rel_error_;
+      return stop;
+    }
+  }
   const WindowError w = window_error(series, window_from_s, now_s);
   const double rel = std::abs(w.e.covering_error / w.e.mean);
   last_rel_error_ = rel;

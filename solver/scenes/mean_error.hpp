@@ -45,6 +45,18 @@ struct StepSeries {
   bool before_whole = true, dt_whole = true;
 };
 
+/// A window the run chose itself (time.average_from = "auto"): `window` holds every sample since
+/// `collected_from_s` (its step lengths in s.window_dt); it is cut where transient_end finds the
+/// start-up transient over, the samples before the cut joining s.before. No estimate (a series too
+/// short for one): no cut.
+struct ChosenWindow {
+  StepSeries steps;
+  std::vector<double> window;
+  double from_s = 0.0;
+};
+ChosenWindow cut_at_transient(const StepSeries& s, const std::vector<double>& window, double collected_from_s,
+                              double now_s);
+
 /// transient_end_s (core/statistics.hpp: transient_end over the whole series) and average_from_s
 /// in `j`; with `warn`, a warning when the transient ends after the window's start and the
 /// samples between shift the mean beyond noise. Returns transient_end_s (NaN: no estimate).
@@ -91,8 +103,11 @@ class PrecisionTarget {
   static constexpr double kConfirmWindowFraction = 0.3;
   static constexpr std::int64_t kFirstCheck = 50;  ///< samples
 
-  /// target: time.target_rel_error (NaN: no target, never stops).
-  explicit PrecisionTarget(double target) : target_(target) {}
+  /// target: time.target_rel_error (NaN: no target, never stops). cut_transient: the window is
+  /// the run's own choice (time.average_from = "auto"): each check judges the series from where
+  /// its start-up transient is detected to end.
+  explicit PrecisionTarget(double target, bool cut_transient = false)
+      : target_(target), cut_transient_(cut_transient) {}
   bool active() const { return target_ == target_; }
   /// After a sample was added to `series`: true when the run may stop now.
   bool reached(const std::vector<double>& series, double window_from_s, double now_s);
@@ -105,6 +120,7 @@ class PrecisionTarget {
 
  private:
   double target_;
+  bool cut_transient_;
   double last_rel_error_ = std::numeric_limits<double>::quiet_NaN();
 };
 

@@ -229,7 +229,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
     const double G = run.fluid().mean_pressure_gradient_pa_m();
     alpha_min_seen = std::min(alpha_min_seen, run.coupler().totals().min_alpha_f);
     ke_max_seen = std::max(ke_max_seen, run.dem().kinetic_energy_j());
-    if (t > p.time.average_from_s + 1e-12) {
+    if (t > p.time.average_from.time_s + 1e-12) {
       q_avg.add(q);
       g_avg.add(G);
       wf_avg.add(run.fluid().mean_flux_z());

@@ -68,7 +68,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
     const double t = run.time_s();
     const double vx = particle(s.vx), vy = particle(s.vy), vz = particle(s.vz);
     if (run.steps() == 1) acc0 = vz / st.dt_s;
-    if (t > p.time.average_from_s + 1e-12) wp_avg.add(vz);
+    if (t > p.time.average_from.time_s + 1e-12) wp_avg.add(vz);
     const double slip = std::sqrt(std::pow(vx - particle(s.ufx), 2) + std::pow(vy - particle(s.ufy), 2) +
                                   std::pow(vz - particle(s.ufz), 2));
     csv.row({t, vz, vx, vy, run.mean_fluid_velocity_z(), run.slurry_velocity_z(),

@@ -323,3 +323,42 @@ TEST(CaseParams, AStoredRecordWithoutALateKeyHadItsOldBehaviour) {
   EXPECT_EQ(case_from_json(to_json(m)).forces.lift, "saffman_mei");
   EXPECT_EQ(case_id(case_from_json(to_json(m))), case_id(m));
 }
+
+TEST(CaseParams, AverageFromAutoIsTakenByTheSceneThatFindsItsTransientAndTravelsAsAuto) {
+  const std::string head = "scene = \"inclined_settling\"\n[time]\nend = 1\n";
+  CaseParams a = parse_case_string(head + "average_from = \"auto\"\n");
+  validate(a);
+  EXPECT_TRUE(a.time.average_from.automatic);
+  EXPECT_EQ(a.time.average_from.collect_from_s(), 0.0);
+  // Written and read back (params.json, the case file for the solver): still auto, same id.
+  const nlohmann::json j = to_json(a);
+  EXPECT_EQ(j["time"]["average_from"], "auto");
+  CaseParams b = case_from_json(j);
+  validate(b);
+  EXPECT_TRUE(b.time.average_from.automatic);
+  EXPECT_EQ(case_id(b), case_id(a));
+  // A number stays a number, with an id of its own; --set takes the bare word.
+  CaseParams n = parse_case_string(head + "average_from = 0.5\n");
+  validate(n);
+  EXPECT_FALSE(n.time.average_from.automatic);
+  EXPECT_EQ(to_json(n)["time"]["average_from"], 0.5);
+  EXPECT_NE(case_id(n), case_id(a));
+  apply_override(n, "time.average_from=auto");
+  EXPECT_TRUE(n.time.average_from.automatic);
+  // Scenes without the per-step series refuse it, naming the scene; other words are refused.
+  auto message = [](const std::string& text) {
+    try {
+      CaseParams p = parse_case_string(text);
+      validate(p);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message("scene = \"single_particle\"\n[time]\nend = 1\naverage_from = \"auto\"\n")
+                .find("time.average_from = \"auto\" is not taken by scene single_particle"),
+            std::string::npos);
+  EXPECT_NE(
+      message(head + "average_from = \"soon\"\n").find("time.average_from must be a number or \"auto\""),
+      std::string::npos);
+}

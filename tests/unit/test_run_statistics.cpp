@@ -121,3 +121,49 @@ TEST(TransientReport, AWindowThatStartsInsideTheTransientIsWarnedWithWhereItEnds
   scenes::report_transient(ok, "<w_p>", late, late_window, 5.0, true);
   EXPECT_FALSE(ok.contains("warnings")) << ok.dump();
 }
+
+TEST(TransientReport, AnAutomaticWindowStartsWhereTheTransientEndsAndReportsNoTransientInside) {
+  // time.average_from = "auto": the same decay (amplitude 5, 0.5 s) on white noise, every step
+  // collected from t = 0 in steps of 10 ms and 30 ms alternately. The window is cut where the
+  // transient ends, its start is the sum of the steps before the cut, the head joins `before`.
+  std::mt19937_64 rng(12);
+  std::normal_distribution<double> g(0.0, 1.0);
+  scenes::StepSeries s;
+  std::vector<double> all;
+  double t = 0.0;
+  for (int k = 0; k < 2000; ++k) {
+    const double dt = k % 2 ? 0.03 : 0.01;
+    t += dt;
+    all.push_back(5.0 * std::exp(-t / 0.5) + g(rng));
+    s.window_dt.push_back(dt);
+  }
+  const scenes::ChosenWindow c = scenes::cut_at_transient(s, all, 0.0, t);
+  const std::size_t cut = c.steps.before.size();
+  ASSERT_EQ(cut + c.window.size(), all.size());
+  ASSERT_EQ(c.steps.before_dt.size(), cut);
+  ASSERT_EQ(c.steps.window_dt.size(), c.window.size());
+  EXPECT_EQ(c.window.front(), all[cut]);
+  double from = 0.0;
+  for (std::size_t k = 0; k < cut; ++k) from += s.window_dt[k];
+  EXPECT_DOUBLE_EQ(c.from_s, from);
+  // 5 exp(-t / 0.5) under a few tenths of the noise: 1-2.5 s (40-125 steps of 20 ms on average).
+  EXPECT_GT(c.from_s, 1.0);
+  EXPECT_LT(c.from_s, 2.5);
+  // Reported as a window that starts at the transient's end: no warning, the end where it starts.
+  nlohmann::json j;
+  j["simulated_time_s"] = t;
+  const double end_s = scenes::report_transient(j, "<w_p>", c.steps, c.window, c.from_s, true);
+  EXPECT_NEAR(end_s, c.from_s, 1e-12);
+  EXPECT_FALSE(j.contains("warnings")) << j.dump();
+  // A stationary series loses little; a series too short for an estimate is not cut.
+  std::vector<double> flat(2000);
+  for (auto& x : flat) x = g(rng);
+  scenes::StepSeries none;
+  none.dt_whole = false;
+  const auto f = scenes::cut_at_transient(none, flat, 1.0, 21.0);
+  EXPECT_LE(f.steps.before.size(), 200u);
+  EXPECT_NEAR(f.from_s, 1.0 + 20.0 * static_cast<double>(f.steps.before.size()) / 2000.0, 1e-12);
+  const auto tiny = scenes::cut_at_transient(none, {1.0, 2.0, 3.0}, 1.0, 2.0);
+  EXPECT_EQ(tiny.window.size(), 3u);
+  EXPECT_EQ(tiny.from_s, 1.0);
+}

@@ -1,5 +1,7 @@
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -203,6 +205,30 @@ TEST(StudyExpansion, EveryShippedStudyExpandsToValidCases) {
     }
   }
   EXPECT_GE(files, 8);
+}
+
+// A case's id names its runs in every database: a change to how cases are read or written (a
+// new key, a new kind of value) must leave the ids of cases that do not use it as they were.
+TEST(StudyExpansion, ShippedStudiesKeepTheirCaseIds) {
+  namespace fs = std::filesystem;
+  std::map<std::string, std::vector<std::string>> want;
+  std::ifstream in(fs::path(BOYCOTT_SOURCE_DIR) / "tests" / "data" / "study_case_ids.csv");
+  ASSERT_TRUE(in.good());
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line[0] != '#') {
+      const auto comma = line.find(',');
+      want[line.substr(0, comma)].push_back(line.substr(comma + 1));
+    }
+  std::size_t files = 0;
+  for (const auto& e : fs::directory_iterator(fs::path(BOYCOTT_SOURCE_DIR) / "studies")) {
+    if (e.path().extension() != ".toml") continue;
+    ++files;
+    std::vector<std::string> got;
+    for (const auto& c : bd::expand_study_file(e.path().string()).cases) got.push_back(c.id);
+    const auto name = e.path().filename().string();
+    EXPECT_EQ(got, want[name]) << name << ": its case ids changed";
+  }
+  EXPECT_EQ(files, want.size()) << "a study was added or removed: regenerate tests/data/study_case_ids.csv";
 }
 
 TEST(StudyExpansionErrors, NameTheOffendingKey) {
