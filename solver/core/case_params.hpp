@@ -225,7 +225,8 @@ std::string case_key_location(const std::string& toml_text, const std::string& o
 CaseParams case_from_json(const nlohmann::json& j);
 
 /// Applies "section.key=value" (value in TOML syntax: 1e-3, true, "vreman", [1,2,3]).
-void apply_override(CaseParams& p, const std::string& assignment);
+/// Returns the key it set.
+std::string apply_override(CaseParams& p, const std::string& assignment);
 
 /// Refuses a user-set key the scene does not read (naming the key and the scene), applies the
 /// scene's defaults to the keys the user did not set, derives the particle count (from

@@ -263,15 +263,13 @@ CaseParams parse_case_file(const std::string& path) {
 CaseParams load_case_file(const std::string& path, const std::vector<std::string>& overrides) {
   const std::string text = read_input_file(path, "case file");
   CaseParams p = parse_case_string(text, path);
-  for (const auto& s : overrides) apply_override(p, s);
+  std::set<std::string> set_by_option;
+  for (const auto& s : overrides) set_by_option.insert(apply_override(p, s));
   try {
     validate(p);
   } catch (const InputError& e) {
     // The line is named where the file set the value at fault, not where --set did.
-    const bool from_set = std::any_of(overrides.begin(), overrides.end(), [&](const std::string& s) {
-      return s.rfind(e.key() + "=", 0) == 0 || s.rfind(e.key() + " ", 0) == 0;
-    });
-    if (e.key().empty() || from_set) throw;
+    if (e.key().empty() || set_by_option.count(e.key())) throw;
     throw InputError(case_key_location(text, path, e.key()) + e.what(), e.key());
   }
   return p;
@@ -297,7 +295,7 @@ CaseParams case_from_json(const nlohmann::json& j) {
   return p;
 }
 
-void apply_override(CaseParams& p, const std::string& assignment) {
+std::string apply_override(CaseParams& p, const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
     throw InputError(fmt::format("--set '{}': expected key=value", assignment));
@@ -318,6 +316,7 @@ void apply_override(CaseParams& p, const std::string& assignment) {
   }
   if (key == "particles.volume_fraction")
     p.set_keys.erase(std::remove(p.set_keys.begin(), p.set_keys.end(), "particles.count"), p.set_keys.end());
+  return key;
 }
 
 nlohmann::json to_json(const CaseParams& p) {

@@ -122,15 +122,16 @@ CoupledStep CoupledSystem::step() {
   }
   st.dt_s = dt;
   if (interrupted_) throw std::logic_error("CoupledSystem::step after an interrupted step");
+  // One count over ranks per step (a collective), for the test below and the stop checks.
+  const double per_substep = interrupt_ ? work_per_substep() : 0.0;
   const bool long_step = opt_.move_particles && interrupt_ &&
-                         static_cast<double>(st.dem_substeps) *
-                                 std::max(static_cast<double>(dem_->global_count()), kSubstepOverhead) >=
-                             kLongStepParticleSteps;
+                         static_cast<double>(st.dem_substeps) * per_substep >= kLongStepParticleSteps;
   if (long_step) start_of_step_ = {dem_->export_state(), coupler_->export_state()};
   coupler_->prepare(*dem_, *fluid_, dt_prev_);
   if (opt_.move_particles) {
     if (long_step) {
-      st.substeps_done = dem_->advance_interruptible(st.dem_substeps, stop_check_substeps(), interrupt_);
+      st.substeps_done =
+          dem_->advance_interruptible(st.dem_substeps, substeps_per_check(per_substep), interrupt_);
       if (st.substeps_done < st.dem_substeps) {
         // The particles are part-way through the step and the coupler has sampled for it: only
         // the state kept above may be checkpointed.
@@ -196,9 +197,16 @@ CoupledStep CoupledSystem::step() {
   return st;
 }
 
-int CoupledSystem::stop_check_substeps() const {
-  const double per_substep = std::max(static_cast<double>(dem_->global_count()), kSubstepOverhead);
+double CoupledSystem::work_per_substep() const {
+  return std::max(static_cast<double>(dem_->global_count()), kSubstepOverhead);
+}
+
+int CoupledSystem::substeps_per_check(double per_substep) {
   return std::max(1, static_cast<int>(kStopCheckParticleSteps / per_substep));
+}
+
+int CoupledSystem::stop_check_substeps() const {
+  return substeps_per_check(work_per_substep());
 }
 
 double CoupledSystem::mean_particle_velocity(int c) const {

@@ -126,6 +126,9 @@ class CoupledSystem {
   void activate_models(ModelTimers& t) const;
 
  private:
+  /// max(particles over all ranks, kSubstepOverhead): a sub-step's work in particle-steps (collective).
+  double work_per_substep() const;
+  static int substeps_per_check(double per_substep);
   // The coupling's halo of planes beyond a rank's slab (slab_exchange.hpp), below and above:
   // a particle reaches one cell past its slab face (skin/2 < one cell), its kernel one cell
   // more and the face fields one face more, and the fields are derived with one-plane stencils.
