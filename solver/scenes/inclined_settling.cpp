@@ -249,9 +249,8 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   const std::int64_t particles = run.dem().global_count();
   sb.particle_steps = static_cast<double>(particles) * static_cast<double>(run.dem().steps());
   sb.mean_settling_velocity_m_s = wp_avg.count() ? wp_avg.mean() : kUnset;
-  ChosenWindow chosen{steps, wp_series, collect_from_s};
   const bool chose = p.time.average_from.automatic && wp_series_whole;
-  if (chose) chosen = cut_at_transient(steps, wp_series, collect_from_s, run.time_s());
+  const ChosenWindow chosen = averaging_window(p.time.average_from, steps, wp_series, run.time_s());
   const WindowError wp_err = window_error(chosen.window, chosen.from_s, run.time_s());
   if (chose && !chosen.window.empty()) sb.mean_settling_velocity_m_s = wp_err.e.mean;
   sb.settling_velocity_stderr_m_s = wp_series_whole ? wp_err.e.stderr_of_mean : wp_avg.stderr_of_mean();

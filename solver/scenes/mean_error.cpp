@@ -98,6 +98,12 @@ ChosenWindow cut_at_transient(const StepSeries& s, const std::vector<double>& wi
   return c;
 }
 
+ChosenWindow averaging_window(const WindowStart& start, const StepSeries& s,
+                              const std::vector<double>& collected, double now_s) {
+  return start.automatic ? cut_at_transient(s, collected, start.collect_from_s(), now_s)
+                         : ChosenWindow{s, collected, start.collect_from_s()};
+}
+
 double report_transient(nlohmann::json& j, const std::string& what, const StepSeries& s,
                         const std::vector<double>& window, double window_from_s, bool warn) {
   j["average_from_s"] = window_from_s;
@@ -184,20 +190,14 @@ bool PrecisionTarget::reached(const std::vector<double>& series, double window_f
   // Checks every 2 % of the samples (at least 25): their cost grows with the window.
   const auto n = static_cast<std::int64_t>(series.size());
   next_check_ = n + std::max<std::int64_t>(25, n / 50);
-  if (cut_transient_) {
-    const ChosenWindow c =
-        cut_at_transient(StepSeries{{}, {}, {}, true, false}, series, window_from_s, now_s);
-    if (c.window.size() < series.size()) {
-      PrecisionTarget judge(target_);
-      judge.next_check_ = 0;
-      judge.met_since_s_ = met_since_s_;
-      const bool stop = judge.reached(c.window, c.from_s, now_s);
-      met_since_s_ = judge.met_since_s_;
-      last_rel_error_ = judge.last_rel_error_;
-      return stop;
-    }
-  }
-  const WindowError w = window_error(series, window_from_s, now_s);
+  // The run's own window: judged from where the transient is detected to end (no step lengths
+  // here: the cut's time from the mean step).
+  ChosenWindow cut;
+  if (cut_transient_)
+    cut = cut_at_transient(StepSeries{{}, {}, {}, true, false}, series, window_from_s, now_s);
+  const std::vector<double>& x = cut_transient_ ? cut.window : series;
+  if (cut_transient_) window_from_s = cut.from_s;
+  const WindowError w = window_error(x, window_from_s, now_s);
   const double rel = std::abs(w.e.covering_error / w.e.mean);
   last_rel_error_ = rel;
   const bool met = std::isfinite(rel) && rel < target_ && w.e.correlation_times >= kMinCorrelationTimes;

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/case_params.hpp"
 #include "core/statistics.hpp"
 
 namespace boycott::scenes {
@@ -56,6 +57,11 @@ struct ChosenWindow {
 };
 ChosenWindow cut_at_transient(const StepSeries& s, const std::vector<double>& window, double collected_from_s,
                               double now_s);
+/// The window a run averages over, from what it collected since start.collect_from_s(): cut at the
+/// transient where `start` is automatic, as collected otherwise. One rule for the scene and for
+/// `case summarize`.
+ChosenWindow averaging_window(const WindowStart& start, const StepSeries& s,
+                              const std::vector<double>& collected, double now_s);
 
 /// transient_end_s (core/statistics.hpp: transient_end over the whole series) and average_from_s
 /// in `j`; with `warn`, a warning when the transient ends after the window's start and the

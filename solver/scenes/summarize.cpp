@@ -63,10 +63,7 @@ nlohmann::json resummarize_run(const std::filesystem::path& run_dir) {
       if (!w.is_string() || !is_settling_statistics_warning(w.get<std::string>())) kept.push_back(w);
     j["warnings"] = kept;
   }
-  const double collect_from_s = p.time.average_from.collect_from_s();
-  const ChosenWindow chosen = p.time.average_from.automatic
-                                  ? cut_at_transient(steps, window, collect_from_s, now_s)
-                                  : ChosenWindow{steps, window, collect_from_s};
+  const ChosenWindow chosen = averaging_window(p.time.average_from, steps, window, now_s);
   const WindowError w = window_error(chosen.window, chosen.from_s, now_s);
   report_settling_statistics(j, chosen.steps, chosen.window, w, true);
   if (p.time.average_from.automatic) {

@@ -86,12 +86,10 @@ void expect_stable(const std::string& tag, const std::vector<std::string>& sets)
   const double wt = terminal_speed(p);
   const double bound = p.particles.count * 0.5 * p.particle_mass_kg() * (10.0 * wt) * (10.0 * wt);
   std::printf(
-      "[ report ] %-22s N %6lld  w_t %.4g m/s  <<w_p>> %+.4g m/s  alpha_f [%.4f, %.4f]  KE_max/bound %.3g  "
-      "wall %.1f s\n",
+      "[ report ] %-22s N %6lld  w_t %.4g m/s  <<w_p>> %+.4g m/s  alpha_f [%.4f, %.4f]  KE_max/bound %.3g\n",
       tag.c_str(), static_cast<long long>(p.particles.count), wt,
       j["mean_settling_velocity_m_s"].get<double>(), j["min_fluid_fraction"].get<double>(),
-      j["max_fluid_fraction"].get<double>(), j["max_kinetic_energy_j"].get<double>() / bound,
-      j["wall_time_s"].get<double>());
+      j["max_fluid_fraction"].get<double>(), j["max_kinetic_energy_j"].get<double>() / bound);
   EXPECT_EQ(j["status"], "completed") << tag;
   EXPECT_NEAR(j["simulated_time_s"].get<double>(), p.time.end_s, 1e-9) << tag;
   EXPECT_GT(j["min_fluid_fraction"].get<double>(), 0.0) << tag;
