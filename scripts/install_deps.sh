@@ -9,7 +9,7 @@
 set -euo pipefail
 pkgs=(build-essential cmake pkg-config git libpetsc-real-dev libhdf5-openmpi-dev openmpi-bin libcli11-dev
       libsqlite3-dev sqlite3 libgtest-dev libtomlplusplus-dev libfmt-dev nlohmann-json3-dev libbenchmark-dev
-      libfftw3-dev libfftw3-mpi-dev libcairo2-dev clang-format-14 python3)
+      libfftw3-dev libfftw3-mpi-dev libcairo2-dev nettle-dev clang-format-14 python3)
 for a in "$@"; do
   case "$a" in
     --with-slurm) pkgs+=(slurmctld slurmd slurm-client munge) ;;

@@ -1,7 +1,8 @@
 #pragma once
 // The case: one plain struct of parameters with Table III defaults (Zeng et al. 2021), units in
-// the names. Parsed, overridden, validated, serialised and hashed in one place (case_params.cpp);
-// every key appears once in the key table there, so adding a key means editing that table only.
+// the names. Every key appears once, in the key table (case_key_table.hpp), which parsing and
+// overrides (case_parse.cpp), validation (case_rules.cpp), serialisation and the case id
+// (case_params.cpp) all read, so adding a key means editing that table only.
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -39,7 +40,7 @@ struct ParticleParams {
 
 struct ContactParams {
   double stiffness_n_m = 3.5;     ///< k_n = k_t
-  double restitution = 0.1;       ///< e, sets gamma_n (design brief section 2)
+  double restitution = 0.1;       ///< e, sets gamma_n (docs/model.md)
   double friction = 0.6;          ///< mu_s, Coulomb cap (Eq. 10)
   double rolling_friction = 0.1;  ///< mu_r (Eq. 11)
   /// gamma_t / gamma_n (the paper leaves gamma_t open; LIGGGHTS' deck of the bench uses 1/2).

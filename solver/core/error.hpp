@@ -1,5 +1,5 @@
 #pragma once
-// Error kinds map to the process exit codes of design brief section 7, so a driver can tell
+// Error kinds map to the process exit codes (README.md, "Running a case"), so a driver can tell
 // bad input (never retried) from a run that went unstable (retry may help after a change).
 #include <stdexcept>
 #include <string>

@@ -3,7 +3,7 @@
 //   double beta(alpha_f, slip_m_s, diameter_m, rho_f_kg_m3, mu_pa_s)  ->  kg/s,
 // such that the drag on one particle is F = beta (u_f - u_p). Writing every law as a linear
 // coefficient lets both the particle update and the fluid momentum matrix treat drag implicitly
-// (design brief section 2, stiff drag). Hot loops get the law as a template parameter through
+// (docs/model.md: stiff drag). Hot loops get the law as a template parameter through
 // visit_drag_law, so there is no virtual call per particle.
 #include <cmath>
 #include <string>

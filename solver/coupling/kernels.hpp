@@ -1,7 +1,7 @@
 #pragma once
 // Void-fraction kernels: how one particle's volume and force are shared among grid cells, and,
-// transposed, how grid values are read at the particle (section II C of the paper; design brief
-// section 2: with dx = 1 mm and d = 0.6 mm a one-cell deposit is noisy, so the default spreads
+// transposed, how grid values are read at the particle (section II C of the paper:
+// with dx = 1 mm and d = 0.6 mm a one-cell deposit is noisy, so the default spreads
 // each particle over its neighbourhood).
 //
 // A kernel is separable: the weight of cell (i,j,k) is wx(i) wy(j) wz(k), each 1-D set summing

@@ -14,6 +14,10 @@
 namespace boycott::io {
 
 void write_file_atomic(const std::filesystem::path& path, std::string_view bytes) {
+  write_file_atomic(path, {bytes});
+}
+
+void write_file_atomic(const std::filesystem::path& path, std::initializer_list<std::string_view> parts) {
   const std::string tmp = path.string() + ".tmp";
   const auto fail = [&](const char* what, int err) {
     ::unlink(tmp.c_str());
@@ -21,15 +25,17 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view bytes
   };
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (fd < 0) throw StorageError(fmt::format("cannot create {}: {}", tmp, std::strerror(errno)));
-  std::size_t off = 0;
-  while (off < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + off, bytes.size() - off);
-    if (n <= 0) {
-      const int err = n < 0 ? errno : ENOSPC;
-      ::close(fd);
-      fail("write", err);
+  for (const std::string_view bytes : parts) {
+    std::size_t off = 0;
+    while (off < bytes.size()) {
+      const ssize_t n = ::write(fd, bytes.data() + off, bytes.size() - off);
+      if (n <= 0) {
+        const int err = n < 0 ? errno : ENOSPC;
+        ::close(fd);
+        fail("write", err);
+      }
+      off += static_cast<std::size_t>(n);
     }
-    off += static_cast<std::size_t>(n);
   }
   if (::fsync(fd) != 0) {
     const int err = errno;

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 #include "io/sha256.hpp"
 
 namespace boycott::io {
@@ -319,36 +320,10 @@ void CheckpointWriter::commit() {
   Sha256 h;
   h.update(image.data(), image.size());
   const std::string footer = std::string(kFooterMagic, kMagicSize) + h.hex() + "\n";
-  const auto fail = [&](const char* what, int err) {
-    ::unlink(tmp_.c_str());
-    storage_failure(fmt::format("cannot {} {}", what, tmp_.string()), std::strerror(err));
-  };
   std::error_code ec;
   fs::create_directories(final_.parent_path(), ec);
   if (ec) storage_failure(fmt::format("cannot create {}", final_.parent_path().string()), ec.message());
-  const int fd = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (fd < 0) storage_failure(fmt::format("cannot create {}", tmp_.string()), std::strerror(errno));
-  for (const std::string_view part :
-       {std::string_view(image.data(), image.size()), std::string_view(footer)}) {
-    std::size_t off = 0;
-    while (off < part.size()) {
-      const ssize_t n = ::write(fd, part.data() + off, part.size() - off);
-      if (n <= 0) {
-        const int err = n < 0 ? errno : ENOSPC;
-        ::close(fd);
-        fail("write", err);
-      }
-      off += static_cast<std::size_t>(n);
-    }
-  }
-  if (::fsync(fd) != 0) {
-    const int err = errno;
-    ::close(fd);
-    fail("sync", err);
-  }
-  if (::close(fd) != 0) fail("close", errno);
-  fs::rename(tmp_, final_, ec);
-  if (ec) fail("rename into place", ec.value());
+  write_file_atomic(final_, {std::string_view(image.data(), image.size()), std::string_view(footer)});
   committed_ = true;
   fsync_path(final_.parent_path(), O_RDONLY | O_DIRECTORY);
 }

@@ -1,5 +1,5 @@
 #pragma once
-// Restart checkpoints as HDF5 files of named datasets (design brief section 7, issue 5).
+// Restart checkpoints as HDF5 files of named datasets (README.md, "Running a case").
 //
 // One file per checkpoint, DIR/checkpoints/ckpt_<step>.h5. A writer builds the file in memory,
 // writes the attribute `complete` last, then writes the image to "<name>.h5.tmp" followed by the

@@ -12,7 +12,7 @@ namespace boycott::particles {
 
 /// Linear spring-dashpot (Zeng et al. 2021 Eqs. 7-8, k_t = k_n) with Coulomb cap (Eq. 10).
 ///
-/// Damping from the restitution coefficient e (design brief section 2; the printed Eq. 9 is
+/// Damping from the restitution coefficient e (docs/model.md, "The particle engine"; the printed Eq. 9 is
 /// garbled):  gamma_n = -2 ln(e) sqrt(m_eff k_n) / sqrt(pi^2 + ln^2 e).
 /// With this gamma_n the linear oscillator m_eff x'' + gamma_n x' + k_n x = 0 returns with speed
 /// ratio exactly e after half a damped period, provided the contact ends when the overlap (not

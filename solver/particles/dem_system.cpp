@@ -145,16 +145,16 @@ bool DemSystem::needs_rebuild() const {
   return std::min(w[0], w[1]) > 0.25 * cfg_.skin_m * cfg_.skin_m;
 }
 
-void DemSystem::rebuild() {
-  auto t0 = std::chrono::steady_clock::now();
-  collect_histories();
-  // Wrap periodic coordinates into the box, then store particles cell by cell.
+void DemSystem::wrap_periodic() {
   for (int d = 0; d < 3; ++d) {
     if (!cfg_.box.periodic[d]) continue;
     auto& c = d == 0 ? s_.x : (d == 1 ? s_.y : s_.z);
     const double lo = cfg_.box.lo[d], len = cfg_.box.len[d];
     for (double& v : c) v -= len * std::floor((v - lo) / len);
   }
+}
+
+void DemSystem::sort_by_cell() {
   const auto order = nl_.bin_and_order(s_, cfg_.box, cutoff_m_);
   s_.permute(order);
   std::vector<double> tmp(order.size());
@@ -168,6 +168,14 @@ void DemSystem::rebuild() {
       for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = a[order[k]];
       a.swap(tmp);
     }
+}
+
+void DemSystem::rebuild() {
+  auto t0 = std::chrono::steady_clock::now();
+  collect_histories();
+  // Wrap periodic coordinates into the box, then store particles cell by cell.
+  wrap_periodic();
+  sort_by_cell();
   nl_.build_binned(s_, cfg_.box, cutoff_m_);
   restore_histories(carry_a_, carry_b_, carry_h_);
   rescan_wall_contacts();

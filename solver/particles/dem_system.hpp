@@ -176,6 +176,10 @@ class DemSystem {
   /// The displacement box of the local particles: the fused kick's when fresh, else a pass.
   DisplacementSpread local_displacement_box() const;
   void rebuild();
+  /// Periodic coordinates wrapped into the box (before a rebuild bins them).
+  void wrap_periodic();
+  /// The particles (and their predictions and wall histories) stored cell by cell.
+  void sort_by_cell();
   void collect_histories();
   /// Zeroes the shear history of the pairs that were in contact and are not among the first nc
   /// entries of contact_p_.

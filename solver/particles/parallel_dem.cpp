@@ -140,25 +140,9 @@ void DemSystem::rebuild_parallel(bool collect) {
   const auto t0 = std::chrono::steady_clock::now();
   if (collect) collect_histories();
   drop_ghosts();
-  for (int d = 0; d < 3; ++d) {
-    if (!cfg_.box.periodic[d]) continue;
-    auto& c = d == 0 ? s_.x : (d == 1 ? s_.y : s_.z);
-    const double lo = cfg_.box.lo[d], len = cfg_.box.len[d];
-    for (double& v : c) v -= len * std::floor((v - lo) / len);
-  }
+  wrap_periodic();
   migrate();
-  const auto order = nl_.bin_and_order(s_, cfg_.box, cutoff_m_);
-  s_.permute(order);
-  std::vector<double> tmp(order.size());
-  for (auto& a : pred_) {
-    for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = a[order[k]];
-    a.swap(tmp);
-  }
-  for (auto* wh : {&whx_, &why_, &whz_})
-    for (auto& a : *wh) {
-      for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = a[order[k]];
-      a.swap(tmp);
-    }
+  sort_by_cell();
   exchange_ghosts();
   nl_.build(s_, cfg_.box, cutoff_m_, s_.n_local);
   restore_histories(carry_a_, carry_b_, carry_h_);

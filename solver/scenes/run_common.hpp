@@ -1,6 +1,6 @@
 #pragma once
-// What every scene writes the same way: summary.json with the common keys of design brief
-// section 7, timeseries.csv, atomic file replacement.
+// What every scene writes the same way: summary.json with the common keys (README.md,
+// "Outputs"), timeseries.csv, atomic file replacement.
 #include <algorithm>
 #include <chrono>
 #include <cmath>

@@ -137,7 +137,7 @@ TEST(CaseParams, IdentityVersion2LeavesOutTheRunLengthAndOutputOnly) {
   validate(c);
   EXPECT_NE(case_id(c), case_id(a));
   // The default case's id under version 2 (a change of the scheme must bump kCaseIdVersion and
-  // migrate stored ids, see driver/case_id_migration.cpp). Mei's lift became the default after
+  // migrate stored ids, see driver/store/case_id_migration.cpp). Mei's lift became the default after
   // it: the default case of earlier builds, Saffman's lift, keeps its id.
   EXPECT_EQ(case_id(a), "98d95b7d3ced7ffb");
   CaseParams saffman;

@@ -3,7 +3,7 @@
 // coverage at 10 000 studies: 0.005). The series are AR(1) with a known integrated
 // autocorrelation time tau_int of 10 steps, started from the stationary distribution (no
 // transient), true mean 0; the product's own rules make the intervals (core/statistics.hpp,
-// core/distributions.hpp, driver/point_error.hpp).
+// core/distributions.hpp, driver/store/point_error.hpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,7 +14,7 @@
 
 #include "core/distributions.hpp"
 #include "core/statistics.hpp"
-#include "driver/point_error.hpp"
+#include "driver/store/point_error.hpp"
 
 using namespace boycott;
 namespace bd = boycott::driver;

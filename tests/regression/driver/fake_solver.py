@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""A stand-in for `boycott case run CASE --out DIR` that obeys the contract of design brief
-section 7, so the study driver's resume, retry and signal logic is tested against real processes.
+"""A stand-in for `boycott case run CASE --out DIR` that obeys its contract (README.md,
+"Running a case"), so the study driver's resume, retry and signal logic is tested against real processes.
 
 It advances a simulated clock in steps of 0.1 s up to time.end (sleeping FAKE_STEP_WALL_S per
 step), checkpoints its state to DIR/checkpoint.json every step, appends DIR/timeseries.csv, and

@@ -160,17 +160,31 @@ for _ in $(seq 600); do
     [ -f "$ts" ] || continue
     t=$(tail -n 1 "$ts" | cut -d, -f1)
     # Once it has a checkpoint (timeseries.csv grows in bursts: t is only a bound) and before the
-    # last 0.3 s of its 1 s (about 1 s of wall time left: the warning reaches the solver within
-    # ~0.1 s). A window of 0.1-0.2 s only, with this loop slowed beside two busy processes, was
-    # missed once: every task ended first.
+    # last 0.3 s of its 1 s. The solver is held (SIGSTOP) while the warning travels, so it cannot
+    # finish before the warning reaches it however fast the machine: this loop needs only to see
+    # one task in that window, not to beat the task's end.
     if [ -n "$(ls "$work/slurm.sqlite.runs/$c/checkpoints" 2> /dev/null)" ] && [ ! -f "$work/slurm.sqlite.runs/$c/summary.json" ] &&
       awk -v t="$t" 'BEGIN { exit !(t <= 0.7) }'; then
       # What --signal=B:USR1 does: USR1 to the task's batch shell only. Sent here with kill, since
       # `scancel -b -s USR1` answered "can not be altered now" and retried for 15 s, and once the
       # warning came too late.
       shell=$(pgrep -f "$work/spool/job$(printf %05d "$job")/slurm_script" | head -n 1)
-      [ -n "$shell" ] || continue
+      solver=$(pgrep -f "case run $work/slurm.sqlite.runs/$c/case.toml" | head -n 1)
+      [ -n "$shell" ] && [ -n "$solver" ] || continue
+      kill -STOP "$solver" 2> /dev/null || continue
+      if [ -f "$work/slurm.sqlite.runs/$c/summary.json" ]; then
+        kill -CONT "$solver"
+        continue
+      fi
       kill -USR1 "$shell"
+      # The batch shell's trap hands USR1 on to the solver, where it waits (pending) until the
+      # solver runs again.
+      for _ in $(seq 200); do
+        pending=$(awk '/^ShdPnd:/ { print $2 }' "/proc/$solver/status" 2> /dev/null || echo 0)
+        (((16#${pending:-0} & 0x200) != 0)) && break
+        sleep 0.05
+      done
+      kill -CONT "$solver"
       signalled_job=$job
       signalled_case=$c
       echo "warned job $job (case $c) at t = $t s, $(($(date +%s) - t_submit)) s after submitting"

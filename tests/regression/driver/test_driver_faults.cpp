@@ -25,7 +25,7 @@
 
 #include "core/error.hpp"
 #include "core/run_status.hpp"
-#include "driver/database.hpp"
+#include "driver/store/database.hpp"
 
 namespace bd = boycott::driver;
 namespace fs = std::filesystem;

@@ -14,7 +14,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "driver/database.hpp"
+#include "driver/store/database.hpp"
 
 namespace bd = boycott::driver;
 namespace fs = std::filesystem;

@@ -1,4 +1,4 @@
-// Drag laws against the design brief's terminal velocities (computed from Eqs. 12-15) and the
+// Drag laws against the base case's terminal velocities (computed from the paper's Eqs. 12-15) and the
 // Ergun equation that the dense branch of Eq. 13 encodes.
 #include <gtest/gtest.h>
 

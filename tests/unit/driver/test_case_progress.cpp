@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "driver/case_progress.hpp"
-#include "driver/progress.hpp"
+#include "driver/cli/case_progress.hpp"
+#include "driver/run/progress.hpp"
 
 namespace bd = boycott::driver;
 using Clock = bd::CaseProgress::Clock;

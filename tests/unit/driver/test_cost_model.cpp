@@ -4,7 +4,7 @@
 // judges the arithmetic, which a shared machine's timing noise cannot.
 #include <gtest/gtest.h>
 
-#include "driver/cost_model.hpp"
+#include "driver/study/cost_model.hpp"
 
 namespace boycott::driver {
 namespace {

@@ -1,4 +1,4 @@
-// The tree of readable names beside the run folders (driver/run_tree.hpp): one link per case,
+// The tree of readable names beside the run folders (driver/run/run_tree.hpp): one link per case,
 // replicas of a point in a folder of their own, an older tree corrected in place.
 #include <unistd.h>
 
@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "driver/run_tree.hpp"
-#include "driver/study.hpp"
+#include "driver/run/run_tree.hpp"
+#include "driver/study/study.hpp"
 
 namespace bd = boycott::driver;
 namespace fs = std::filesystem;

@@ -12,10 +12,10 @@
 #include <sqlite3.h>
 #include "core/distributions.hpp"
 
-#include "driver/database.hpp"
-#include "driver/schema_files.hpp"
-#include "driver/store.hpp"
-#include "driver/study.hpp"
+#include "driver/store/database.hpp"
+#include "driver/store/schema_files.hpp"
+#include "driver/store/store.hpp"
+#include "driver/study/study.hpp"
 
 namespace bd = boycott::driver;
 namespace fs = std::filesystem;

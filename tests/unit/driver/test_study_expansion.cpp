@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
-#include "driver/runner.hpp"
-#include "driver/study.hpp"
+#include "driver/run/solver_process.hpp"
+#include "driver/study/study.hpp"
 
 namespace bd = boycott::driver;
 

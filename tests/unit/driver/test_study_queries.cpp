@@ -12,15 +12,15 @@
 
 #include "core/distributions.hpp"
 #include "core/error.hpp"
-#include "driver/curve.hpp"
-#include "driver/database.hpp"
-#include "driver/plot_cairo.hpp"
-#include "driver/replica_rounds.hpp"
-#include "driver/store.hpp"
-#include "driver/study.hpp"
-#include "driver/terminal_text.hpp"
-#include "driver/validation_query.hpp"
-#include "driver/work_precision.hpp"
+#include "driver/report/curve.hpp"
+#include "driver/report/plot_cairo.hpp"
+#include "driver/report/terminal_text.hpp"
+#include "driver/report/validation_query.hpp"
+#include "driver/report/work_precision.hpp"
+#include "driver/run/replica_rounds.hpp"
+#include "driver/store/database.hpp"
+#include "driver/store/store.hpp"
+#include "driver/study/study.hpp"
 
 namespace bd = boycott::driver;
 namespace fs = std::filesystem;

@@ -1,7 +1,8 @@
-// Checkpoint files that prove they are intact (issue 26): SHA-256 against the standard's
-// examples, every flipped byte of a sealed file refused, files without a hash accepted as
-// unverified, states that no run can continue from refused naming the check, and a write to a
-// full disk reported as a storage error with the system's words, the .tmp removed.
+// Checkpoint files that prove they are intact: SHA-256 against the standard's examples, a file
+// sealed by the project's own SHA-256 before nettle computed it still verified, every flipped byte of a
+// sealed file refused, files without a hash accepted as unverified, states that no run can continue from
+// refused naming the check, and a write to a full disk reported as a storage error with the system's words,
+// the .tmp removed.
 #include <fcntl.h>
 #include <hdf5.h>
 #include <sys/mount.h>
@@ -110,6 +111,19 @@ TEST(CheckpointFile, SealedFileVerifiesAndEveryFlippedByteIsRefused) {
   EXPECT_EQ(refused, static_cast<int>(offsets.size()));
   std::printf("[ report ] %d of %zu single-byte flips refused (a %zu-byte file)\n", refused, offsets.size(),
               good.size());
+}
+
+// tests/data/ckpt_sealed_own_sha256.h5: write_small_checkpoint's file as the build before nettle
+// wrote it, sealed by the SHA-256 the project then computed itself (written from FIPS 180-4):
+// the checkpoints of runs made before the change still verify.
+TEST(CheckpointFile, FileSealedByTheEarlierOwnSha256StillVerifies) {
+  TempDir d;
+  const fs::path f = d.path / "ckpt_000000000250.h5";
+  fs::copy_file(fs::path(BOYCOTT_SOURCE_DIR) / "tests/data/ckpt_sealed_own_sha256.h5", f);
+  EXPECT_EQ(verify_file(f), Integrity::kVerified);
+  CheckpointReader r(f);
+  EXPECT_EQ(r.integrity(), Integrity::kVerified);
+  EXPECT_EQ(r.scalar("run.time_s"), 0.25);
 }
 
 TEST(CheckpointFile, LostHashFooterIsRefused) {

@@ -1,4 +1,4 @@
-// Stability of the coupled solver on stiff and extreme cases (issue 7, design brief section 5):
+// Stability of the coupled solver on stiff and extreme cases :
 // each runs to its end with alpha_f in (0, 1] and bounded kinetic energy; cases that cannot work
 // are refused before anything is written, naming the limit; a NaN stops the run before it is
 // checkpointed. Reduced boxes (a few hundred to two thousand particles, 0.1 s) so that the whole
@@ -207,7 +207,7 @@ TEST(StiffAndExtremeCases, ImpossibleCasesAreRefusedNamingTheLimit) {
 }
 
 TEST(Preflight, ReportsTheDimensionlessGroupsOfTheBaseCase) {
-  CaseParams p;  // Table III: Ga 1456, Sg 2.65, Sr 0.1 (design brief section 4)
+  CaseParams p;  // Table III: Ga 1456, Sg 2.65, Sr 0.1 (Table III of the paper)
   validate(p);
   const Preflight pre = preflight(p);
   std::map<std::string, double> v;
@@ -215,7 +215,7 @@ TEST(Preflight, ReportsTheDimensionlessGroupsOfTheBaseCase) {
   EXPECT_NEAR(v["Ga"], 1456.0, 1.0);
   EXPECT_NEAR(v["Sg"], 2.65, 1e-12);
   EXPECT_NEAR(v["Sr"], 0.1, 1e-12);
-  EXPECT_NEAR(v["terminal_velocity"], 0.090, 0.0005);  // design brief: base 0.090 m/s, Re 54
+  EXPECT_NEAR(v["terminal_velocity"], 0.090, 0.0005);  // the base case: 0.090 m/s, Re 54 (Eqs. 12-15)
   EXPECT_NEAR(v["Re_p"], 54.0, 0.5);
   // Collision time of the spring-dashpot at e = 0.1: pi / (w0 sqrt(1 - zeta^2)).
   const double m = p.particle_mass_kg(), w0 = std::sqrt(3.5 / (0.5 * m));

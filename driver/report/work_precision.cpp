@@ -1,0 +1,410 @@
+#include "driver/report/work_precision.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "driver/report/report_util.hpp"
+
+namespace boycott::driver {
+
+namespace {
+
+constexpr const char* kAngleKey = "gravity.angle_deg";
+
+std::vector<SweptValue> setting_of(Database& db, const std::string& case_id) {
+  auto v = case_swept_values(db, case_id);
+  std::erase_if(v, [](const SweptValue& x) { return x.key == kAngleKey; });
+  return v;
+}
+
+const SettlingResult& reference_at(const std::vector<SettlingResult>& refs, const std::string& ref_group,
+                                   Database& db, const SettlingResult& run) {
+  std::vector<const SettlingResult*> found;
+  for (const auto& r : refs)
+    if (r.angle_deg == run.angle_deg) found.push_back(&r);
+  if (found.empty())
+    throw InputError(fmt::format(
+        "no finished case of reference group '{}' at {} = {:g} (needed by group '{}' case {}): run the "
+        "reference at that angle, or name another reference group with --reference",
+        ref_group, kAngleKey, run.angle_deg, run.group, run.case_id));
+  if (found.size() > 1) {
+    std::string names;
+    for (const auto* r : found)
+      names += fmt::format("{}{} ({})", names.empty() ? "" : ", ", r->case_id,
+                           report::join_values(setting_of(db, r->case_id)));
+    throw InputError(
+        fmt::format("reference group '{}' has {} finished cases at {} = {:g}: {}; a work-precision reference "
+                    "needs exactly "
+                    "one case per angle",
+                    ref_group, found.size(), kAngleKey, run.angle_deg, names));
+  }
+  if (found[0]->w_m_s == 0.0)
+    throw InputError(
+        fmt::format("reference case {} at {} = {:g} has <<w_p>> = 0: the relative error is undefined",
+                    found[0]->case_id, kAngleKey, run.angle_deg));
+  return *found[0];
+}
+
+std::string percent_pm(double e, double u) {
+  // No uncertainty where a run gave no error of its own (a window too short to estimate one).
+  if (std::isnan(u)) return report::percent(e) + " +- n/a";
+  const double up = u * 100.0;
+  return fmt::format("{} +- {}", report::percent(e),
+                     up >= 0.01 || up == 0.0 ? fmt::format("{:.2f} %", up) : fmt::format("{:.2g} %", up));
+}
+
+std::string opt_csv(const std::optional<double>& v) {
+  return v && !std::isnan(*v) ? fmt::format("{:.9g}", *v) : std::string();
+}
+nlohmann::json opt_json(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+}  // namespace
+
+WorkPrecision query_work_precision(Database& db, const std::string& study,
+                                   const std::string& reference_group) {
+  require_study(db, study);
+  const std::vector<std::string> groups = study_groups(db, study);  // study order
+  if (std::find(groups.begin(), groups.end(), reference_group) == groups.end()) {
+    std::string names;
+    for (const auto& g : groups) names += (names.empty() ? "" : ", ") + g;
+    throw InputError(
+        fmt::format("study '{}' has no group '{}' (its groups: {}): name the reference group with "
+                    "--reference",
+                    study, reference_group, names.empty() ? "none" : names));
+  }
+
+  std::vector<SettlingResult> refs, runs;
+  for (auto& r : settling_results(db, study))
+    (r.group == reference_group ? refs : runs).push_back(std::move(r));
+
+  WorkPrecision wp{study, reference_group, {}, {}};
+  for (const auto& run : runs) {
+    const auto& ref = reference_at(refs, reference_group, db, run);
+    WorkPrecisionRow row;
+    row.group = run.group;
+    row.case_id = run.case_id;
+    row.setting = setting_of(db, run.case_id);
+    row.angle_deg = run.angle_deg;
+    row.wall_time_s = run.wall_time_s;
+    row.particle_steps = run.particle_steps;
+    row.w_m_s = run.w_m_s;
+    row.w_err_m_s = run.w_err_m_s;
+    row.ref_case_id = ref.case_id;
+    row.w_ref_m_s = ref.w_m_s;
+    row.w_ref_err_m_s = ref.w_err_m_s;
+    // e = w/w_ref - 1; de/dw = 1/w_ref, de/dw_ref = -w/w_ref^2 (independent standard errors).
+    row.rel_error_w = run.w_m_s / ref.w_m_s - 1.0;
+    row.rel_error_w_unc =
+        std::hypot(run.w_err_m_s / ref.w_m_s, run.w_m_s * ref.w_err_m_s / (ref.w_m_s * ref.w_m_s));
+    wp.rows.push_back(std::move(row));
+    if (std::none_of(wp.references.begin(), wp.references.end(),
+                     [&](const ReferenceRun& r) { return r.case_id == ref.case_id; }))
+      wp.references.push_back({ref.case_id, ref.angle_deg, ref.w_m_s, ref.w_err_m_s, ref.wall_time_s});
+  }
+
+  // r_acc against the reference's r_acc: the quantity the paper reports, whose error can be far
+  // smaller than that of <<w_p>> when a setting shifts all angles alike.
+  for (auto& row : wp.rows) {
+    if (row.angle_deg == 90.0) continue;
+    const WorkPrecisionRow* v90 = nullptr;
+    for (const auto& q : wp.rows)
+      if (q.group == row.group && q.angle_deg == 90.0 && q.setting == row.setting) v90 = &q;
+    if (!v90 || v90->w_m_s == 0.0) continue;
+    // R = (w / w90) / (wr / wr90); every reference w is non-zero (checked above).
+    const double w = row.w_m_s, w90 = v90->w_m_s, wr = row.w_ref_m_s, wr90 = v90->w_ref_m_s;
+    const double R = (w / w90) * (wr90 / wr);
+    row.rel_error_r_acc = R - 1.0;
+    const double dw = row.w_err_m_s * wr90 / (w90 * wr);
+    const double dw90 = R * v90->w_err_m_s / w90, dwr = R * row.w_ref_err_m_s / wr,
+                 dwr90 = R * v90->w_ref_err_m_s / wr90;
+    row.rel_error_r_acc_unc = std::sqrt(dw * dw + dw90 * dw90 + dwr * dwr + dwr90 * dwr90);
+  }
+
+  std::map<std::string, std::size_t> order;
+  for (std::size_t i = 0; i < groups.size(); ++i) order[groups[i]] = i;
+  std::stable_sort(wp.rows.begin(), wp.rows.end(), [&](const WorkPrecisionRow& a, const WorkPrecisionRow& b) {
+    if (a.group != b.group) return order[a.group] < order[b.group];
+    // Cases without a recorded wall time last.
+    if (a.wall_time_s.has_value() != b.wall_time_s.has_value()) return a.wall_time_s.has_value();
+    if (a.wall_time_s && *a.wall_time_s != *b.wall_time_s) return *a.wall_time_s < *b.wall_time_s;
+    return a.angle_deg < b.angle_deg;
+  });
+  std::sort(wp.references.begin(), wp.references.end(),
+            [](const ReferenceRun& a, const ReferenceRun& b) { return a.angle_deg < b.angle_deg; });
+  return wp;
+}
+
+std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
+  if (f == ListingFormat::kJson) {
+    nlohmann::json refs = nlohmann::json::array(), rows = nlohmann::json::array();
+    for (const auto& r : wp.references)
+      refs.push_back({{"case_id", r.case_id},
+                      {"angle_deg", r.angle_deg},
+                      {"mean_settling_velocity_m_s", r.w_m_s},
+                      {"stderr_m_s", r.w_err_m_s},
+                      {"wall_time_s", opt_json(r.wall_time_s)}});
+    for (const auto& r : wp.rows) {
+      nlohmann::json setting = nlohmann::json::object();
+      for (const auto& v : r.setting) setting[v.key] = report::value_json(v);
+      rows.push_back(
+          {{"group", r.group},
+           {"setting", setting},
+           {"angle_deg", r.angle_deg},
+           {"wall_time_s", opt_json(r.wall_time_s)},
+           {"particle_steps", r.particle_steps ? nlohmann::json(*r.particle_steps) : nlohmann::json(nullptr)},
+           {"mean_settling_velocity_m_s", r.w_m_s},
+           {"stderr_m_s", r.w_err_m_s},
+           {"reference_m_s", r.w_ref_m_s},
+           {"reference_stderr_m_s", r.w_ref_err_m_s},
+           {"rel_error_w", r.rel_error_w},
+           {"rel_error_w_uncertainty", r.rel_error_w_unc},
+           {"rel_error_r_acc", opt_json(r.rel_error_r_acc)},
+           {"rel_error_r_acc_uncertainty", opt_json(r.rel_error_r_acc_unc)},
+           {"case_id", r.case_id},
+           {"reference_case_id", r.ref_case_id}});
+    }
+    const nlohmann::json j = {
+        {"study", wp.study}, {"reference_group", wp.reference_group}, {"references", refs}, {"rows", rows}};
+    return j.dump(2) + "\n";
+  }
+  if (f == ListingFormat::kCsv) {
+    std::string s =
+        "group,setting,angle_deg,wall_time_s,particle_steps,mean_settling_velocity_m_s,stderr_m_s,reference_"
+        "m_s,"
+        "reference_stderr_m_s,rel_error_w,rel_error_w_uncertainty,rel_error_r_acc,rel_error_r_acc_"
+        "uncertainty,"
+        "case_id,reference_case_id\n";
+    for (const auto& r : wp.rows)
+      s += fmt::format(
+          "{},{},{:g},{},{},{:.9g},{},{:.9g},{},{:.9g},{},{},{},{},{}\n", report::csv_field(r.group),
+          report::csv_field(report::join_values(r.setting)), r.angle_deg, opt_csv(r.wall_time_s),
+          r.particle_steps ? std::to_string(*r.particle_steps) : "", r.w_m_s, opt_csv(r.w_err_m_s),
+          r.w_ref_m_s, opt_csv(r.w_ref_err_m_s), r.rel_error_w, opt_csv(r.rel_error_w_unc),
+          opt_csv(r.rel_error_r_acc), opt_csv(r.rel_error_r_acc_unc), r.case_id, r.ref_case_id);
+    return s;
+  }
+  if (wp.rows.empty())
+    return fmt::format("(no finished cases outside the reference group '{}')\n", wp.reference_group);
+  report::TextTable t({"group", "setting", "angle", "wall (s)", "particle steps", "<<w_p>> (mm/s)",
+                       "ref (mm/s)", "error <<w_p>>", "error r_acc"},
+                      {false, false, true, true, true, true, true, true, true});
+  for (const auto& r : wp.rows)
+    t.add({r.group, report::join_values(r.setting), fmt::format("{:g}", r.angle_deg),
+           r.wall_time_s ? report::seconds(*r.wall_time_s) : "-",
+           r.particle_steps ? std::to_string(*r.particle_steps) : "-", fmt::format("{:.4f}", r.w_m_s * 1e3),
+           fmt::format("{:.4f}", r.w_ref_m_s * 1e3), percent_pm(r.rel_error_w, r.rel_error_w_unc),
+           r.rel_error_r_acc ? percent_pm(*r.rel_error_r_acc, *r.rel_error_r_acc_unc) : "-"});
+  std::string s = t.str();
+  for (const auto& r : wp.references)
+    s += fmt::format("reference '{}' at {:g} deg: <<w_p>> {:.4f} +- {} mm/s, wall {} s, case {}\n",
+                     wp.reference_group, r.angle_deg, r.w_m_s * 1e3,
+                     std::isnan(r.w_err_m_s) ? std::string("n/a") : fmt::format("{:.4f}", r.w_err_m_s * 1e3),
+                     r.wall_time_s ? report::seconds(*r.wall_time_s) : "-", r.case_id);
+  return s;
+}
+
+namespace {
+
+/// The order of a group's varied setting: numbers as numbers, key by key.
+bool setting_before(const std::vector<SweptValue>& a, const std::vector<SweptValue>& b) {
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    if (a[i].key != b[i].key) return a[i].key < b[i].key;
+    if (a[i].value_num && b[i].value_num) {
+      if (*a[i].value_num != *b[i].value_num) return *a[i].value_num < *b[i].value_num;
+    } else if (a[i].value != b[i].value) {
+      return a[i].value < b[i].value;
+    }
+  }
+  return a.size() < b.size();
+}
+
+/// A point's label: the values of its setting ("5e-05", "[25, 3, 25]").
+std::string setting_label(const std::vector<SweptValue>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : "; ") + x.display();
+  return s;
+}
+
+/// Only positive wall times have a place on a log axis.
+bool plotted(const WorkPrecisionRow& r) {
+  return r.wall_time_s && *r.wall_time_s > 0;
+}
+
+/// `query work-precision --plot`: one log-log panel of |error| against wall time per angle, each
+/// group a line through its settings, the reference runs' wall times as dashed lines.
+class WorkPrecisionFigure {
+ public:
+  static constexpr double kFloor = kWorkPrecisionErrorFloor;
+  static constexpr double w = 360, h = 360, y0 = 60, gap = 80;
+
+  explicit WorkPrecisionFigure(const WorkPrecision& wp) : wp_(wp) {
+    for (const auto& r : wp.rows) {
+      if (std::find(groups_.begin(), groups_.end(), r.group) == groups_.end()) groups_.push_back(r.group);
+      if (std::find(angles_.begin(), angles_.end(), r.angle_deg) == angles_.end())
+        angles_.push_back(r.angle_deg);
+    }
+    std::sort(angles_.begin(), angles_.end());
+    if (angles_.empty()) angles_.push_back(90.0);
+    set_ranges();
+  }
+
+  double width() const { return 90 + angles_.size() * (w + gap) + 170; }
+  static constexpr double height() { return 490; }
+
+  void draw(plot::Canvas& c, const std::string& title) const {
+    c.text((90 + angles_.size() * (w + gap) - gap) / 2 + 45, 24, title, plot::Anchor::kMiddle, 15);
+    for (std::size_t a = 0; a < angles_.size(); ++a) draw_panel(c, a);
+    draw_legend(c);
+  }
+
+ private:
+  /// The range is the points', not their error bars': a large bar is clipped at the frame rather
+  /// than squeezing every point together.
+  void set_ranges() {
+    for (const auto& r : wp_.rows) {
+      if (!plotted(r)) continue;
+      xlo_ = std::min(xlo_, *r.wall_time_s), xhi_ = std::max(xhi_, *r.wall_time_s);
+      const double e = std::max(std::abs(r.rel_error_w), kFloor);
+      ylo_ = std::min(ylo_, e), yhi_ = std::max(yhi_, e);
+    }
+    for (const auto& r : wp_.references)
+      if (r.wall_time_s && *r.wall_time_s > 0)
+        xlo_ = std::min(xlo_, *r.wall_time_s), xhi_ = std::max(xhi_, *r.wall_time_s);
+    if (!std::isfinite(xlo_)) xlo_ = 1, xhi_ = 10;
+    if (!std::isfinite(ylo_)) ylo_ = 1e-3, yhi_ = 1e-1;
+    // A margin of a fifth of a decade (at least one decade in view) keeps markers off the frame.
+    if (xhi_ / xlo_ < 10) {
+      const double m = std::sqrt(10 * xlo_ / xhi_);
+      xlo_ /= m, xhi_ *= m;
+    }
+    if (yhi_ / ylo_ < 10) {
+      const double m = std::sqrt(10 * ylo_ / yhi_);
+      ylo_ /= m, yhi_ *= m;
+    }
+    xlo_ /= 1.6, xhi_ *= 1.6, ylo_ /= 1.6, yhi_ *= 1.6;
+  }
+
+  double px(double x0, double t) const {
+    return x0 + (std::log10(t) - std::log10(xlo_)) / (std::log10(xhi_) - std::log10(xlo_)) * w;
+  }
+  double py(double e) const {
+    e = std::clamp(e, ylo_, yhi_);
+    return y0 + h - (std::log10(e) - std::log10(ylo_)) / (std::log10(yhi_) - std::log10(ylo_)) * h;
+  }
+
+  void draw_panel(plot::Canvas& c, std::size_t a) const {
+    using plot::Anchor;
+    const double angle = angles_[a], x0 = 90 + a * (w + gap);
+    for (double t : report::log_ticks(xlo_, xhi_)) {
+      c.line(px(x0, t), y0, px(x0, t), y0 + h, "#ddd");
+      c.text(px(x0, t), y0 + h + 18, fmt::format("{:g}", t), Anchor::kMiddle);
+    }
+    for (double e : report::log_ticks(ylo_, yhi_)) {
+      c.line(x0, py(e), x0 + w, py(e), "#ddd");
+      c.text(x0 - 6, py(e) + 4, fmt::format("{:g}", e), Anchor::kEnd);
+    }
+    c.stroke_rect(x0, y0, w, h, "#000", "panel");
+    c.text(x0 + w / 2, y0 - 8, fmt::format("θ = {:g}°", angle), Anchor::kMiddle);
+    c.text(x0 + w / 2, y0 + h + 40, "wall time (s)", Anchor::kMiddle);
+    if (a == 0)
+      c.label(x0 - 62, y0 + h / 2, "|⟨⟨w_{p}⟩⟩ / ⟨⟨w_{p}⟩⟩_{ref} − 1| (dimensionless)", Anchor::kMiddle, 13,
+              true);
+    bool any_floor = false;
+    for (const auto& r : wp_.rows)
+      if (r.angle_deg == angle && plotted(r) && std::abs(r.rel_error_w) < kFloor) any_floor = true;
+    if (any_floor) c.line(x0, py(kFloor), x0 + w, py(kFloor), "#999", 1.0, {2, 3}, "floor");
+    // The reference run's cost: how much cheaper each point is than the run it is measured against.
+    for (const auto& r : wp_.references) {
+      if (r.angle_deg != angle || !r.wall_time_s || *r.wall_time_s <= 0) continue;
+      const double x = px(x0, *r.wall_time_s);
+      c.line(x, y0, x, y0 + h, "#555", 1.0, {6, 4}, "reference");
+      c.text(x - 4, y0 + h - 6, wp_.reference_group, Anchor::kStart, 11, "#555", true);
+    }
+    for (std::size_t g = 0; g < groups_.size(); ++g) draw_group(c, x0, angle, g);
+  }
+
+  /// One group at one angle, joined in the order of the varied setting, each point labelled with
+  /// its value.
+  void draw_group(plot::Canvas& c, double x0, double angle, std::size_t g) const {
+    const char* color = report::color(g);
+    std::vector<const WorkPrecisionRow*> mine;
+    for (const auto& r : wp_.rows)
+      if (r.group == groups_[g] && r.angle_deg == angle && plotted(r)) mine.push_back(&r);
+    if (mine.empty()) return;
+    std::stable_sort(mine.begin(), mine.end(), [](const WorkPrecisionRow* p, const WorkPrecisionRow* q) {
+      return setting_before(p->setting, q->setting);
+    });
+    auto at = [&](const WorkPrecisionRow* r) {
+      return std::pair{px(x0, *r->wall_time_s), py(std::max(std::abs(r->rel_error_w), kFloor))};
+    };
+    std::vector<std::pair<double, double>> line;
+    for (const auto* r : mine) line.push_back(at(r));
+    c.polyline(line, color, 1.5, "group");
+    // Error bars are clipped to the panel's frame.
+    c.clip(x0, y0, w, h);
+    for (const auto* r : mine) {
+      if (!(r->rel_error_w_unc > 0)) continue;  // none, or NaN: no bar
+      const double e = std::abs(r->rel_error_w), x = at(r).first;
+      const double top = e + r->rel_error_w_unc, bottom = std::max(e - r->rel_error_w_unc, kFloor);
+      c.line(x, py(bottom), x, py(top), color, 1.0, {}, "errorbar");
+      c.line(x - 4, py(top), x + 4, py(top), color);
+    }
+    c.unclip();
+    for (const auto* r : mine) {
+      const auto [x, y] = at(r);
+      c.marker(report::marker_kind(g), x, y, color, std::abs(r->rel_error_w) < kFloor);
+      const std::string label = setting_label(r->setting);
+      if (!label.empty()) c.text(x + 6, y - 6, label, plot::Anchor::kStart, 10, color, false, "setting");
+    }
+  }
+
+  /// The legend right of the panels, and the caption: what a bar is, and why a point may have
+  /// none (a window too short for an error of its own).
+  void draw_legend(plot::Canvas& c) const {
+    const double lx = 90 + angles_.size() * (w + gap) - gap + 20;
+    double ly = y0 + 10;
+    for (std::size_t g = 0; g < groups_.size(); ++g, ly += 20) {
+      c.marker(report::marker_kind(g), lx + 8, ly, report::color(g));
+      c.text(lx + 20, ly + 4, groups_[g], plot::Anchor::kStart, 13, "#000", false, "legend");
+    }
+    c.line(lx, ly, lx + 16, ly, "#555", 1.0, {6, 4});
+    c.text(lx + 20, ly + 4, "reference wall time");
+    ly += 20;
+    if (std::any_of(wp_.rows.begin(), wp_.rows.end(), [&](const WorkPrecisionRow& r) {
+          return plotted(r) && std::abs(r.rel_error_w) < kFloor;
+        })) {
+      c.marker("circle", lx + 8, ly, "#555", true);
+      c.text(lx + 20, ly + 4, fmt::format("|error| < {:g}, drawn at {:g}", kFloor, kFloor));
+    }
+    const bool any_without = std::any_of(wp_.rows.begin(), wp_.rows.end(), [&](const WorkPrecisionRow& r) {
+      return plotted(r) && !(r.rel_error_w_unc > 0);
+    });
+    c.text(90, height() - 14,
+           std::string(
+               "bars: 68 % interval of the error from the statistical errors of the run and the reference") +
+               (any_without ? "; no bar: a run gave no error estimate (window too short)" : ""),
+           plot::Anchor::kStart, 11, "#333", false, "caption");
+  }
+
+  const WorkPrecision& wp_;
+  std::vector<std::string> groups_;
+  std::vector<double> angles_;
+  double xlo_ = INFINITY, xhi_ = -INFINITY, ylo_ = INFINITY, yhi_ = -INFINITY;
+};
+
+}  // namespace
+
+plot::Plot work_precision_plot(const WorkPrecision& wp, const std::string& title, plot::Format format) {
+  const WorkPrecisionFigure figure(wp);
+  return plot::render(figure.width(), WorkPrecisionFigure::height(), format,
+                      [&](plot::Canvas& c) { figure.draw(c, title); });
+}
+
+}  // namespace boycott::driver

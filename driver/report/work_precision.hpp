@@ -1,0 +1,66 @@
+#pragma once
+// Error against run time: a work-precision study has one group of fine
+// reference runs (default name "reference") and groups that each change one setting (time.dt_dem,
+// domain.cells, ...), all over the same gravity.angle_deg values. Every finished case outside the
+// reference group is compared with the reference case of its angle.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "driver/report/curve.hpp"
+#include "driver/report/plot_cairo.hpp"
+#include "driver/store/database.hpp"
+#include "driver/store/store.hpp"
+
+namespace boycott::driver {
+
+struct WorkPrecisionRow {
+  std::string group, case_id;
+  std::vector<SweptValue> setting;  ///< the case's swept values without gravity.angle_deg
+  double angle_deg = 0;
+  std::optional<double> wall_time_s;
+  std::optional<std::int64_t> particle_steps;
+  double w_m_s = 0, w_err_m_s = 0;  ///< <<w_p>> and its standard error
+  std::string ref_case_id;
+  double w_ref_m_s = 0, w_ref_err_m_s = 0;
+  /// w / w_ref - 1: positive when the case settles faster than the reference (both velocities
+  /// have the sign of gravity, so this is (|w| - |w_ref|)/|w_ref| whenever w and w_ref agree in sign).
+  double rel_error_w = 0;
+  double rel_error_w_unc = 0;  ///< first-order propagation of both standard errors, independent
+  /// r_acc(theta) / r_acc_ref(theta) - 1, r_acc = w(theta)/w(90) within the same group and
+  /// setting; unset at 90 deg and where the group has no 90 deg case of the same setting.
+  std::optional<double> rel_error_r_acc, rel_error_r_acc_unc;
+};
+
+struct ReferenceRun {
+  std::string case_id;
+  double angle_deg = 0;
+  double w_m_s = 0, w_err_m_s = 0;
+  std::optional<double> wall_time_s;
+};
+
+struct WorkPrecision {
+  std::string study, reference_group;
+  std::vector<ReferenceRun> references;  ///< the finished reference cases used, by angle
+  std::vector<WorkPrecisionRow> rows;    ///< groups in study order, by wall time within a group
+};
+
+/// InputError when the study or the reference group does not exist, when a case has no finished
+/// reference case at its angle (naming the group and the angle), when the reference group has
+/// several finished cases at one angle (naming them), or when a reference <<w_p>> is zero.
+WorkPrecision query_work_precision(Database& db, const std::string& study,
+                                   const std::string& reference_group = "reference");
+
+std::string format_work_precision(const WorkPrecision& wp, ListingFormat f);
+
+/// Below this |relative error| a point is drawn on the floor of the log axis, hollow.
+inline constexpr double kWorkPrecisionErrorFloor = 1e-6;
+/// Log-log |rel_error_w| against wall time, one panel per angle: one colour and marker per group,
+/// its points joined in the order of the varied setting and labelled with its value, error bars
+/// clipped to the frame, the reference's wall time as a dashed vertical line. Drawn with Cairo as
+/// SVG, PDF or PNG (driver/report/plot_cairo.hpp).
+plot::Plot work_precision_plot(const WorkPrecision& wp, const std::string& title,
+                               plot::Format format = plot::Format::kSvg);
+
+}  // namespace boycott::driver

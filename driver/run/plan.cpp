@@ -1,0 +1,237 @@
+#include "driver/run/plan.hpp"
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <optional>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "driver/report/listing_format.hpp"
+#include "driver/report/report_util.hpp"
+#include "driver/run/progress.hpp"
+#include "driver/store/store.hpp"
+#include "driver/study/cost_model.hpp"
+
+namespace fs = std::filesystem;
+
+namespace boycott::driver {
+
+namespace {
+std::string duration(double s) {
+  if (!std::isfinite(s) || s < 0) return "?";
+  if (s >= 48 * 3600.0) return fmt::format("{:.1f} d", s / 86400.0);
+  if (s >= 3600.0) return fmt::format("{:.1f} h", s / 3600.0);
+  if (s >= 60.0) return fmt::format("{:.1f} min", s / 60.0);
+  return fmt::format("{:.0f} s", s);
+}
+
+std::vector<MeasuredCost> measured(Database& db) {
+  std::vector<MeasuredCost> out;
+  for (const auto& f : finished_costs(db)) {
+    bool ok = false;
+    auto m = measured_cost(f.case_id, f.params_json, f.summary_json, &ok);
+    if (ok) out.push_back(std::move(m));
+  }
+  return out;
+}
+
+CaseWork work_of(const StudyCase& c) {
+  return case_work(to_json(c.params), 0.0, c.params.time.end_s);
+}
+
+std::string swept_text(const StudyCase& c) {
+  std::string s;
+  for (const auto& [k, v] : c.swept) s += (s.empty() ? "" : " ") + k + "=" + readable_value(v);
+  if (c.replica > 0) s += fmt::format("{}replica {}", s.empty() ? "" : " ", c.replica);
+  return s.empty() ? "-" : s;
+}
+}  // namespace
+
+PlanEstimate plan_estimate(Database& db, const Study& study, const std::vector<std::string>& to_run_ids,
+                           int jobs, int ranks) {
+  const CostModel model(measured(db));
+  std::map<std::string, const StudyCase*> by_id;
+  for (const auto& c : study.cases) by_id[c.id] = &c;
+  std::vector<double> costs;
+  std::map<std::string, bool> scenes;
+  for (const auto& id : to_run_ids)
+    if (const auto it = by_id.find(id); it != by_id.end()) {
+      costs.push_back(model.core_s(work_of(*it->second)));
+      scenes[it->second->params.scene] = true;
+    }
+  std::string basis;
+  for (const auto& [scene, _] : scenes)
+    basis += (basis.empty() ? "" : ", ") + scene + ": " + model.basis(scene);
+  PlanEstimate e;
+  e.line = fmt::format("plan: {} to run, estimated {} on {} x {} (cost model {})",
+                       count_of(static_cast<long long>(costs.size()), "case"),
+                       duration(study_wall_s(costs, jobs, ranks)), count_of(jobs, "job"),
+                       count_of(ranks, "rank"), basis.empty() ? "-" : basis);
+  double sum = 0.0;
+  for (double c : costs) sum += study_wall_s({c}, 1, ranks);
+  e.mean_case_wall_s = costs.empty() ? 0.0 : sum / static_cast<double>(costs.size());
+  return e;
+}
+
+namespace {
+
+/// Every case of the plan: its JSON row (numbers in seconds) and its line in the table.
+struct PlanRows {
+  nlohmann::json rows = nlohmann::json::array();
+  report::TextTable table;
+  std::vector<double> pending_costs;  ///< core-seconds of each case still to run
+  double total_core_s = 0.0;          ///< of every case, done or not
+};
+
+PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<std::string, CaseState>& states,
+                   const std::vector<MeasuredCost>& finished, const CostModel& model) {
+  std::map<std::string, const MeasuredCost*> measured_by_id;
+  for (const auto& m : finished) measured_by_id[m.case_id] = &m;
+  std::vector<std::string> header{"group", "varied", "case", "state", "core time"};
+  if (opt.check_model) header.emplace_back("leave one out");
+  PlanRows out{
+      nlohmann::json::array(), report::TextTable(header, {false, false, false, false, true, false}), {}, 0.0};
+  for (const auto& c : study.cases) {
+    const auto it = states.find(c.id);
+    const CaseStatus st = it == states.end() ? CaseStatus::kPending : it->second.status;
+    const double est = model.core_s(work_of(c));
+    out.total_core_s += est;
+    if (st != CaseStatus::kDone) out.pending_costs.push_back(est);
+    nlohmann::json row = {{"group", c.group},
+                          {"swept", swept_text(c)},
+                          {"case_id", c.id},
+                          {"state", to_string(st)},
+                          {"estimated_core_s", est},
+                          {"scene", c.params.scene},
+                          {"cost_basis", model.basis(c.params.scene)}};
+    const auto m = measured_by_id.find(c.id);
+    if (m != measured_by_id.end()) row["measured_core_s"] = m->second->core_s;
+    if (opt.check_model && m != measured_by_id.end()) {
+      // Leave one out: the same model without this run.
+      std::vector<MeasuredCost> others;
+      for (const auto& f : finished)
+        if (f.case_id != c.id) others.push_back(f);
+      row["predicted_by_others_core_s"] = CostModel(others).core_s(m->second->work);
+    }
+    std::vector<std::string> cells{c.group, swept_text(c), c.id, to_string(st), duration(est)};
+    if (opt.check_model)
+      cells.push_back(row.contains("predicted_by_others_core_s")
+                          ? fmt::format("measured {}, from the others {}", duration(m->second->core_s),
+                                        duration(row["predicted_by_others_core_s"].get<double>()))
+                          : std::string("-"));
+    out.table.add(std::move(cells));
+    out.rows.push_back(row);
+  }
+  return out;
+}
+
+/// The rows with their numbers in seconds (the table shows them for people).
+std::string plan_csv(const nlohmann::json& rows) {
+  const char* cols[] = {"group",           "swept",
+                        "case_id",         "state",
+                        "scene",           "estimated_core_s",
+                        "measured_core_s", "predicted_by_others_core_s",
+                        "cost_basis"};
+  std::string out;
+  for (const char* c : cols) out += fmt::format("{}{}", out.empty() ? "" : ",", c);
+  out += "\n";
+  for (const auto& r : rows) {
+    std::string line;
+    for (const char* c : cols) {
+      const auto v = r.value(c, nlohmann::json());
+      const std::string cell = v.is_string() ? v.get<std::string>()
+                               : v.is_null() ? ""
+                                             : fmt::format("{:.6g}", v.get<double>());
+      line += (c == cols[0] ? "" : ",") + report::csv_field(cell);
+    }
+    out += line + "\n";
+  }
+  return out;
+}
+
+/// A line per group: a table of a million lines is read by nobody (--all, csv and json list them).
+std::string plan_per_group(const Study& study, const nlohmann::json& rows) {
+  std::map<std::string, std::array<double, 3>> groups;  // cases, to run, core-seconds to run
+  for (std::size_t i = 0; i < study.cases.size(); ++i) {
+    auto& g = groups[study.cases[i].group];
+    g[0] += 1;
+    if (rows[i]["state"] != "done") {
+      g[1] += 1;
+      g[2] += rows[i]["estimated_core_s"].get<double>();
+    }
+  }
+  report::TextTable per_group({"group", "cases", "to run", "core time to run"}, {false, true, true, true});
+  for (const auto& [name, g] : groups)
+    per_group.add({name, fmt::format("{:.0f}", g[0]), fmt::format("{:.0f}", g[1]), duration(g[2])});
+  return fmt::format("{}(more than {} cases: one line per group; --all lists every case)\n", per_group.str(),
+                     kListEveryCaseMax);
+}
+
+/// What each scene's estimates rest on: its fitted runs, or the default model with its constants.
+void print_cost_models(const Study& study, const CostModel& model) {
+  std::map<std::string, bool> scenes;
+  for (const auto& c : study.cases) scenes[c.params.scene] = true;
+  for (const auto& [scene, _] : scenes)
+    std::printf(
+        "cost model %s: %s%s\n", scene.c_str(), model.basis(scene).c_str(),
+        model.basis(scene) == "default"
+            ? fmt::format(" ({:g} s + {:g} ns per particle-step + {:g} us per fluid cell-step)",
+                          CostModel::kStartS, CostModel::kParticleStepS * 1e9, CostModel::kCellStepS * 1e6)
+                  .c_str()
+            : "");
+}
+
+}  // namespace
+
+int study_plan(const PlanOptions& opt) {
+  const ListingFormat format = parse_listing_format(opt.format);
+  if (opt.jobs < 1 || opt.ranks < 1) throw InputError("--jobs and --ranks must be at least 1");
+  const Study study = expand_study_file(opt.study_file);
+  // The plan reads an existing database and creates none.
+  std::optional<Database> db;
+  if (!opt.db_path.empty() && fs::exists(opt.db_path)) db.emplace(opt.db_path, OpenMode::kReadOnly);
+  std::map<std::string, CaseState> states;
+  std::vector<MeasuredCost> finished;
+  if (db) {
+    for (auto& s : case_states(*db, study.name, 2)) states[s.id] = s;
+    finished = measured(*db);
+  }
+  const CostModel model(finished);
+  const PlanRows plan = plan_rows(study, opt, states, finished, model);
+  const double wall = study_wall_s(plan.pending_costs, opt.jobs, opt.ranks);
+  if (format == ListingFormat::kCsv) {
+    std::fputs(plan_csv(plan.rows).c_str(), stdout);
+    return 0;
+  }
+  if (format == ListingFormat::kJson) {
+    std::printf("%s\n", nlohmann::json{{"study", study.name},
+                                       {"cases", plan.rows},
+                                       {"jobs", opt.jobs},
+                                       {"ranks", opt.ranks},
+                                       {"remaining_cases", plan.pending_costs.size()},
+                                       {"estimated_wall_s", wall},
+                                       {"estimated_core_s_all_cases", plan.total_core_s}}
+                            .dump(1)
+                            .c_str());
+    return 0;
+  }
+  std::printf("study %s: %s, %zu to run\n", study.name.c_str(),
+              count_of(static_cast<long long>(study.cases.size()), "case").c_str(),
+              plan.pending_costs.size());
+  if (study.cases.size() <= kListEveryCaseMax || opt.all)
+    std::printf("%s", plan.table.str().c_str());
+  else
+    std::fputs(plan_per_group(study, plan.rows).c_str(), stdout);
+  std::printf("estimated wall time of the cases to run: %s on %s x %s (parallel efficiency %.2f)\n",
+              duration(wall).c_str(), count_of(opt.jobs, "job").c_str(), count_of(opt.ranks, "rank").c_str(),
+              ranks_efficiency(opt.ranks));
+  print_cost_models(study, model);
+  return 0;
+}
+
+}  // namespace boycott::driver

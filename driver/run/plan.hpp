@@ -1,0 +1,37 @@
+#pragma once
+// `boycott study plan`: the cases of a study, their state and their estimated cost, and the
+// study's wall time on J jobs of N ranks, from the cost model calibrated on the database's
+// finished runs (cost_model.hpp). Runs nothing; reads the database only if it exists.
+#include <string>
+#include <vector>
+
+#include "driver/store/database.hpp"
+#include "driver/study/study.hpp"
+
+namespace boycott::driver {
+
+struct PlanOptions {
+  std::string study_file;
+  std::string db_path;  ///< may not exist
+  int jobs = 1;
+  int ranks = 1;
+  std::string format = "table";  ///< table, csv or json
+  /// Also each finished case of the study predicted by a model fitted to the others only.
+  bool check_model = false;
+  /// The table lists every case even past kListEveryCaseMax (otherwise one line per group).
+  bool all = false;
+};
+/// A table of more cases than this is summarised per group unless PlanOptions::all.
+inline constexpr std::size_t kListEveryCaseMax = 10000;
+int study_plan(const PlanOptions& opt);
+
+/// What `study run` prints before it starts (cases to run and their estimated wall time), and
+/// the estimated wall time of one of them on average (its progress display's first ETA).
+struct PlanEstimate {
+  std::string line;
+  double mean_case_wall_s = 0.0;
+};
+PlanEstimate plan_estimate(Database& db, const Study& study, const std::vector<std::string>& to_run_ids,
+                           int jobs, int ranks);
+
+}  // namespace boycott::driver

@@ -1,0 +1,108 @@
+#include "driver/run/progress.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <utility>
+
+#include <fmt/format.h>
+
+namespace fs = std::filesystem;
+
+namespace boycott::driver {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+}  // namespace
+
+std::string count_of(long long n, const std::string& noun) {
+  return fmt::format("{} {}{}", n, noun, n == 1 ? "" : "s");
+}
+
+std::string eta_text(double s) {
+  if (!std::isfinite(s) || s < 0) return "?";
+  const long v = std::lround(s);
+  if (v >= 3600) return fmt::format("{}h{:02d}m", v / 3600, static_cast<int>(v % 3600 / 60));
+  if (v >= 60) return fmt::format("{}m{:02d}s", v / 60, static_cast<int>(v % 60));
+  return fmt::format("{}s", v);
+}
+
+double simulated_time_s(const fs::path& run_dir) {
+  std::ifstream in(run_dir / "timeseries.csv", std::ios::ate);
+  if (!in) return 0.0;
+  const auto size = static_cast<std::streamoff>(in.tellg());
+  const std::streamoff back = std::min<std::streamoff>(size, 4096);
+  in.seekg(size - back);
+  std::string chunk(static_cast<std::size_t>(back), '\0');
+  in.read(chunk.data(), back);
+  auto end = chunk.find_last_not_of("\n\r ");
+  if (end == std::string::npos) return 0.0;
+  const auto begin = chunk.rfind('\n', end);
+  const std::string line = chunk.substr(begin == std::string::npos ? 0 : begin + 1, end + 1);
+  char* stop = nullptr;
+  const double t = std::strtod(line.c_str(), &stop);
+  return stop == line.c_str() ? 0.0 : t;
+}
+
+ProgressDisplay::ProgressDisplay(std::string study, int jobs, bool live, double plain_every_s)
+    : study_(std::move(study)),
+      jobs_(jobs),
+      live_(live),
+      plain_every_s_(plain_every_s),
+      last_draw_(Clock::now()) {}
+
+void ProgressDisplay::redraw_if_due(const ProgressCounts& counts, const std::vector<RunningCase>& running) {
+  const auto every =
+      live_ ? std::chrono::duration<double>(0.5) : std::chrono::duration<double>(plain_every_s_);
+  if ((live_ || plain_every_s_ > 0) && Clock::now() - last_draw_ >= every) {
+    draw(counts, running);
+    last_draw_ = Clock::now();
+  }
+}
+
+void ProgressDisplay::draw(const ProgressCounts& counts, const std::vector<RunningCase>& running) {
+  if (!live_ && plain_every_s_ <= 0) return;
+  std::string s;
+  if (live_) {
+    if (printed_lines_ > 0) s += fmt::format("\033[{}A", printed_lines_);
+    s += "\033[J";
+  }
+  double remaining_s = 0, estimated_case_s = 0;
+  int estimated = 0, unknown = 0;  // unknown: running cases without a sim_s_per_s yet
+  std::string rows;
+  for (const auto& j : running) {
+    const double t_s = simulated_time_s(j.dir);
+    const double wall_s = std::chrono::duration<double>(Clock::now() - j.started).count();
+    const double sim_s_per_s = wall_s > 0 ? (t_s - j.t_start_s) / wall_s : 0;
+    const double end_s = j.c->params.time.end_s;
+    remaining_s += sim_s_per_s > 0 ? (end_s - t_s) / sim_s_per_s : 0.0;
+    unknown += sim_s_per_s > 0 ? 0 : 1;
+    if (sim_s_per_s > 0) {
+      estimated_case_s += end_s / sim_s_per_s;
+      ++estimated;
+    }
+    rows += fmt::format("  {} {:<12} {:5.1f} deg  t = {:8.3f} / {:g} s  {:8.4f} sim s/s\n", j.c->id,
+                        j.c->group, j.c->params.gravity.angle_deg, t_s, end_s, sim_s_per_s);
+  }
+  // Mean wall time of the cases finished in this run, else an estimate from the running ones,
+  // else the plan's.
+  double per_case_s = estimated > 0 ? estimated_case_s / estimated : planned_case_wall_s_;
+  if (!finished_wall_s_.empty()) {
+    per_case_s = 0;
+    for (double w : finished_wall_s_) per_case_s += w;
+    per_case_s /= static_cast<double>(finished_wall_s_.size());
+  }
+  const double eta_s = (remaining_s + static_cast<double>(counts.pending + unknown) * per_case_s) / jobs_;
+  s += fmt::format("study {}: {} done, {} running, {} failed, {} pending; ETA {}{}\n", study_, counts.done,
+                   running.size(), counts.failed, counts.pending, eta_text(eta_s),
+                   counts.stopping ? " (stopping)" : "");
+  s += rows;
+  printed_lines_ = 1 + static_cast<int>(running.size());
+  std::fputs(s.c_str(), stderr);
+  std::fflush(stderr);
+}
+
+}  // namespace boycott::driver

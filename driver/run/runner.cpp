@@ -1,0 +1,211 @@
+#include "driver/run/runner.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "driver/report/curve.hpp"
+#include "driver/report/report_util.hpp"
+#include "driver/report/validation_query.hpp"
+#include "driver/run/collect.hpp"
+#include "driver/run/plan.hpp"
+#include "driver/run/progress.hpp"
+#include "driver/run/replica_rounds.hpp"
+#include "driver/run/run_tree.hpp"
+#include "driver/run/scheduler.hpp"
+#include "driver/run/slurm_commands.hpp"
+#include "driver/run/solver_process.hpp"
+#include "driver/store/database.hpp"
+#include "driver/store/store.hpp"
+#include "driver/store/store_slurm.hpp"
+#include "driver/study/study.hpp"
+
+namespace fs = std::filesystem;
+
+namespace boycott::driver {
+
+int study_run(const StudyRunOptions& opt) {
+  if (opt.jobs < 1) throw InputError(fmt::format("--jobs = {} must be >= 1", opt.jobs));
+  if (opt.retries < 0) throw InputError(fmt::format("--retries = {} must be >= 0", opt.retries));
+  if (opt.ranks < 1) throw InputError(fmt::format("--ranks = {} must be >= 1", opt.ranks));
+  // The whole study is expanded and validated before the database is touched.
+  const Study study = expand_study_file(opt.study_file);
+  Database db(opt.db_path, OpenMode::kCreate);
+  const fs::path root = runs_root(opt.db_path);
+  prepare_study_database(db, study, root);
+  // What Slurm tasks (study submit) left in the run folders; the cases still in Slurm jobs stay
+  // theirs.
+  const CollectResult collected = collect_run_folders(db, study, root);
+  update_run_tree(study, opt.db_path, root);
+  if (collected.results > 0 || collected.attempts > 0 || collected.abandoned > 0)
+    std::fprintf(stderr, "collected %d results and %d attempt ends, closed %d abandoned attempts\n",
+                 collected.results, collected.attempts, collected.abandoned);
+  if (!collected.in_slurm.empty())
+    std::fprintf(stderr,
+                 "%zu cases are in Slurm jobs (queued or running) and are left to them: `boycott study "
+                 "collect` records them when they end\n",
+                 collected.in_slurm.size());
+  fs::create_directories(root);
+  auto solver = solver_argv(opt.solver_command);
+  install_stop_handlers();
+
+  auto states = case_states(db, study.name, opt.retries);
+  std::erase_if(states, [&](const CaseState& s) { return collected.in_slurm.count(s.id) > 0; });
+  std::vector<std::string> to_run;
+  for (const auto& s : states)
+    if (s.status != CaseStatus::kDone && s.status != CaseStatus::kFailed) to_run.push_back(s.id);
+  const PlanEstimate plan = plan_estimate(db, study, to_run, opt.jobs, opt.ranks);
+  if (!to_run.empty()) std::fprintf(stderr, "%s\n", plan.line.c_str());
+  Scheduler scheduler(db, study, states, opt, root, solver);
+  scheduler.set_planned_case_wall_s(plan.mean_case_wall_s);
+  bool stopped = scheduler.run();
+  std::string storage_stop = scheduler.storage_stop();
+  // replicas_target_rel_error: more replicas, round by round, where the scatter is too large.
+  Study grown = study;
+  while (!stopped && storage_stop.empty() && has_replica_target(grown)) {
+    const ReplicaRound round = next_replica_round(db, grown);
+    if (round.added.empty()) break;
+    std::fprintf(stderr, "replicas: %zu points get one more (%d within the target, %d at replicas_max)\n",
+                 round.added.size(), round.precise, round.at_max);
+    grown.cases.insert(grown.cases.end(), round.added.begin(), round.added.end());
+    register_study(db, grown);
+    update_run_tree(grown, opt.db_path, root);
+    auto more_states = case_states(db, grown.name, opt.retries);
+    std::erase_if(more_states, [&](const CaseState& s) { return collected.in_slurm.count(s.id) > 0; });
+    Scheduler more(db, grown, more_states, opt, root, solver);
+    stopped = more.run();
+    storage_stop = more.storage_stop();
+  }
+  if (!storage_stop.empty()) {
+    std::fprintf(stderr, "error: study %s stopped: %s; once the storage works again, run the same command\n",
+                 study.name.c_str(), storage_stop.c_str());
+    return kExitStorageError;
+  }
+
+  const int n_total = static_cast<int>(grown.cases.size());
+  int done = 0, failed = 0;
+  for (const auto& s : case_states(db, study.name, opt.retries)) {
+    done += s.status == CaseStatus::kDone;
+    failed += s.status == CaseStatus::kFailed;
+  }
+  if (stopped) {
+    std::printf("study %s stopped by signal %d: %d of %s done; run the same command to resume\n",
+                study.name.c_str(), stop_signal(), done, count_of(n_total, "case").c_str());
+    return kExitInterrupted;
+  }
+  std::printf("study %s: %d of %s done, %d failed\n", study.name.c_str(), done,
+              count_of(n_total, "case").c_str(), failed);
+  // The settling curve where the study has one; otherwise (ergun, single_particle, channel_flow,
+  // sediment_transport) each finished case's validation errors against their tolerances.
+  const auto curve = query_curve(db, study.name);
+  if (!curve.empty() || done == 0)
+    std::fputs(format_curve(curve, ListingFormat::kTable).c_str(), stdout);
+  else
+    std::fputs(format_validation(query_validation(db, study.name), ListingFormat::kTable).c_str(), stdout);
+  return failed > 0 ? kExitFailure : kExitOk;
+}
+
+std::vector<CaseState> case_states_now(Database& db, const std::string& db_path, const std::string& study,
+                                       int retries) {
+  auto states = case_states(db, study, retries);
+  std::set<std::string> in_slurm;
+  if (has_slurm_columns(db))
+    for (const auto& a : slurm_attempts(db, study, true)) in_slurm.insert(a.case_id);
+  // An open attempt whose folder nobody holds, and no Slurm task owns: its driver died (kill -9,
+  // power loss). A task not yet started holds no folder, and is running as far as we know.
+  for (auto& c : states)
+    if (c.status == CaseStatus::kRunning && !in_slurm.count(c.id) &&
+        run_folder_unheld(fs::path(runs_root(db_path)) / c.id))
+      c.status = CaseStatus::kInterrupted;
+  return states;
+}
+
+int study_status(const std::string& study_file, const std::string& db_path, int retries,
+                 ListingFormat format) {
+  const Study study = expand_study_file(study_file);
+  // A status reads a database and creates none: a missing one is most likely a mistyped path
+  // (the cases of a study not yet run are listed by `study plan`).
+  if (!fs::exists(db_path))
+    throw InputError(
+        fmt::format("no database at '{}' (`boycott study plan {}` lists the cases of a study not "
+                    "yet run)",
+                    db_path, study_file));
+  std::optional<Database> db;
+  db.emplace(db_path, OpenMode::kReadOnly);
+  std::map<std::string, CaseState> known;
+  for (auto& s : case_states_now(*db, db_path, study.name, retries)) known[s.id] = s;
+  // Cases submitted to Slurm (study submit): their array task and, where squeue answers, its state.
+  std::map<std::string, std::string> jobs;
+  std::optional<std::vector<SlurmJob>> queue;
+  std::string queue_why;
+  const auto open_slurm =
+      db && has_slurm_columns(*db) ? slurm_attempts(*db, study.name, true) : std::vector<SlurmAttempt>{};
+  if (!open_slurm.empty()) queue = squeue_jobs(&queue_why);
+  for (const auto& a : open_slurm) {
+    const SlurmJob* job = queue ? find_slurm_job(*queue, a.array_job_id, a.array_task_id, a.job_id) : nullptr;
+    jobs[a.case_id] = fmt::format("{}_{} {}", a.array_job_id.value_or(0), a.array_task_id.value_or(0),
+                                  !queue ? "?"
+                                  : job  ? job->state
+                                         : "ended");
+  }
+  int uncollected = 0;
+  std::map<std::string, int> counts;
+  std::vector<std::string> header = {"case", "group", "angle_deg", "status", "ranks"};
+  std::vector<bool> numeric = {false, false, true, false, true};
+  if (!jobs.empty()) {
+    header.push_back("slurm_job");
+    numeric.push_back(false);
+  }
+  header.push_back("last_error");
+  numeric.push_back(false);
+  report::TextTable table(header, numeric);
+  for (const auto& c : study.cases) {
+    auto it = known.find(c.id);
+    const char* st = it == known.end() ? "pending" : to_string(it->second.status);
+    const auto job = jobs.find(c.id);
+    ++counts[st];
+    if ((it == known.end() || it->second.status != CaseStatus::kDone) &&
+        finished_summary_in(fs::path(runs_root(db_path)) / c.id, c.id))
+      ++uncollected;
+    std::vector<std::string> row = {
+        c.id, c.group, fmt::format("{:.1f}", c.params.gravity.angle_deg), st,
+        it != known.end() && it->second.ranks > 0 ? std::to_string(it->second.ranks) : "-"};
+    if (!jobs.empty()) row.push_back(job == jobs.end() ? "-" : job->second);
+    row.push_back(it != known.end() && it->second.status != CaseStatus::kDone ? it->second.last_error : "");
+    table.add(std::move(row));
+  }
+  const char* kStates[] = {"done", "running", "failed", "interrupted", "pending"};
+  if (format == ListingFormat::kCsv) {
+    std::fputs(table.csv().c_str(), stdout);
+    return 0;
+  }
+  if (format == ListingFormat::kJson) {
+    nlohmann::json j = {{"study", study.name},
+                        {"cases_total", study.cases.size()},
+                        {"uncollected_run_folders", uncollected},
+                        {"slurm_states_unknown", !open_slurm.empty() && !queue ? queue_why : ""},
+                        {"cases", table.json()}};
+    for (const char* st : kStates) j["counts"][st] = counts[st];
+    std::printf("%s\n", j.dump(2).c_str());
+    return 0;
+  }
+  std::printf("study %s: %s: %d done, %d running, %d failed, %d interrupted, %d pending\n",
+              study.name.c_str(), count_of(static_cast<long long>(study.cases.size()), "case").c_str(),
+              counts["done"], counts["running"], counts["failed"], counts["interrupted"], counts["pending"]);
+  if (!open_slurm.empty() && !queue) std::printf("Slurm job states unknown: %s\n", queue_why.c_str());
+  if (uncollected > 0)
+    std::printf("%d finished run folders are not recorded yet: boycott study collect %s --db %s\n",
+                uncollected, study_file.c_str(), db_path.c_str());
+  std::fputs(table.str().c_str(), stdout);
+  return 0;
+}
+
+}  // namespace boycott::driver

@@ -1,0 +1,129 @@
+#include "driver/store/point_error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "core/distributions.hpp"
+
+namespace boycott::driver {
+namespace {
+
+struct Scatter {
+  double mean = 0.0, sd = 0.0;
+};
+
+Scatter scatter_of(const std::vector<double>& w) {
+  Scatter s;
+  const double n = static_cast<double>(w.size());
+  for (double x : w) s.mean += x / n;
+  double ss = 0.0;
+  for (double x : w) ss += (x - s.mean) * (x - s.mean);
+  s.sd = w.size() >= 2 ? std::sqrt(ss / (n - 1.0)) : std::numeric_limits<double>::quiet_NaN();
+  return s;
+}
+
+// The probability that the values are this far apart or closer (chi-square lower tail), given
+// each one's own standard error: small means they scatter more than their errors say.
+double agreement_cdf(const std::vector<RunEstimate>& runs, double mean) {
+  double chi2 = 0.0;
+  for (const auto& r : runs) chi2 += (r.w_m_s - mean) * (r.w_m_s - mean) / (*r.stderr_m_s * *r.stderr_m_s);
+  return chi_square_cdf(chi2, static_cast<double>(runs.size()) - 1.0);
+}
+
+}  // namespace
+
+PointError point_error(const std::vector<RunEstimate>& runs, int stage_one) {
+  PointError e;
+  if (runs.empty()) return e;
+  if (runs.size() == 1) {
+    const auto& r = runs.front();
+    if (!r.stderr_m_s) return e;
+    e.plain_m_s = r.stderr_m_s;
+    if (r.dof && std::isfinite(*r.dof) && *r.dof > 0.0) {
+      e.dof = *r.dof;
+      e.error_m_s = *r.stderr_m_s * one_sigma_t_factor(e.dof);
+      e.basis = "single_run";
+    } else {
+      e.dof = std::numeric_limits<double>::infinity();
+      e.error_m_s = r.stderr_m_s;
+      e.basis = "single_run_plain";
+    }
+    return e;
+  }
+  std::vector<double> w;
+  for (const auto& r : runs) w.push_back(r.w_m_s);
+  const Scatter all = scatter_of(w);
+  const double n = static_cast<double>(runs.size());
+  e.plain_m_s = all.sd / std::sqrt(n);
+  e.dof = n - 1.0;
+  if (stage_one >= 2 && static_cast<int>(runs.size()) >= stage_one) {
+    const Scatter first = scatter_of({w.begin(), w.begin() + stage_one});
+    e.dof = stage_one - 1.0;
+    e.plain_m_s = first.sd / std::sqrt(n);
+    e.error_m_s = one_sigma_t_factor(e.dof) * *e.plain_m_s;
+    e.basis = "two_stage_stein";
+    return e;
+  }
+  e.error_m_s = one_sigma_t_factor(e.dof) * *e.plain_m_s;
+  e.basis = "between_replicas_t";
+  const bool all_within = std::all_of(runs.begin(), runs.end(), [](const RunEstimate& r) {
+    return r.stderr_m_s && std::isfinite(*r.stderr_m_s) && *r.stderr_m_s > 0.0;
+  });
+  if (!all_within) return e;
+  // The pooled within-run error of the mean, and how well the scatter agrees with it.
+  double var = 0.0;
+  for (const auto& r : runs) var += *r.stderr_m_s * *r.stderr_m_s / (n * n);
+  double within_dof = 0.0;  // Welch-Satterthwaite over the runs' own degrees of freedom
+  bool dofs = true;
+  for (const auto& r : runs) {
+    if (!r.dof || !(*r.dof > 0.0)) dofs = false;
+    if (dofs) within_dof += std::pow(*r.stderr_m_s / n, 4) / *r.dof;
+  }
+  const double within_plain = std::sqrt(var);
+  const double within_nu =
+      dofs && within_dof > 0.0 ? var * var / within_dof : std::numeric_limits<double>::infinity();
+  const double within = within_plain * one_sigma_t_factor(within_nu);
+  const double p = agreement_cdf(runs, all.mean);
+  if (p > 0.975) {
+    e.basis +=
+        fmt::format("; the replicas scatter more than their own errors (chi-square p = {:.3f})", 1.0 - p);
+    if (within > *e.error_m_s) e.error_m_s = within, e.plain_m_s = within_plain, e.dof = within_nu;
+  } else if (p < 0.025) {
+    e.basis = fmt::format(
+        "within_runs_pooled; the replicas agree more closely than their own errors say "
+        "(chi-square p = {:.3f})",
+        p);
+    if (within > *e.error_m_s) {
+      e.error_m_s = within, e.plain_m_s = within_plain, e.dof = within_nu;
+    } else {
+      e.basis = "between_replicas_t" + e.basis.substr(std::string("within_runs_pooled").size());
+    }
+  }
+  return e;
+}
+
+std::optional<double> ratio_error(double w, const PointError& e, double w90, const PointError& e90) {
+  if (!e.plain_m_s || !e90.plain_m_s || w90 == 0.0) return std::nullopt;
+  const double r = w / w90;
+  const double a = *e.plain_m_s / w90, b = r * *e90.plain_m_s / w90;
+  const double var = a * a + b * b;
+  if (var == 0.0) return 0.0;
+  const auto term = [](double x, double nu) { return std::isinf(nu) ? 0.0 : x * x * x * x / nu; };
+  const double denom = term(a, e.dof) + term(b, e90.dof);
+  const double nu = denom > 0.0 ? var * var / denom : std::numeric_limits<double>::infinity();
+  return std::sqrt(var) * one_sigma_t_factor(nu);
+}
+
+int stein_replicas_needed(const std::vector<double>& stage_one_w, double target_rel_error, int max) {
+  const int n0 = static_cast<int>(stage_one_w.size());
+  const Scatter s = scatter_of(stage_one_w);
+  const double t = one_sigma_t_factor(n0 - 1.0);
+  int n = n0;
+  while (n < max && t * s.sd / std::sqrt(static_cast<double>(n)) > target_rel_error * std::abs(s.mean)) ++n;
+  return n;
+}
+
+}  // namespace boycott::driver

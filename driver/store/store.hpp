@@ -1,0 +1,145 @@
+#pragma once
+// What the driver writes to and reads from the study database; each function that writes is
+// one transaction.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "driver/store/database.hpp"
+#include "driver/store/point_error.hpp"
+#include "driver/study/study.hpp"
+
+namespace boycott::driver {
+
+/// Inserts the study, its cases and their swept values (existing cases are kept as they are).
+void register_study(Database& db, const Study& s);
+
+/// Opens an attempt; closes any attempt of the case left open by a driver that died.
+std::int64_t begin_attempt(Database& db, const std::string& case_id, int ranks, const std::string& run_dir);
+/// Closes an attempt that produced no result (failure or interruption).
+void finish_attempt(Database& db, std::int64_t attempt, int exit_status, const std::string& error_text);
+/// Closes the attempt and stores the result from the solver's summary.json, in one transaction.
+/// A recorded result's statistics replaced by a recomputed summary (`case summarize`): its error
+/// column and summary_json. False when the database holds no result of the case.
+bool update_result_summary(Database& db, const std::string& case_id, const nlohmann::json& summary);
+void record_result(Database& db, std::int64_t attempt, const std::string& case_id,
+                   const nlohmann::json& summary);
+/// Whether the case has a result (recorded by any driver on this database).
+bool has_result(Database& db, const std::string& case_id);
+/// Whether a finished run's summary.json (its text) reached the case's time.end as the stored
+/// case now sets it, or met its precision target: a result of it would make the case done.
+bool summary_reaches_end(Database& db, const std::string& case_id, const std::string& summary_json);
+/// The case's recorded <<w_p>>; unset without a result or a value.
+std::optional<double> result_settling_velocity(Database& db, const std::string& case_id);
+
+enum class CaseStatus { kPending, kRunning, kDone, kFailed, kInterrupted };
+const char* to_string(CaseStatus s);
+
+struct CaseState {
+  std::string study, group, id;
+  double angle_deg = 0;
+  CaseStatus status = CaseStatus::kPending;
+  int failures = 0;    ///< attempts that ended with a failure exit code
+  int last_exit = -1;  ///< -1: none
+  std::string last_error;
+  bool input_error = false;  ///< an attempt exited 2: retrying cannot help
+  int ranks = 0;             ///< MPI ranks of the latest attempt (0: none yet)
+};
+
+/// Cases of one study (or all, study empty) with their status; `retries` decides when a failing
+/// case counts as failed rather than pending.
+std::vector<CaseState> case_states(Database& db, const std::string& study, int retries);
+
+/// One point of a curve: a (group, setting, angle) and its finished replicas (the cases of the
+/// study that differ only in their seed; one without `replicas`).
+struct CurvePoint {
+  std::string group;
+  /// What else the study sets on the case besides the angle ("key=value; ..."), empty when the
+  /// group sweeps only the angle: one curve per (group, setting), r_acc within it.
+  std::string setting;
+  std::string case_id;  ///< the first replica's
+  double angle_deg = 0;
+  double w_m_s = 0;  ///< <<w_p>>, the mean over the replicas
+  /// The standard error of w_m_s: between_replica_stderr_m_s with two replicas or more, else the
+  /// run's own error; unset when the run recorded none.
+  std::optional<double> w_err_m_s;
+  int n_replicas = 1;
+  std::vector<std::string> replica_case_ids;
+  std::vector<double> replica_w_m_s;  ///< each replica's <<w_p>>, in study order
+  /// Sample standard deviation of the replicas' <<w_p>> over sqrt(N); unset below two replicas.
+  std::optional<double> between_replica_stderr_m_s;
+  /// The mean of the replicas' own (within-run) errors; unset when any replica recorded none.
+  std::optional<double> mean_within_run_stderr_m_s;
+  /// How the runs estimated their own errors (summary.json's settling_velocity_error_method;
+  /// "batch_means" for runs that predate it), "mixed" when the replicas differ.
+  std::string error_method;
+  /// The covering error of w_m_s (error_m_s, about 68 % for any number of replicas) and what it
+  /// rests on (error_basis); driver/store/point_error.hpp.
+  PointError error;
+  /// A single run's degrees of freedom of its error (summary.json settling_velocity_error_dof).
+  std::optional<double> run_dof;
+  /// <<w_p>>/<<w_p>>(90 deg), unset without a 90 deg case; its covering error, from the two
+  /// points' errors, unset when an error it depends on is.
+  std::optional<double> r_acc, r_acc_err;
+};
+
+/// A key a study sets on a case (group `set`, matrix, zip), as stored in case_values.
+struct SweptValue {
+  std::string key;
+  std::string value;                ///< TOML text, e.g. 2.0000000000000002e-05 or [200, 6, 100]
+  std::optional<double> value_num;  ///< when the value is a number
+  bool operator==(const SweptValue& o) const { return key == o.key && value == o.value; }
+  /// The value for people: numbers in 6 significant digits (the TOML text keeps all 17).
+  std::string display() const;
+};
+
+/// The swept values of one case, by key.
+std::vector<SweptValue> case_swept_values(Database& db, const std::string& case_id);
+
+/// The correlation curve of finished cases, per group in study order, by angle; the replicas of
+/// a point (cases that differ only in their seed) are averaged, r_acc's error propagated from
+/// their scatter.
+std::vector<CurvePoint> query_curve(Database& db, const std::string& study, const std::string& group = "");
+
+/// InputError "no study 'S' in 'FILE'" when the database has no study of that name.
+void require_study(Database& db, const std::string& study);
+
+/// The groups of a study in study order (the first position of any of their cases).
+std::vector<std::string> study_groups(Database& db, const std::string& study);
+
+/// A recorded result as `query validation` reads it; unset where the column is null.
+struct StoredResult {
+  std::optional<std::string> study, group;  ///< unset for a case that no study lists any more
+  std::string case_id, scene;
+  std::optional<double> w_m_s, wall_time_s;
+  std::optional<std::string> validation_errors_json;  ///< as stored, not parsed
+};
+
+/// Every result, once per study group its case belongs to (and once with no study for a case that
+/// none lists), of one study (or all, study empty); by study (none last), position, case id.
+std::vector<StoredResult> stored_results(Database& db, const std::string& study);
+
+/// A finished case with a <<w_p>>, as `query work-precision` reads it.
+struct SettlingResult {
+  std::string group, case_id;
+  double angle_deg = 0;
+  double w_m_s = 0, w_err_m_s = 0;  ///< <<w_p>> and its standard error (NaN when the run gave none)
+  std::optional<double> wall_time_s;
+  std::optional<std::int64_t> particle_steps;
+};
+
+/// The study's cases with a recorded <<w_p>>, once per group they belong to, in study order.
+std::vector<SettlingResult> settling_results(Database& db, const std::string& study);
+
+/// A finished result's cost, for the cost model of `study plan`: every study's results count.
+struct FinishedCost {
+  std::string case_id;
+  std::string params_json;
+  std::string summary_json;
+};
+std::vector<FinishedCost> finished_costs(Database& db);
+
+}  // namespace boycott::driver

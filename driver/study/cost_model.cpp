@@ -1,0 +1,171 @@
+#include "driver/study/cost_model.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <queue>
+
+namespace boycott::driver {
+
+namespace {
+double num(const nlohmann::json& j, const char* section, const char* key, double fallback) {
+  if (!j.contains(section) || !j[section].contains(key) || !j[section][key].is_number()) return fallback;
+  return j[section][key].get<double>();
+}
+
+/// Solves the n x n system a x = b (n <= 3) by Gaussian elimination; false when singular.
+bool solve(std::array<std::array<double, 3>, 3> a, std::array<double, 3> b, int n, std::array<double, 3>& x) {
+  for (int c = 0; c < n; ++c) {
+    int piv = c;
+    for (int r = c + 1; r < n; ++r)
+      if (std::abs(a[r][c]) > std::abs(a[piv][c])) piv = r;
+    if (std::abs(a[piv][c]) < 1e-300) return false;
+    std::swap(a[c], a[piv]);
+    std::swap(b[c], b[piv]);
+    for (int r = c + 1; r < n; ++r) {
+      const double f = a[r][c] / a[c][c];
+      for (int k = c; k < n; ++k) a[r][k] -= f * a[c][k];
+      b[r] -= f * b[c];
+    }
+  }
+  for (int r = n - 1; r >= 0; --r) {
+    double s = b[r];
+    for (int k = r + 1; k < n; ++k) s -= a[r][k] * x[k];
+    x[r] = s / a[r][r];
+  }
+  return true;
+}
+}  // namespace
+
+CaseWork case_work(const nlohmann::json& p, double from_s, double to_s) {
+  CaseWork w;
+  w.scene = p.value("scene", "");
+  const double span = std::max(0.0, to_s - from_s);
+  const double count = num(p, "particles", "count", 0.0);
+  const double dt_dem = num(p, "time", "dt_dem", 0.0), dt_cfd = num(p, "time", "dt_cfd", 0.0);
+  if (count > 0 && dt_dem > 0) w.particle_steps = count * span / dt_dem;
+  if (p.contains("domain") && p["domain"].contains("cells") && dt_cfd > 0 && w.scene != "dem_only") {
+    double cells = 1.0;
+    for (const auto& n : p["domain"]["cells"]) cells *= n.get<double>();
+    w.fluid_cell_steps = cells * span / dt_cfd;
+  }
+  return w;
+}
+
+MeasuredCost measured_cost(const std::string& case_id, const std::string& params_json,
+                           const std::string& summary_json, bool* ok) {
+  MeasuredCost m;
+  m.case_id = case_id;
+  *ok = false;
+  try {
+    const auto p = nlohmann::json::parse(params_json);
+    const auto s = nlohmann::json::parse(summary_json);
+    const double wall = s.value("wall_time_s", 0.0), t = s.value("simulated_time_s", 0.0);
+    if (!(wall > 0) || !(t > 0)) return m;
+    // A branch started from its parent's time: only its own interval was paid for.
+    const double from = s.contains("parent") ? s["parent"].value("time_s", 0.0) : 0.0;
+    m.work = case_work(p, from, t);
+    // One attempt from the start: its CPU time (steadier on a shared machine); a resumed run's
+    // earlier attempts are only in its wall time.
+    const bool one_attempt = !s.value("resumed_from_checkpoint", false);
+    m.core_s = one_attempt && s.contains("attempt_cpu_time_s") && s["attempt_cpu_time_s"].is_number()
+                   ? s["attempt_cpu_time_s"].get<double>()
+                   : wall * std::max(1, s.value("mpi_ranks", 1));
+    *ok = true;
+  } catch (const std::exception&) {
+    // An unreadable row does not calibrate anything.
+  }
+  return m;
+}
+
+CostModel::CostModel(const std::vector<MeasuredCost>& finished) {
+  std::map<std::string, std::vector<const MeasuredCost*>> runs;
+  for (const auto& m : finished) runs[m.work.scene].push_back(&m);
+  for (const auto& [scene, ms] : runs) {
+    Coefficients c;
+    c.runs = static_cast<int>(ms.size());
+    // Relative least squares: sum over runs of ((prediction - measured) / measured)^2. A term
+    // whose coefficient comes out negative (or that no run exercises) is dropped and the rest
+    // refitted; the start-up term is dropped last.
+    std::array<bool, 3> use = {true, true, true};
+    bool fitted = false;
+    for (int tries = 0; tries < 3 && ms.size() >= 3 && !fitted; ++tries) {
+      std::vector<int> idx;
+      for (int k = 0; k < 3; ++k)
+        if (use[k]) idx.push_back(k);
+      const int n = static_cast<int>(idx.size());
+      std::array<std::array<double, 3>, 3> a{};
+      std::array<double, 3> b{}, x{};
+      for (const auto* m : ms) {
+        const std::array<double, 3> f = {1.0, m->work.particle_steps, m->work.fluid_cell_steps};
+        const double w = 1.0 / (m->core_s * m->core_s);
+        for (int r = 0; r < n; ++r) {
+          for (int q = 0; q < n; ++q) a[r][q] += w * f[idx[r]] * f[idx[q]];
+          b[r] += w * f[idx[r]] * m->core_s;
+        }
+      }
+      if (!solve(a, b, n, x)) {
+        // No run varies this term: drop the one with the smallest diagonal.
+        int worst = 0;
+        for (int r = 1; r < n; ++r)
+          if (a[r][r] < a[worst][worst]) worst = r;
+        use[idx[worst]] = false;
+        continue;
+      }
+      int negative = -1;
+      for (int r = n - 1; r >= 0; --r)
+        if (x[r] < 0) negative = idx[r];
+      if (negative >= 0) {
+        use[negative] = false;
+        continue;
+      }
+      std::array<double, 3> coef = {0.0, 0.0, 0.0};
+      for (int r = 0; r < n; ++r) coef[idx[r]] = x[r];
+      c.start_s = coef[0], c.particle_step_s = coef[1], c.cell_step_s = coef[2];
+      fitted = true;
+    }
+    if (!fitted) {
+      // Too few runs to fit: the defaults, scaled to what was measured.
+      double ratio = 0.0;
+      for (const auto* m : ms) ratio += m->core_s / core_s(m->work);
+      ratio /= static_cast<double>(ms.size());
+      c.start_s *= ratio, c.particle_step_s *= ratio, c.cell_step_s *= ratio;
+    }
+    c.fitted = fitted;
+    by_scene_[scene] = c;
+  }
+}
+
+double CostModel::core_s(const CaseWork& w) const {
+  const auto it = by_scene_.find(w.scene);
+  const Coefficients c = it == by_scene_.end() ? Coefficients{} : it->second;
+  return c.start_s + c.particle_step_s * w.particle_steps + c.cell_step_s * w.fluid_cell_steps;
+}
+
+std::string CostModel::basis(const std::string& scene) const {
+  const auto it = by_scene_.find(scene);
+  if (it == by_scene_.end()) return "default";
+  return (it->second.fitted ? "fit to " : "default scaled by ") + std::to_string(it->second.runs) + " runs";
+}
+
+double ranks_efficiency(int ranks) {
+  return std::pow(0.9, std::log2(std::max(1, ranks)));
+}
+
+double study_wall_s(std::vector<double> core_s, int jobs, int ranks) {
+  const double per_core = 1.0 / (std::max(1, ranks) * ranks_efficiency(ranks));
+  std::sort(core_s.begin(), core_s.end(), std::greater<>());
+  std::priority_queue<double, std::vector<double>, std::greater<>> slots;
+  for (int j = 0; j < std::max(1, jobs); ++j) slots.push(0.0);
+  double end = 0.0;
+  for (double c : core_s) {
+    const double t = slots.top() + c * per_core;
+    slots.pop();
+    slots.push(t);
+    end = std::max(end, t);
+  }
+  return end;
+}
+
+}  // namespace boycott::driver
