@@ -109,4 +109,35 @@ class CoupledSceneOutput {
   OutputTimes snapshots_, images_;
 };
 
+/// The time loop of the coupled scenes with checkpoints (inclined_settling, sediment_transport),
+/// written once: to time.end, each step preceded by before_step() and followed by
+/// measure(step, end_early), in which the scene takes its samples and returns the step's row (a
+/// callable, called only when a row is due, that must not refer to measure's locals); it sets
+/// end_early when the run is to stop here, before time.end (time.target_rel_error met: the
+/// summary's status is then converged). Rows, pictures, checkpoints and stop requests are the
+/// output's (after_step, end_early, stop_inside_step). Returns kExitOk, or kExitInterrupted
+/// after a stop (the summary marked interrupted).
+template <class BeforeStep, class Measure, class WriteCheckpoint>
+int run_coupled_steps(coupling::CoupledSystem& run, CoupledSceneOutput& out, BeforeStep&& before_step,
+                      Measure&& measure, WriteCheckpoint&& write_checkpoint, SummaryBase& summary) {
+  const double end = run.params().time.end_s;
+  while (run.time_s() < end - 1e-12) {
+    before_step();
+    const coupling::CoupledStep st = run.step();
+    if (st.interrupted) {
+      out.stop_inside_step(st, write_checkpoint, summary);
+      return kExitInterrupted;
+    }
+    bool end_early = false;
+    const auto row = measure(st, end_early);
+    if (end_early) {
+      out.end_early(row, write_checkpoint);
+      summary.status = kStatusConverged;
+      return kExitOk;
+    }
+    if (out.after_step(row, write_checkpoint, summary)) return kExitInterrupted;
+  }
+  return kExitOk;
+}
+
 }  // namespace boycott::scenes

@@ -169,17 +169,12 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
             std::vector<double>{static_cast<double>(target.next_check_), target.met_since_s_});
     });
   };
-  int exit_code = kExitOk;
   SummaryBase sb;
   const double end = p.time.end_s;
-  while (run.time_s() < end - 1e-12) {
+  const auto before_step = [&] {
     if (budget) run.set_force_budget(run.time_s() >= collect_from_s - 1e-12 ? &*budget : nullptr);
-    const coupling::CoupledStep st = run.step();
-    if (st.interrupted) {
-      out.stop_inside_step(st, write_checkpoint, sb);
-      exit_code = kExitInterrupted;
-      break;
-    }
+  };
+  const auto measure = [&](const coupling::CoupledStep& st, bool& end_early) {
     const double t = run.time_s();
     const double wp = run.mean_particle_velocity(2);
     const double wf = run.mean_fluid_velocity_z();
@@ -202,7 +197,10 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       steps.before.push_back(wp);
       steps.before_dt.push_back(st.dt_s);
     }
-    const auto row = [&]() -> std::vector<double> {
+    // time.target_rel_error met before time.end: the last row, a checkpoint, status converged.
+    end_early = wp_series_whole && target.reached(wp_series, collect_from_s, t) && t < end - 1e-12;
+    return [&run, t, wp, wf, slurry, dt_s = st.dt_s,
+            iterations = st.fluid.simple_iterations]() -> std::vector<double> {
       return {t,
               wp,
               wf,
@@ -210,22 +208,13 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
               run.mean_particle_velocity(0),
               run.mean_particle_velocity(1),
               run.fluid().mean_pressure_gradient_pa_m(),
-              st.dt_s,
-              static_cast<double>(st.fluid.simple_iterations),
+              dt_s,
+              static_cast<double>(iterations),
               run.coupler().totals().min_alpha_f,
               run.dem().kinetic_energy_j()};
     };
-    // time.target_rel_error met before time.end: the last row, a checkpoint, status converged.
-    if (wp_series_whole && target.reached(wp_series, collect_from_s, t) && t < end - 1e-12) {
-      out.end_early(row, write_checkpoint);
-      sb.status = kStatusConverged;
-      break;
-    }
-    if (out.after_step(row, write_checkpoint, sb)) {
-      exit_code = kExitInterrupted;
-      break;
-    }
-  }
+  };
+  const int exit_code = run_coupled_steps(run, out, before_step, measure, write_checkpoint, sb);
   out.flush();
   run.report_timers(timers);
   pdf_y = over_ranks(run, pdf_y);

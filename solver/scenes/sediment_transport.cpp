@@ -216,14 +216,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
     });
   };
   SummaryBase sb;
-  int exit_code = kExitOk;
-  while (run.time_s() < p.time.end_s - 1e-12) {
-    const coupling::CoupledStep st = run.step();
-    if (st.interrupted) {
-      out.stop_inside_step(st, write_checkpoint, sb);
-      exit_code = kExitInterrupted;
-      break;
-    }
+  const auto measure = [&](const coupling::CoupledStep& st, bool&) {
     const double t = run.time_s();
     const double q = transport_rate();
     const double G = run.fluid().mean_pressure_gradient_pa_m();
@@ -236,7 +229,8 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
       vp_avg.add(run.mean_particle_velocity(1));
       profiles.add(run.fluid(), s, h_y);
     }
-    const auto row = [&]() -> std::vector<double> {
+    return [&run, t, q, q_scale, G, dt_s = st.dt_s,
+            iterations = st.fluid.simple_iterations]() -> std::vector<double> {
       return {t,
               q,
               q / q_scale,
@@ -244,16 +238,14 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
               run.fluid().mean_flux_z(),
               run.mean_particle_velocity(2),
               run.mean_particle_velocity(1),
-              st.dt_s,
-              static_cast<double>(st.fluid.simple_iterations),
+              dt_s,
+              static_cast<double>(iterations),
               run.coupler().totals().min_alpha_f,
               run.dem().kinetic_energy_j()};
     };
-    if (out.after_step(row, write_checkpoint, sb)) {
-      exit_code = kExitInterrupted;
-      break;
-    }
-  }
+  };
+  const int exit_code = run_coupled_steps(
+      run, out, [] {}, measure, write_checkpoint, sb);
   out.flush();
   profiles.over_ranks(run).write(ctx.out_dir / "profiles.csv", h_y, A);
   run.report_timers(timers);
