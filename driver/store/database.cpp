@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "core/run_status.hpp"
 #include "driver/store/schema_files.hpp"
 
 namespace boycott::driver {
@@ -254,6 +255,18 @@ void Database::require_own_schema() {
         path_, missing));
 }
 
+namespace {
+/// SQL reached_end(t, end): core/run_status.hpp's definition, for the queries that judge whether a
+/// case is done against the study's current time.end; NULL when either is.
+void sql_reached_end(sqlite3_context* ctx, int, sqlite3_value** argv) {
+  if (sqlite3_value_type(argv[0]) == SQLITE_NULL || sqlite3_value_type(argv[1]) == SQLITE_NULL) {
+    sqlite3_result_null(ctx);
+    return;
+  }
+  sqlite3_result_int(ctx, reached_end(sqlite3_value_double(argv[0]), sqlite3_value_double(argv[1])) ? 1 : 0);
+}
+}  // namespace
+
 void Database::open(const std::string& name, int flags) {
   if (sqlite3_open_v2(name.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
     std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
@@ -266,6 +279,13 @@ void Database::open(const std::string& name, int flags) {
     if (!folder.empty() && !std::filesystem::is_directory(folder, ec))
       msg = fmt::format("its folder '{}' does not exist (make it first: mkdir -p {})", folder.string(),
                         folder.string());
+    throw DatabaseError(fmt::format("cannot open database '{}': {}", path_, msg));
+  }
+  if (sqlite3_create_function_v2(db_, "reached_end", 2, SQLITE_UTF8 | SQLITE_DETERMINISTIC, nullptr,
+                                 &sql_reached_end, nullptr, nullptr, nullptr) != SQLITE_OK) {
+    const std::string msg = sqlite3_errmsg(db_);
+    sqlite3_close(db_);
+    db_ = nullptr;
     throw DatabaseError(fmt::format("cannot open database '{}': {}", path_, msg));
   }
 }

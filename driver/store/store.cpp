@@ -198,7 +198,7 @@ namespace {
 std::string reaches_end_sql(const std::string& S, const std::string& P) {
   return fmt::format(
       "(json_extract({P}, '$.time.end') IS NULL OR json_extract({S}, '$.simulated_time_s') IS NULL OR "
-      "json_extract({S}, '$.simulated_time_s') >= json_extract({P}, '$.time.end') * (1 - 1e-9) OR "
+      "reached_end(json_extract({S}, '$.simulated_time_s'), json_extract({P}, '$.time.end')) OR "
       "(json_extract({S}, '$.status') = 'converged' AND "
       "IFNULL(json_extract({P}, '$.time.target_rel_error'), 0) >= json_extract({S}, '$.target_rel_error')))",
       fmt::arg("S", S), fmt::arg("P", P));

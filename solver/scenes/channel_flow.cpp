@@ -84,7 +84,7 @@ int run_channel_flow(const CaseParams& p, RunContext& ctx) {
   double next_row = 0.0;
   bool interrupted = false;
   int unconverged = 0;
-  while (solver.time_s() < end * (1.0 - 1e-12)) {
+  while (!reached_end(solver.time_s(), end)) {
     if (ctx.should_stop()) {
       interrupted = true;
       break;
@@ -97,7 +97,7 @@ int run_channel_flow(const CaseParams& p, RunContext& ctx) {
       rep = solver.step(dt);
     }
     if (!rep.converged) ++unconverged;
-    if (solver.time_s() >= next_row - 1e-12 || solver.time_s() >= end * (1.0 - 1e-12)) {
+    if (solver.time_s() >= next_row - 1e-12 || reached_end(solver.time_s(), end)) {
       const auto w = solver.profile_y(2);
       const double wc = p.domain.periodic_y ? solver.mean_velocity(2)
                                             : centreline(w, p.domain.width_y_m, settings.top_slip);

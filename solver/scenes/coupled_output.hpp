@@ -43,7 +43,7 @@ class CoupledSceneOutput {
     // The last step's row is written whenever it falls, but it does not move the schedule: a
     // run continued to a later end keeps the rows a run straight to that end writes.
     const bool scheduled = t >= next_out_s_ - 1e-12;
-    if (scheduled || t >= end - 1e-12) {
+    if (scheduled || reached_end(t, end)) {
       report_row(row(), scheduled);
     }
     write_pictures(t);
@@ -121,7 +121,7 @@ template <class BeforeStep, class Measure, class WriteCheckpoint>
 int run_coupled_steps(coupling::CoupledSystem& run, CoupledSceneOutput& out, BeforeStep&& before_step,
                       Measure&& measure, WriteCheckpoint&& write_checkpoint, SummaryBase& summary) {
   const double end = run.params().time.end_s;
-  while (run.time_s() < end - 1e-12) {
+  while (!reached_end(run.time_s(), end)) {
     before_step();
     const coupling::CoupledStep st = run.step();
     if (st.interrupted) {

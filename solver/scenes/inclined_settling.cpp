@@ -198,7 +198,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       steps.before_dt.push_back(st.dt_s);
     }
     // time.target_rel_error met before time.end: the last row, a checkpoint, status converged.
-    end_early = wp_series_whole && target.reached(wp_series, collect_from_s, t) && t < end - 1e-12;
+    end_early = wp_series_whole && target.reached(wp_series, collect_from_s, t) && !reached_end(t, end);
     return [&run, t, wp, wf, slurry, dt_s = st.dt_s,
             iterations = st.fluid.simple_iterations]() -> std::vector<double> {
       return {t,

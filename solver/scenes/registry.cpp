@@ -172,7 +172,7 @@ void drop_off_schedule_last_row(const std::filesystem::path& csv, const CasePara
 /// Whether the run in `dir` already reached time.end (then it says so); refuses an end below
 /// the time it reached.
 bool already_complete(const CaseParams& params, const RunContext& ctx) {
-  const double end = params.time.end_s, tol = 1e-12 * end + 1e-12;
+  const double end = params.time.end_s;
   double reached = -1.0, target = kUnset;
   std::string status;
   try {
@@ -195,12 +195,12 @@ bool already_complete(const CaseParams& params, const RunContext& ctx) {
   // The time loop may pass time.end by up to one fluid step (it stops at the first step at or
   // beyond it): only an end below that is a request to go back.
   const double step_s = std::max(params.time.dt_cfd_s, params.time.dt_dem_s);
-  if (reached > end + step_s + tol)
+  if (reached > end + step_s + kEndToleranceS)
     throw InputError(
         fmt::format("time.end = {:g} s is below the time this run reached, {:g} s ({}): raise it, or "
                     "use another --out folder",
                     end, reached, ctx.out_dir.string()));
-  if (is_finished_status(status) && reached >= end - tol) {
+  if (is_finished_status(status) && reached_end(reached, end)) {
     if (!ctx.quiet && output_rank())
       std::fprintf(stderr, "%s is already complete at t = %g s (time.end = %g s)\n", ctx.out_dir.c_str(),
                    reached, end);

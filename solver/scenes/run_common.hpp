@@ -82,7 +82,7 @@ class CheckpointClock {
   CheckpointClock(double every_s, double now_s) : every_(every_s), next_(following(now_s)) {}
   /// True when a step that reached t_s is due one (then the next is scheduled).
   bool due(double t_s, double end_s, bool stop) {
-    if (t_s < next_ - 1e-12 && t_s < end_s - 1e-12 && !stop) return false;
+    if (t_s < next_ - 1e-12 && !reached_end(t_s, end_s) && !stop) return false;
     next_ = following(t_s);
     return true;
   }

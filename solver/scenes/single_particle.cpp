@@ -63,7 +63,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   SummaryBase sb;
   const double end = p.time.end_s;
   const double d = p.particles.diameter_m, nu = p.fluid.viscosity_pa_s / rf;
-  while (run.time_s() < end - 1e-12) {
+  while (!reached_end(run.time_s(), end)) {
     const coupling::CoupledStep st = run.step();
     const double t = run.time_s();
     const double vx = particle(s.vx), vy = particle(s.vy), vz = particle(s.vz);

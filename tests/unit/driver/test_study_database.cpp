@@ -11,6 +11,7 @@
 
 #include <sqlite3.h>
 #include "core/distributions.hpp"
+#include "core/run_status.hpp"
 
 #include "driver/store/database.hpp"
 #include "driver/store/schema_files.hpp"
@@ -80,6 +81,25 @@ TEST(StudyDatabase, SchemaIsCreatedFromResultsSchemaFiles) {
   auto st = db.prepare("PRAGMA journal_mode");
   st.step();
   EXPECT_EQ(st.text(0), "wal");
+}
+
+// The queries judge "reached time.end" by the SQL function reached_end, which is the C++
+// predicate of core/run_status.hpp: the same answer on either side of its tolerance, NULL for NULL.
+TEST(StudyDatabase, SqlReachedEndIsTheSolversPredicate) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const double end = 20.0;
+  for (const double t : {end - 1e-3, end - 2e-12, end - 0.5e-12, end, end + 1e-3}) {
+    auto st = db.prepare("SELECT reached_end(?1, ?2)");
+    st.bind(1, t).bind(2, end);
+    ASSERT_TRUE(st.step());
+    EXPECT_EQ(st.integer(0) == 1, boycott::reached_end(t, end)) << "t = end " << t - end;
+  }
+  EXPECT_FALSE(boycott::reached_end(end - 2e-12, end));
+  EXPECT_TRUE(boycott::reached_end(end - 0.5e-12, end));
+  auto st = db.prepare("SELECT reached_end(NULL, 1) IS NULL");
+  ASSERT_TRUE(st.step());
+  EXPECT_EQ(st.integer(0), 1);
 }
 
 TEST(StudyDatabase, Version1DatabaseMigratesToTheLatestKeepingItsRows) {
