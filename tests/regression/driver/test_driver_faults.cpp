@@ -235,10 +235,11 @@ TEST(FakeSolverContract, SummaryKeysAndStatusesMatchTheRealSolver) {
   const std::set<std::string> kNullable = {"settling_velocity_stderr_m_s", "settling_velocity_rel_stderr"};
   std::set<std::string> missing;
   for (const auto& [k, v] : fake.items()) {
-    if (!real.contains(k))
+    if (!real.contains(k)) {
       missing.insert(k);
-    else if (!(kNullable.count(k) && (real[k].is_null() || v.is_null())))
+    } else if (!(kNullable.count(k) && (real[k].is_null() || v.is_null()))) {
       EXPECT_EQ(real[k].type_name(), std::string(v.type_name())) << k;
+    }
   }
   EXPECT_TRUE(missing.empty()) << "keys the test double writes and the real solver does not: "
                                << nlohmann::json(missing).dump();
