@@ -27,6 +27,13 @@ void add_db(CLI::App* cmd, QueryArgs& a) {
   cmd->add_option("--db", a.db, "results database")->required();
 }
 
+/// --db, --study (a filter) and --format: what the listings of every study's cases take.
+void add_listing_options(CLI::App* cmd, QueryArgs& a) {
+  add_db(cmd, a);
+  cmd->add_option("--study", a.study, "only this study");
+  add_format(cmd, a.format);
+}
+
 void write_plot(const std::string& path, const std::string& data) {
   std::ofstream out(path, std::ios::binary);
   out << data;
@@ -74,9 +81,7 @@ Command setup_query_validation(CLI::App* parent) {
   auto* cmd = parent->add_subcommand(
       "validation",
       "per finished case: the scene's measured errors against its reference, and the wall time");
-  add_db(cmd, *a);
-  cmd->add_option("--study", a->study, "only this study");
-  add_format(cmd, a->format);
+  add_listing_options(cmd, *a);
   return {cmd, [a] {
             const auto format = parse_listing_format(a->format);
             auto db = open_for_query(a->db);
@@ -121,9 +126,7 @@ Command setup_query_work_precision(CLI::App* parent) {
 Command setup_query_cases(CLI::App* parent) {
   auto a = std::make_shared<QueryArgs>();
   auto* cmd = parent->add_subcommand("cases", "list cases and their status");
-  add_db(cmd, *a);
-  cmd->add_option("--study", a->study, "only this study");
-  add_format(cmd, a->format);
+  add_listing_options(cmd, *a);
   return {cmd, [a] {
             const auto format = parse_listing_format(a->format);
             auto db = open_for_query(a->db);
