@@ -180,7 +180,7 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv) {
 
 int case_check(const std::string& file, const std::vector<std::string>& sets) {
   CaseParams p = load_case_file(file, sets);
-  const scenes::Preflight pre = scenes::preflight(p);
+  const scenes::Preflight pre = scenes::check_case(p, 1, false);
   std::printf("case %s (scene %s): %s\n", case_id(p).c_str(), p.scene.c_str(),
               pre.errors.empty()
                   ? (pre.warnings.empty() && pre.machine_errors.empty() ? "valid" : "valid, with warnings")

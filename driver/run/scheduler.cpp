@@ -128,10 +128,10 @@ bool Scheduler::start(const StudyCase* c) {
     unlock_run_folder(j.lock_fd);
     return true;
   }
-  const fs::path case_file = j.dir / "case.toml";
+  const fs::path case_file = j.dir / kCaseFileName;
   // Written at every attempt: the same case, in this program's form (a folder written by an
   // older version holds its own form, which this one may refuse).
-  write_atomic(case_file, case_to_toml(c->params));
+  write_atomic(case_file, case_file_text(c->params));
   j.attempt = begin_attempt(db_, c->id, opt_.ranks, j.dir.string());
   // A solver that finished but whose result the driver never recorded: take it as it is.
   if (record_left_summary(db_, j.attempt, c->id, j.dir)) {

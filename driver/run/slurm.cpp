@@ -106,8 +106,8 @@ task=${SLURM_ARRAY_TASK_ID:?run this script with sbatch}
 restart=${SLURM_RESTART_COUNT:-0}
 read -r case_id failures_before < <(sed -n "$((task + 1))p" "$tasks")
 dir=$runs/${case_id:-}
-if [ -z "${case_id:-}" ] || [ ! -f "$dir/case.toml" ]; then
-  echo "task $task: no case on line $((task + 1)) of $tasks, or no $dir/case.toml" >&2
+if [ -z "${case_id:-}" ] || [ ! -f "$dir/case.json" ]; then
+  echo "task $task: no case on line $((task + 1)) of $tasks, or no $dir/case.json" >&2
   exit 2
 fi
 # The run folder's lock, as `study run` takes it: held here and by the solver while it runs. Where
@@ -180,7 +180,7 @@ while :; do
   started=$(now); offset=$(log_size); ended=null; exit_code=null; log_end=null
   aside=null; counted=false; warned_json=false
   write_attempt
-  "${launcher[@]}" "${solver[@]}" case run "$dir/case.toml" --out "$dir" --quiet >> "$dir/solver.log" 2>&1 &
+  "${launcher[@]}" "${solver[@]}" case run "$dir/case.json" --out "$dir" --quiet >> "$dir/solver.log" 2>&1 &
   pid=$!
   while :; do
     trapped=0
@@ -218,7 +218,7 @@ while :; do
         mkdir -p "$aside_dir"
         for f in "$dir"/* "$dir"/.[!.]*; do
           case ${f##*/} in
-            case.toml|attempts|attempt.json|.lock|'*'|'.[!.]*') ;;
+            case.json|attempts|attempt.json|.lock|'*'|'.[!.]*') ;;
             *) mv -f "$f" "$aside_dir/" ;;
           esac
         done
@@ -353,7 +353,7 @@ std::int64_t submit_array(const std::vector<const StudyCase*>& pending, const Sc
   fs::create_directories(paths.folder);
   for (const auto* c : pending) {
     fs::create_directories(paths.runs_root / c->id);
-    write_file(paths.runs_root / c->id / "case.toml", case_to_toml(c->params));
+    write_file(paths.runs_root / c->id / kCaseFileName, case_file_text(c->params));
   }
   write_file(paths.tasks, tasks);
   const fs::path script_path = paths.folder / "job.sh";

@@ -5,17 +5,18 @@
 #include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "core/case_toml.hpp"
 #include "core/error.hpp"
 #include "core/input_file.hpp"
 #include "core/key_docs.hpp"
 #include "core/scene_specs.hpp"
 #include "core/toml_lookup.hpp"
+#include "scenes/preflight.hpp"
 
 namespace boycott::driver {
 namespace {
@@ -24,7 +25,7 @@ std::string quote(const std::string& s) {
   return nlohmann::json(s).dump();
 }
 
-/// A TOML value written back as TOML text, for apply_override.
+/// A TOML value as people read it (labels, the database's swept values).
 std::string toml_text(const toml::node& n) {
   if (auto v = n.value_exact<std::string>()) return quote(*v);
   if (auto v = n.value_exact<std::int64_t>()) return std::to_string(*v);
@@ -36,6 +37,17 @@ std::string toml_text(const toml::node& n) {
     return s + "]";
   }
   throw InputError("tables cannot be used as values here");
+}
+
+/// A value a study sets: the parsed node (applied to the case as it is; it lives as long as the
+/// study's parsed table) and its text for people.
+struct StudyValue {
+  const toml::node* node = nullptr;
+  std::string text;
+};
+
+StudyValue study_value(const toml::node& n) {
+  return {&n, toml_text(n)};
 }
 
 /// Flattens {fluid = {viscosity = 1}} and {"fluid.viscosity" = 1} alike into dotted keys.
@@ -79,7 +91,7 @@ std::string study_key_location(const toml::table& root, const std::string& origi
 /// One axis of the expansion: the keys it sets, and for each point their TOML values.
 struct Axis {
   std::vector<std::string> keys;
-  std::vector<std::vector<std::string>> points;  ///< points[i][k] is the value of keys[k]
+  std::vector<std::vector<StudyValue>> points;  ///< points[i][k] is the value of keys[k]
 };
 
 std::vector<Axis> read_axes(const toml::table& root) {
@@ -94,7 +106,7 @@ std::vector<Axis> read_axes(const toml::table& root) {
         throw InputError(fmt::format("[matrix] '{}' must be a non-empty list of values", key));
       Axis ax;
       ax.keys = {key};
-      for (const auto& e : *a) ax.points.push_back({toml_text(e)});
+      for (const auto& e : *a) ax.points.push_back({study_value(e)});
       axes.push_back(std::move(ax));
     }
   } else if (root.contains("matrix")) {
@@ -121,7 +133,7 @@ std::vector<Axis> read_axes(const toml::table& root) {
                         a->size(), first, len));
       }
       ax.keys.push_back(key);
-      for (std::size_t i = 0; i < len; ++i) ax.points[i].push_back(toml_text(*a->get(i)));
+      for (std::size_t i = 0; i < len; ++i) ax.points[i].push_back(study_value(*a->get(i)));
     }
     if (!ax.keys.empty()) axes.push_back(std::move(ax));
   } else if (root.contains("zip")) {
@@ -203,9 +215,9 @@ ReplicaPlan resolve_replicas(const ReplicaKeys& study, const ReplicaKeys& group,
   return plan;
 }
 
-void apply_named(CaseParams& p, const std::string& key, const std::string& value, const std::string& where) {
+void apply_named(CaseParams& p, const std::string& key, const StudyValue& value, const std::string& where) {
   try {
-    apply_override(p, key + "=" + value);
+    apply_value(p, key, *value.node);
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", where, e.what()), e.key());
   }
@@ -218,7 +230,7 @@ namespace {
 /// A [[group]] as the file states it (or the implicit one of a study without groups).
 struct Group {
   std::string name;
-  std::vector<std::pair<std::string, std::string>> sets;
+  std::vector<std::pair<std::string, StudyValue>> sets;
   std::vector<Axis> axes;  ///< the group's own [group.matrix] / [group.zip], before the study's
   ReplicaKeys replicas;
   std::optional<std::size_t> index;  ///< in the file's [[group]] array; none for the implicit one
@@ -226,16 +238,11 @@ struct Group {
 
 /// The [base] table as a case (every key not set there at its default).
 CaseParams read_base(const toml::table& root, const std::string& origin) {
-  std::string base_text;
-  if (const auto* b = root["base"].as_table()) {
-    std::ostringstream os;
-    os << *b;
-    base_text = os.str();
-  } else if (root.contains("base")) {
+  if (root.contains("base") && !root["base"].as_table())
     throw InputError(fmt::format("{}: 'base' must be a table of case keys", origin));
-  }
   try {
-    return parse_case_string(base_text, origin + " [base]", false);
+    const auto* b = root["base"].as_table();
+    return case_from_toml(b ? *b : toml::table{});
   } catch (const InputError& e) {
     throw InputError(fmt::format("[base]: {}", e.what()), e.key());
   }
@@ -270,7 +277,7 @@ Group read_group(const toml::table& gt, std::size_t index, const std::string& or
     flatten(*set, "", entries);
     for (const auto& [key, node] : entries) {
       check_known_key(key, fmt::format("group '{}'", g.name));
-      g.sets.emplace_back(key, toml_text(*node));
+      g.sets.emplace_back(key, study_value(*node));
     }
   } else if (gt.contains("set")) {
     throw InputError(fmt::format("group '{}': 'set' must be a table of key = value", g.name));
@@ -324,17 +331,19 @@ void expand_group(Study& s, const Group& g, const CaseParams& base, const std::v
     c.params = base;
     for (const auto& [k, v] : g.sets) {
       apply_named(c.params, k, v, where);
-      c.swept.emplace_back(k, v);
+      c.swept.emplace_back(k, v.text);
     }
     for (std::size_t a = 0; a < all.size(); ++a)
       for (std::size_t k = 0; k < all[a].keys.size(); ++k) {
         apply_named(c.params, all[a].keys[k], all[a].points[idx[a]][k], where);
-        c.swept.emplace_back(all[a].keys[k], all[a].points[idx[a]][k]);
+        c.swept.emplace_back(all[a].keys[k], all[a].points[idx[a]][k].text);
       }
     std::string label = where;
     for (const auto& [k, v] : c.swept) label += fmt::format(" {}={}", k, v);
     try {
-      validate(c.params);
+      // Completely, pre-flight included: a case that cannot work is refused when the study is
+      // read (by every command that reads it), not when its solver starts.
+      scenes::check_case(c.params);
     } catch (const InputError& e) {
       throw InputError(fmt::format("{}: {}", label, e.what()), e.key());
     }
@@ -429,8 +438,8 @@ StudyCase replica_of(const StudyCase& replica0, int k) {
   StudyCase c = replica0;
   c.replica = k;
   c.point_id = replica0.id;
-  apply_override(c.params, fmt::format("seed={}", replica0.params.seed + k));
-  validate(c.params);
+  apply_value(c.params, "seed", toml::value<std::int64_t>(replica0.params.seed + k));
+  scenes::check_case(c.params);
   c.id = case_id(c.params);
   return c;
 }
@@ -447,38 +456,8 @@ Study expand_study_file(const std::string& path) {
   return expand_study_string(read_input_file(path, "study file"), path);
 }
 
-namespace {
-std::string json_to_toml_value(const nlohmann::json& v) {
-  if (v.is_string()) return v.dump();
-  if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
-  if (v.is_number_integer()) return std::to_string(v.get<std::int64_t>());
-  if (v.is_number()) return fmt::format("{:.17g}", v.get<double>());
-  if (v.is_array()) {
-    std::string s = "[";
-    bool first = true;
-    for (const auto& e : v) {
-      s += (first ? "" : ", ") + json_to_toml_value(e);
-      first = false;
-    }
-    return s + "]";
-  }
-  throw InputError("cannot write a nested table as a TOML value");
-}
-}  // namespace
-
-std::string case_to_toml(const CaseParams& p) {
-  const auto j = to_json(p);
-  std::string top, sections;
-  for (const auto& [k, v] : j.items()) {
-    if (v.is_object()) {
-      sections += fmt::format("\n[{}]\n", k);
-      for (const auto& [k2, v2] : v.items())
-        if (!v2.is_null()) sections += fmt::format("{} = {}\n", k2, json_to_toml_value(v2));
-    } else if (!v.is_null()) {
-      top += fmt::format("{} = {}\n", k, json_to_toml_value(v));
-    }
-  }
-  return top + sections;
+std::string case_file_text(const CaseParams& p) {
+  return to_json(p).dump(2) + "\n";
 }
 
 }  // namespace boycott::driver

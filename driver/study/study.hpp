@@ -53,8 +53,10 @@ StudyCase replica_of(const StudyCase& replica0, int k);
 Study expand_study_string(const std::string& toml_text, const std::string& origin = "<string>");
 Study expand_study_file(const std::string& path);
 
-/// The case as a TOML case file (what `boycott case run` reads); parsing it gives the same id.
-std::string case_to_toml(const CaseParams& p);
+/// The file a study gives its solver in each run folder: the case as data, its canonical JSON
+/// (`boycott case run FILE.runs/<id>/case.json` reads it back to the same id, unchanged).
+inline constexpr const char* kCaseFileName = "case.json";
+std::string case_file_text(const CaseParams& p);
 
 /// A swept value (TOML text) as people read it: a double's full binary expansion
 /// (0.80000000000000004) becomes the shortest text that reads back the same (0.8); anything else

@@ -217,7 +217,10 @@ CaseParams parse_case_file(const std::string& path);
 CaseParams parse_case_string(const std::string& toml_text, const std::string& origin = "<string>",
                              bool name_lines = true);
 /// A case file with its --set overrides, validated; an error in a value the file sets names the
-/// file and line ("case.toml:12: fluid.viscosity = -1 is out of range: ...").
+/// file and line ("case.toml:12: fluid.viscosity = -1 is out of range: ..."). A file named
+/// *.json is a case in its canonical JSON (a run's params.json, the case.json a study writes for
+/// its solver): checked as it is (nothing resolved again: a --set changes that one value, and
+/// particles.volume_fraction, which only derives the count, is refused), unknown keys refused.
 CaseParams load_case_file(const std::string& path, const std::vector<std::string>& overrides);
 /// "origin:line: " of the line of `toml_text` that sets the dotted `key`; "" where none does.
 std::string case_key_location(const std::string& toml_text, const std::string& origin,

@@ -11,6 +11,7 @@
 
 #include "core/case_key_table.hpp"
 #include "core/case_params.hpp"
+#include "core/case_toml.hpp"
 #include "core/error.hpp"
 #include "core/input_file.hpp"
 #include "core/key_docs.hpp"
@@ -203,6 +204,19 @@ std::string location_in(const toml::table& tbl, const std::string& origin, const
 
 namespace case_keys {
 
+namespace {
+bool set_key(CaseParams& p, const std::string& key, const toml::node& value) {
+  bool found = false;
+  visit_keys(p, [&](const char* k, auto& ref, const Rule&) {
+    if (key == k) {
+      from_toml(k, value, ref);
+      found = true;
+    }
+  });
+  return found;
+}
+}  // namespace
+
 bool set_key(CaseParams& p, const std::string& key, const std::string& value) {
   toml::table t;
   try {
@@ -211,14 +225,7 @@ bool set_key(CaseParams& p, const std::string& key, const std::string& value) {
     // A bare word is a string: --set scene=ergun.
     t = toml::parse("v = \"" + value + "\"");
   }
-  bool found = false;
-  visit_keys(p, [&](const char* k, auto& ref, const Rule&) {
-    if (key == k) {
-      from_toml(k, *t.get("v"), ref);
-      found = true;
-    }
-  });
-  return found;
+  return set_key(p, key, *t.get("v"));
 }
 
 bool is_set_key(const CaseParams& p, const std::string& key) {
@@ -260,8 +267,60 @@ CaseParams parse_case_file(const std::string& path) {
   return parse_case_string(read_input_file(path, "case file"), path);
 }
 
+namespace {
+void collect_json_keys(const nlohmann::json& j, const std::string& prefix, std::vector<std::string>& out) {
+  for (const auto& [k, v] : j.items()) {
+    const std::string name = prefix.empty() ? k : prefix + "." + k;
+    if (v.is_object())
+      collect_json_keys(v, name, out);
+    else
+      out.push_back(name);
+  }
+}
+
+/// A case in its canonical JSON (a run's params.json, the case.json a study gives its solver):
+/// resolved already, so it is checked, not resolved again. A file that is not such a record is
+/// refused, naming what is wrong.
+CaseParams load_case_json(const std::string& path, const std::string& text,
+                          const std::vector<std::string>& overrides) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(fmt::format("{}: malformed JSON: {}", path, e.what()));
+  }
+  if (!j.is_object() || !j.contains("scene") || !j["scene"].is_string())
+    throw InputError(fmt::format("{}: not a case (a JSON case is an object with a string 'scene')", path));
+  const auto names = case_key_names();
+  const std::set<std::string> known(names.begin(), names.end());
+  std::vector<std::string> present;
+  collect_json_keys(j, "", present);
+  for (const auto& k : present)
+    if (!known.count(k) && k != "branch.parent_id" && k != "branch.parent_time_s")
+      throw InputError(
+          fmt::format("{}: unknown key '{}'{} (see `boycott case keys`)", path, k, did_you_mean(k)), k);
+  CaseParams p = case_from_json(j);
+  // Every value is explicit in a resolved case: a --set changes that value and nothing derived
+  // from it. The one input that only derives another (the count) would be silently ignored.
+  for (const auto& s : overrides)
+    if (apply_override(p, s) == "particles.volume_fraction")
+      throw InputError(fmt::format("--set {}: {} is a resolved case, which gives the count: "
+                                   "set particles.count instead",
+                                   s, path),
+                       "particles.volume_fraction");
+  try {
+    validate(p);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", path, e.what()), e.key());
+  }
+  return p;
+}
+}  // namespace
+
 CaseParams load_case_file(const std::string& path, const std::vector<std::string>& overrides) {
   const std::string text = read_input_file(path, "case file");
+  if (path.size() >= 5 && path.compare(path.size() - 5, 5, ".json") == 0)
+    return load_case_json(path, text, overrides);
   CaseParams p = parse_case_string(text, path);
   std::set<std::string> set_by_option;
   for (const auto& s : overrides) set_by_option.insert(apply_override(p, s));
@@ -295,6 +354,23 @@ CaseParams case_from_json(const nlohmann::json& j) {
   return p;
 }
 
+namespace {
+/// What setting `key` by hand means beyond its value: it is the user's (scenes keep defaults
+/// for the others), and the particle load is given one way or the other, the later assignment
+/// winning (otherwise a count set over a case file's volume_fraction would be silently ignored).
+void note_set_key(CaseParams& p, const std::string& key) {
+  p.set_keys.insert(std::lower_bound(p.set_keys.begin(), p.set_keys.end(), key), key);
+  p.set_keys.erase(std::unique(p.set_keys.begin(), p.set_keys.end()), p.set_keys.end());
+  if (key == "particles.count") {
+    p.particles.volume_fraction = kUnset;
+    p.set_keys.erase(std::remove(p.set_keys.begin(), p.set_keys.end(), "particles.volume_fraction"),
+                     p.set_keys.end());
+  }
+  if (key == "particles.volume_fraction")
+    p.set_keys.erase(std::remove(p.set_keys.begin(), p.set_keys.end(), "particles.count"), p.set_keys.end());
+}
+}  // namespace
+
 std::string apply_override(CaseParams& p, const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
@@ -305,18 +381,19 @@ std::string apply_override(CaseParams& p, const std::string& assignment) {
   if (!set_key(p, key, value))
     throw InputError(
         fmt::format("--set: unknown key '{}'{} (see `boycott case keys`)", key, did_you_mean(key)));
-  p.set_keys.insert(std::lower_bound(p.set_keys.begin(), p.set_keys.end(), key), key);
-  p.set_keys.erase(std::unique(p.set_keys.begin(), p.set_keys.end()), p.set_keys.end());
-  // The particle load is given one way or the other; the later assignment wins (otherwise a
-  // count set over a case file's volume_fraction would be silently ignored).
-  if (key == "particles.count") {
-    p.particles.volume_fraction = kUnset;
-    p.set_keys.erase(std::remove(p.set_keys.begin(), p.set_keys.end(), "particles.volume_fraction"),
-                     p.set_keys.end());
-  }
-  if (key == "particles.volume_fraction")
-    p.set_keys.erase(std::remove(p.set_keys.begin(), p.set_keys.end(), "particles.count"), p.set_keys.end());
+  note_set_key(p, key);
   return key;
+}
+
+CaseParams case_from_toml(const toml::table& tbl) {
+  return from_toml_table(tbl);
+}
+
+void apply_value(CaseParams& p, const std::string& key, const toml::node& value) {
+  if (!set_key(p, key, value))
+    throw InputError(fmt::format("unknown key '{}'{} (see `boycott case keys`)", key, did_you_mean(key)),
+                     key);
+  note_set_key(p, key);
 }
 
 nlohmann::json to_json(const CaseParams& p) {

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "core/constants.hpp"
+#include "core/error.hpp"
 #include "core/scene_specs.hpp"
 #include "coupling/drag_laws.hpp"
 
@@ -267,6 +268,13 @@ std::string Preflight::text() const {
   for (const auto& e : errors) s += "  error: " + e + "\n";
   for (const auto& e : machine_errors) s += "  on this machine: " + e + "\n";
   return s;
+}
+
+Preflight check_case(CaseParams& p, int ranks, bool refuse) {
+  validate(p);
+  Preflight pre = preflight(p, ranks);
+  if (refuse && !pre.errors.empty()) throw InputError(pre.errors.front());
+  return pre;
 }
 
 }  // namespace boycott::scenes

@@ -37,6 +37,14 @@ struct Preflight {
 /// memory estimate is per rank). Never throws for physics reasons: it collects.
 Preflight preflight(const CaseParams& p, int ranks = 1);
 
+/// The one complete check of a case, made when a study is expanded and by `case run` and
+/// `case check`: the key rules (validate(), which resolves the defaults into `p`), then the
+/// pre-flight. With `refuse`, the first error is thrown as InputError (a study names the case, a
+/// run leaves its folder as it was); without it the report carries the errors (case check prints
+/// them all). Machine errors are never thrown here: a study may be meant for larger machines, and
+/// `case run` refuses them on the machine it runs on.
+Preflight check_case(CaseParams& p, int ranks = 1, bool refuse = true);
+
 /// Memory of this machine available to the program, bytes (the cgroup limit where lower).
 double machine_memory_bytes();
 /// Estimated peak memory of one rank of a case on `ranks` ranks, bytes: particle and fluid

@@ -51,13 +51,14 @@ std::vector<std::string> registered_scenes() {
 
 namespace {
 
-/// What may be in a run folder before its first run: the driver's lock, case file and log, a
+/// What may be in a run folder before its first run: the driver's lock, case file (case.json;
+/// case.toml from a driver of an earlier version) and log, a
 /// Slurm task's attempt records, checkpoints to start from (a folder prepared by hand), and the
 /// temporary of a params.json whose atomic write was cut short by a crash (incomplete by
 /// construction: the run writes params.json afresh over it).
 bool is_preparation_file(const std::string& name) {
-  return name == ".lock" || name == "case.toml" || name == "solver.log" || name == "checkpoints" ||
-         name == "attempts" || name == "attempt.json" || name == "params.json.tmp";
+  return name == ".lock" || name == "case.json" || name == "case.toml" || name == "solver.log" ||
+         name == "checkpoints" || name == "attempts" || name == "attempt.json" || name == "params.json.tmp";
 }
 
 /// Refuses an --out folder that is not this case's run folder (CheckpointError: exit 4): one that
@@ -224,15 +225,13 @@ bool already_complete(const CaseParams& params, const RunContext& ctx) {
 }  // namespace
 
 int run_case(CaseParams params, RunContext& ctx) {
-  validate(params);
-  const SceneFn fn = find_scene(params.scene);
   int ranks = 1, initialized = 0;
   MPI_Initialized(&initialized);
   if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   // Refused before anything is written: a case that cannot work leaves the folder as it was.
-  const Preflight pre = preflight(params, ranks);
-  if (!pre.errors.empty()) throw InputError(pre.errors.front());
+  const Preflight pre = check_case(params, ranks);
   if (!pre.machine_errors.empty()) throw InputError(pre.machine_errors.front());
+  const SceneFn fn = find_scene(params.scene);
   if (!ctx.branch_from.empty()) prepare_branch(params, ctx);
   // The folder is judged by rank 0 alone, and the others follow its answer: a rank that looked for
   // itself while rank 0 wrote params.json would see only its temporary file, refuse the folder

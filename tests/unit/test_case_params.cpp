@@ -237,6 +237,45 @@ TEST(CaseParams, CanonicalJsonRoundTripsWithoutReResolving) {
   EXPECT_EQ(case_id(b), case_id(a));
 }
 
+// A run's params.json (and the case.json a study writes) is a case file: read back to the same
+// case, a --set changing that one value, anything that is not such a record refused by name.
+TEST(CaseParams, ACanonicalJsonCaseFileRunsTheSameCaseAndRefusesWhatIsNotOne) {
+  const auto dir = std::filesystem::temp_directory_path() / "boycott_json_case";
+  std::filesystem::create_directories(dir);
+  const auto file = (dir / "case.json").string();
+  CaseParams a;
+  apply_override(a, "particles.count=300");
+  apply_override(a, "domain.length_x=0.01");
+  apply_override(a, "domain.height_z=0.01");
+  validate(a);
+  std::ofstream(file) << to_json(a).dump(2);
+  EXPECT_EQ(case_id(load_case_file(file, {})), case_id(a));
+  const CaseParams longer = load_case_file(file, {"time.end=30"});
+  EXPECT_EQ(longer.time.end_s, 30.0);
+  EXPECT_EQ(case_id(longer), case_id(a));  // the run's length is not the case's identity
+  EXPECT_NE(case_id(load_case_file(file, {"fluid.viscosity=2e-3"})), case_id(a));
+  auto message = [&](const std::string& text, const std::vector<std::string>& sets = {}) {
+    std::ofstream(file) << text;
+    try {
+      load_case_file(file, sets);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  auto with = to_json(a);
+  with["fluid"]["viscosty"] = 1e-3;
+  EXPECT_NE(message(with.dump()).find("unknown key 'fluid.viscosty'"), std::string::npos);
+  EXPECT_NE(message("[1, 2]").find("not a case"), std::string::npos);
+  EXPECT_NE(message("{\"scene\": ").find("malformed JSON"), std::string::npos);
+  with = to_json(a);
+  with["fluid"]["viscosity"] = -1.0;
+  EXPECT_NE(message(with.dump()).find("fluid.viscosity = -1"), std::string::npos);
+  EXPECT_NE(message(to_json(a).dump(), {"particles.volume_fraction=0.1"}).find("set particles.count"),
+            std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(CaseParams, OverridesUseTomlSyntax) {
   CaseParams p;
   apply_override(p, "gravity.angle_deg=75");

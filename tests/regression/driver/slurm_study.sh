@@ -169,7 +169,7 @@ for _ in $(seq 600); do
       # `scancel -b -s USR1` answered "can not be altered now" and retried for 15 s, and once the
       # warning came too late.
       shell=$(pgrep -f "$work/spool/job$(printf %05d "$job")/slurm_script" | head -n 1)
-      solver=$(pgrep -f "case run $work/slurm.sqlite.runs/$c/case.toml" | head -n 1)
+      solver=$(pgrep -f "case run $work/slurm.sqlite.runs/$c/case.json" | head -n 1)
       [ -n "$shell" ] && [ -n "$solver" ] || continue
       kill -STOP "$solver" 2> /dev/null || continue
       if [ -f "$work/slurm.sqlite.runs/$c/summary.json" ]; then

@@ -208,21 +208,20 @@ TEST(FakeSolverContract, SummaryKeysAndStatusesMatchTheRealSolver) {
   TempDir d;
   write(d.path / "s.toml", kRealCoupled);
   const auto db = d.path / "s.db";
-  // The real solver (this program) through the driver: a full case.toml and a real summary.
+  // The real solver (this program) through the driver: a full case.json and a real summary.
   const auto r = run(study_run(d.path / "s.toml", db, ""), d.path);
   ASSERT_EQ(r.rc, 0) << r.err;
   fs::path real_dir;
   for (const auto& e : fs::directory_iterator(db.string() + ".runs")) real_dir = e.path();
   const auto real = nlohmann::json::parse(read(real_dir / "summary.json"));
-  const fs::path case_file = real_dir / "case.toml";
+  const fs::path case_file = real_dir / "case.json";
 
   // The fake on the same case, made to take a few of its 0.1 s steps.
-  std::string text = read(case_file);
-  const auto at = text.find("\nend = ");
-  ASSERT_NE(at, std::string::npos) << text;
-  text.replace(at, text.find('\n', at + 1) - at, "\nend = 0.5");
-  const fs::path fake_case = d.path / "fake_case.toml";
-  write(fake_case, text);
+  auto the_case = nlohmann::json::parse(read(case_file));
+  ASSERT_TRUE(the_case["time"].contains("end")) << the_case.dump();
+  the_case["time"]["end"] = 0.5;
+  const fs::path fake_case = d.path / "fake_case.json";
+  write(fake_case, the_case.dump(2));
   const fs::path fake_dir = d.path / "fake" / real_dir.filename();
   fs::create_directories(fake_dir.parent_path());
   const auto f = wait_run(spawn({FAKE_SOLVER, "case", "run", fake_case.string(), "--out", fake_dir.string()},

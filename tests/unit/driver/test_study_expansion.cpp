@@ -5,6 +5,7 @@
 #include <set>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
 #include "driver/run/solver_process.hpp"
@@ -182,11 +183,14 @@ name = "g"
 }
 
 TEST(StudyExpansion, CaseFileWrittenForTheSolverHasTheSameId) {
+  const auto file = (std::filesystem::path(::testing::TempDir()) / bd::kCaseFileName).string();
   for (const auto& c : bd::expand_study_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/paper.toml").cases) {
-    auto p = boycott::parse_case_string(bd::case_to_toml(c.params));
-    boycott::validate(p);
+    std::ofstream(file) << bd::case_file_text(c.params);
+    const auto p = boycott::load_case_file(file, {});
     EXPECT_EQ(boycott::case_id(p), c.id);
+    EXPECT_EQ(boycott::to_json(p), boycott::to_json(c.params));
   }
+  std::filesystem::remove(file);
 }
 
 TEST(StudyExpansion, EveryShippedStudyExpandsToValidCases) {
@@ -200,7 +204,7 @@ TEST(StudyExpansion, EveryShippedStudyExpandsToValidCases) {
     const auto st = bd::expand_study_file(e.path().string());
     EXPECT_FALSE(st.cases.empty());
     for (const auto& c : st.cases) {
-      auto p = boycott::parse_case_string(bd::case_to_toml(c.params));
+      auto p = boycott::case_from_json(nlohmann::json::parse(bd::case_file_text(c.params)));
       EXPECT_NO_THROW(boycott::validate(p));
     }
   }
@@ -286,6 +290,37 @@ TEST(StudyExpansionErrors, NameTheFileAndTheLineThatSetTheValue) {
   EXPECT_EQ(message("name = \"x\"\n\n[matrix]\n\"gravity.angel_deg\" = [10]\n").rfind("s.toml:4: ", 0), 0u);
   // A value no line sets (a scene's default against a key the file sets) names no line.
   EXPECT_EQ(message("name = \"x\"\n[base]\ntime.end = 0.1\n").find("s.toml:"), std::string::npos);
+}
+
+// The pre-flight is part of the one check of a case: a case the coupled solver cannot represent
+// is refused when the study is read (by study plan, run or submit alike), naming the case.
+TEST(StudyExpansionErrors, APreflightErrorRefusesTheStudyWhenItIsRead) {
+  const std::string text =
+      "name = \"x\"\n[base]\nscene = \"sediment_transport\"\n[matrix]\n\"gravity.angle_deg\" = [0, 30]\n";
+  try {
+    bd::expand_study_string(text, "s.toml");
+    ADD_FAILURE() << "a sediment_transport case at 30 deg was accepted";
+  } catch (const boycott::InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("gravity.angle_deg=30"), std::string::npos) << m;
+    EXPECT_NE(m.find("must be 0"), std::string::npos) << m;
+  }
+}
+
+// A study's values reach the case as parsed data: an integer given for a real key, a string, an
+// array and a boolean give the same case as the same values in a case file.
+TEST(StudyExpansion, StudyValuesGiveTheCaseTheSameValuesAsACaseFile) {
+  const auto st = bd::expand_study_string(
+      "name = \"x\"\n[base]\nscene = \"inclined_settling\"\n[[group]]\nname = \"g\"\n[group.set]\n"
+      "\"domain.cells\" = [10, 3, 20]\n\"domain.periodic_y\" = false\n\"fluid.viscosity\" = 0.002\n"
+      "[matrix]\n\"gravity.angle_deg\" = [60]\n\"forces.lift\" = [\"none\"]\n");
+  ASSERT_EQ(st.cases.size(), 1u);
+  auto p = boycott::parse_case_string(
+      "scene = \"inclined_settling\"\n[domain]\ncells = [10, 3, 20]\nperiodic_y = false\n[fluid]\n"
+      "viscosity = 0.002\n[gravity]\nangle_deg = 60\n[forces]\nlift = \"none\"\n");
+  boycott::validate(p);
+  EXPECT_EQ(st.cases[0].id, boycott::case_id(p));
+  EXPECT_EQ(boycott::to_json(st.cases[0].params), boycott::to_json(p));
 }
 
 TEST(StudyLauncher, WrapsTheCaseInMpirunForSeveralRanks) {
