@@ -130,11 +130,11 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   pair_flag_.resize(np);
   const std::size_t nc = kFindContacts[periodic_bits](np, pair_i_.data(), nb, x, y, z, rad, cfg_.box.len,
                                                       pair_flag_.data(), ci, cp);
-  forget_separated_pairs(nc);
+  carry_histories_to_contacts(nc);
   contacts = static_cast<std::int64_t>(nc);
 
-  // Pass 2a: each contact's force and torques, written per contact. Contacts touch distinct
-  // list slots (their histories do not alias) and nothing is accumulated per particle here, so
+  // Pass 2a: each contact's force and torques, written per contact. Each contact has its own
+  // history (they do not alias) and nothing is accumulated per particle here, so
   // the loop has no dependence between iterations and vectorises over contacts (gathers).
   // Pass 2b adds them to the particles. Both run on one block of contacts at a time, so the
   // per-contact results stay in L1 instead of a round trip of 9 doubles per contact through
@@ -151,7 +151,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   double* __restrict oTjx = oTiz + kBlock;
   double* __restrict oTjy = oTjx + kBlock;
   double* __restrict oTjz = oTjy + kBlock;
-  double* __restrict hist = h_.data();
+  double* __restrict hist = contact_hist_.data();  // per contact, in contact order
   const double iLx = 1.0 / Lx, iLy = 1.0 / Ly, iLz = 1.0 / Lz;
   // The period of each direction, 0 where it is not periodic (min_image then leaves d as it is):
   // a select on the loop-invariant flag would keep the loop from vectorising.
@@ -182,8 +182,8 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       if constexpr (!decltype(uniform_masses)::value)
         gn = damping_factor * std::sqrt(mi * mj / (mi + mj) * kn);
       double ftx, fty, ftz;
-      const double fn = spring_dashpot(cm, dt, nx, ny, nz, rsum - r, vrx, vry, vrz, gn, hist[3 * p],
-                                       hist[3 * p + 1], hist[3 * p + 2], ftx, fty, ftz);
+      const double fn = spring_dashpot(cm, dt, nx, ny, nz, rsum - r, vrx, vry, vrz, gn, hist[3 * k],
+                                       hist[3 * k + 1], hist[3 * k + 2], ftx, fty, ftz);
       oFx[k - k0] = fn * nx + ftx;
       oFy[k - k0] = fn * ny + fty;
       oFz[k - k0] = fn * nz + ftz;

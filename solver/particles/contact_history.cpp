@@ -23,27 +23,28 @@ void DemSystem::collect_histories() {
   carry_h_.clear();
   const std::size_t n = s_.size();
   if (nl_.offsets.size() != n + 1) return;
-  // Only the pairs of the last contact list (or of the last restore) can hold a history: every
-  // other slot is zero (forget_separated_pairs). They are in increasing slot order, so this
-  // visits the same slots in the same order as a scan of the whole list, at O(contacts).
-  for (const std::uint32_t p : prev_contacts_) {
-    if (h_[3 * p] == 0.0 && h_[3 * p + 1] == 0.0 && h_[3 * p + 2] == 0.0) continue;
+  // Only the pairs of the last contact list (or of the last restore) hold a history. They are
+  // in increasing slot order, so this visits the same slots in the same order as a scan of the
+  // whole list, at O(contacts).
+  for (std::size_t q = 0; q < prev_contacts_.size(); ++q) {
+    const double* hq = &contact_hist_[3 * q];
+    if (hq[0] == 0.0 && hq[1] == 0.0 && hq[2] == 0.0) continue;
+    const std::uint32_t p = prev_contacts_[q];
     const std::int64_t a = s_.id[pair_i_[p]], b = s_.id[nl_.neighbors[p]];
     const double sg = a < b ? 1.0 : -1.0;
     carry_a_.push_back(std::min(a, b));
     carry_b_.push_back(std::max(a, b));
-    carry_h_.insert(carry_h_.end(), {sg * h_[3 * p], sg * h_[3 * p + 1], sg * h_[3 * p + 2]});
+    carry_h_.insert(carry_h_.end(), {sg * hq[0], sg * hq[1], sg * hq[2]});
   }
 }
 
 void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const std::vector<std::int64_t>& idb,
                                   const std::vector<double>& h) {
   const std::size_t np = nl_.pair_count();
-  h_.assign(3 * np, 0.0);
-  // A new list: the pairs with a history (restored below) are the ones forget_separated_pairs
-  // must look at next, and the flat row index of each slot is refreshed.
-  pair_mark_.assign(np, 0);
+  // A new list: the pairs with a history (restored below, in slot order) stand for the last
+  // evaluation's contacts, and the flat row index of each slot is refreshed.
   prev_contacts_.clear();
+  contact_hist_.clear();
   pair_i_.resize(np);
   for (std::size_t i = 0; i < s_.size(); ++i)
     for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p)
@@ -55,10 +56,7 @@ void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const st
 void DemSystem::restore_history(std::uint32_t p, std::size_t i, std::uint32_t j, const double* hq) {
   // The carried history is seen from the lower id; the list slot sees it from its row i.
   const double sg = s_.id[i] < s_.id[j] ? 1.0 : -1.0;
-  h_[3 * p] = sg * hq[0];
-  h_[3 * p + 1] = sg * hq[1];
-  h_[3 * p + 2] = sg * hq[2];
-  pair_mark_[p] = 1;
+  contact_hist_.insert(contact_hist_.end(), {sg * hq[0], sg * hq[1], sg * hq[2]});
   prev_contacts_.push_back(p);
 }
 
@@ -149,17 +147,31 @@ void DemSystem::rescan_wall_contacts() {
         prev_wall_contacts_[w].push_back(static_cast<std::uint32_t>(i));
 }
 
-void DemSystem::forget_separated_pairs(std::size_t nc) {
-  // A pair's shear spring is reset when it separates (h_ is zero for every pair not in
-  // contact). Only pairs that were in contact at the last evaluation can have just separated,
-  // so only they are visited: O(contacts), not O(list pairs), per step.
-  pair_mark_.resize(nl_.pair_count(), 0);
-  for (std::size_t k = 0; k < nc; ++k) pair_mark_[contact_p_[k]] |= 2;
-  for (std::uint32_t p : prev_contacts_)
-    if (!(pair_mark_[p] & 2)) h_[3 * p] = h_[3 * p + 1] = h_[3 * p + 2] = 0.0;
-  for (std::uint32_t p : prev_contacts_) pair_mark_[p] = 0;
+void DemSystem::carry_histories_to_contacts(std::size_t nc) {
+  // Both lists are in increasing slot order: one merge, O(contacts), sequential in memory. A
+  // pair that separated is not carried (its spring is reset); one that has just touched starts
+  // at zero.
+  next_hist_.resize(3 * nc);
+  const std::uint32_t* __restrict cp = contact_p_.data();
+  const std::uint32_t* __restrict prev = prev_contacts_.data();
+  const double* __restrict from = contact_hist_.data();
+  double* __restrict to = next_hist_.data();
+  const std::size_t nprev = prev_contacts_.size();
+  std::size_t q = 0;
+  for (std::size_t k = 0; k < nc; ++k) {
+    while (q < nprev && prev[q] < cp[k]) ++q;
+    const bool kept = q < nprev && prev[q] == cp[k];
+    to[3 * k] = kept ? from[3 * q] : 0.0;
+    to[3 * k + 1] = kept ? from[3 * q + 1] : 0.0;
+    to[3 * k + 2] = kept ? from[3 * q + 2] : 0.0;
+  }
+  contact_hist_.swap(next_hist_);
   prev_contacts_.assign(contact_p_.begin(), contact_p_.begin() + static_cast<std::ptrdiff_t>(nc));
-  for (std::uint32_t p : prev_contacts_) pair_mark_[p] = 1;
+}
+
+const double* DemSystem::history_of_slot(std::uint32_t p, std::size_t& q) const {
+  while (q < prev_contacts_.size() && prev_contacts_[q] < p) ++q;
+  return q < prev_contacts_.size() && prev_contacts_[q] == p ? &contact_hist_[3 * q] : nullptr;
 }
 
 }  // namespace boycott::particles

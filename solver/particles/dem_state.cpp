@@ -78,17 +78,20 @@ DemState DemSystem::export_local() const {
   st.ref_x.assign(ref_x_.begin(), ref_x_.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
   st.ref_y.assign(ref_y_.begin(), ref_y_.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
   st.ref_z.assign(ref_z_.begin(), ref_z_.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
-  for (std::size_t i = 0; i < s_.n_local; ++i)
-    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
-      if (h_[3 * p] == 0.0 && h_[3 * p + 1] == 0.0 && h_[3 * p + 2] == 0.0) continue;
-      const std::int64_t a = s_.id[i], b = s_.id[nl_.neighbors[p]];
-      const double sg = a < b ? 1.0 : -1.0;
-      st.pair_id_a.push_back(std::min(a, b));
-      st.pair_id_b.push_back(std::max(a, b));
-      st.pair_hx.push_back(sg * h_[3 * p]);
-      st.pair_hy.push_back(sg * h_[3 * p + 1]);
-      st.pair_hz.push_back(sg * h_[3 * p + 2]);
-    }
+  // The local rows' pairs with a history, in list order (the histories are kept in it).
+  for (std::size_t q = 0; q < prev_contacts_.size(); ++q) {
+    const std::uint32_t p = prev_contacts_[q];
+    if (pair_i_[p] >= s_.n_local) break;
+    const double* hq = &contact_hist_[3 * q];
+    if (hq[0] == 0.0 && hq[1] == 0.0 && hq[2] == 0.0) continue;
+    const std::int64_t a = s_.id[pair_i_[p]], b = s_.id[nl_.neighbors[p]];
+    const double sg = a < b ? 1.0 : -1.0;
+    st.pair_id_a.push_back(std::min(a, b));
+    st.pair_id_b.push_back(std::max(a, b));
+    st.pair_hx.push_back(sg * hq[0]);
+    st.pair_hy.push_back(sg * hq[1]);
+    st.pair_hz.push_back(sg * hq[2]);
+  }
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w)
     for (std::size_t i = 0; i < s_.n_local; ++i)
       st.wall_h.insert(st.wall_h.end(), {whx_[w][i], why_[w][i], whz_[w][i]});

@@ -210,13 +210,13 @@ double DemSystem::pair_overlap(std::size_t i, std::size_t j) const {
 double DemSystem::spring_energy_j() const {
   const double kn = cfg_.contact.kn_n_m, kt = cfg_.contact.kt_n_m;
   double e = 0.0;
+  std::size_t q = 0;
   for (std::size_t i = 0; i < s_.size(); ++i)
     for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
       const double ov = pair_overlap(i, nl_.neighbors[p]);
+      const double* h = history_of_slot(p, q);
       if (ov > 0.0)
-        e += 0.5 * kn * ov * ov +
-             0.5 * kt *
-                 (h_[3 * p] * h_[3 * p] + h_[3 * p + 1] * h_[3 * p + 1] + h_[3 * p + 2] * h_[3 * p + 2]);
+        e += 0.5 * kn * ov * ov + (h ? 0.5 * kt * (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]) : 0.0);
     }
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
     const PlaneWall& W = cfg_.walls[w];

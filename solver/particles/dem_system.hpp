@@ -181,9 +181,14 @@ class DemSystem {
   /// The particles (and their predictions and wall histories) stored cell by cell.
   void sort_by_cell();
   void collect_histories();
-  /// Zeroes the shear history of the pairs that were in contact and are not among the first nc
-  /// entries of contact_p_.
-  void forget_separated_pairs(std::size_t nc);
+  /// The shear histories of this evaluation's nc contacts (contact_p_), in contact order, from
+  /// those of the last one: a pair still in contact keeps its spring, a new one starts at zero,
+  /// and a pair that separated is dropped (its spring reset).
+  void carry_histories_to_contacts(std::size_t nc);
+  /// The history of list slot p (3 values, seen from its row), or null where p was not in
+  /// contact at the last evaluation; `q` walks contact_hist_ and must start at 0 for slots
+  /// visited in increasing order.
+  const double* history_of_slot(std::uint32_t p, std::size_t& q) const;
   /// Rebuilds prev_wall_contacts_ from the wall histories (after a reordering or a restart).
   void rescan_wall_contacts();
   void update_uniform_mass();
@@ -197,7 +202,8 @@ class DemSystem {
                                 const std::vector<double>& h);
   void restore_histories_by_key(const std::vector<std::int64_t>& ida, const std::vector<std::int64_t>& idb,
                                 const std::vector<double>& h);
-  /// List slot p (row i, partner j) takes the carried history hq (3 values, seen from the lower id).
+  /// List slot p (row i, partner j) takes the carried history hq (3 values, seen from the lower
+  /// id); slots must come in increasing order.
   void restore_history(std::uint32_t p, std::size_t i, std::uint32_t j, const double* hq);
 
   DemConfig cfg_;
@@ -214,13 +220,14 @@ class DemSystem {
   std::vector<double> vz_end_;   ///< v_z (m/s) after a fused pass's closing kick (advance's sums)
   std::vector<double> pred_[6];  ///< v, w (m/s, rad/s) seen by the forces: predicted to the force time
   std::vector<double> ref_x_, ref_y_, ref_z_;
-  // Tangential spring displacement per list pair (seen from the lower-index particle i), m;
-  // x, y, z interleaved so a pair's history is one cache line.
-  std::vector<double> h_;
   // This evaluation's contacts (particle i and list slot p of each, found by the first pass of
-  // the force loop), the list slots in contact at the last one, and a mark per list slot.
+  // the force loop, in increasing slot order) and the list slots in contact at the last one.
   std::vector<std::uint32_t> contact_i_, contact_p_, prev_contacts_;
-  std::vector<std::uint8_t> pair_mark_;
+  // Tangential spring displacement of each pair in contact (seen from its row's particle i), m,
+  // per contact: x, y, z of prev_contacts_[q] at 3q. Kept per contact, not per list slot, so the
+  // force loop reads it in order and nothing streams the 8 in 9 list pairs that are apart.
+  // next_hist_ is the scratch the next evaluation's histories are gathered into.
+  std::vector<double> contact_hist_, next_hist_;
   // Particle i of each list slot (the list's row, flattened; rebuilt with the list) and the
   // overlap test's result per slot (scratch).
   std::vector<std::uint32_t> pair_i_;
