@@ -130,7 +130,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   pair_flag_.resize(np);
   const std::size_t nc = kFindContacts[periodic_bits](np, pair_i_.data(), nb, x, y, z, rad, cfg_.box.len,
                                                       pair_flag_.data(), ci, cp);
-  carry_histories_to_contacts(nc);
+  pair_hist_.carry_to_contacts(cp, nc);
   contacts = static_cast<std::int64_t>(nc);
 
   // Pass 2a: each contact's force and torques, written per contact. Each contact has its own
@@ -151,7 +151,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   double* __restrict oTjx = oTiz + kBlock;
   double* __restrict oTjy = oTjx + kBlock;
   double* __restrict oTjz = oTjy + kBlock;
-  double* __restrict hist = contact_hist_.data();  // per contact, in contact order
+  double* __restrict hist = pair_hist_.data();  // per contact, in contact order
   const double iLx = 1.0 / Lx, iLy = 1.0 / Ly, iLz = 1.0 / Lz;
   // The period of each direction, 0 where it is not periodic (min_image then leaves d as it is):
   // a select on the loop-invariant flag would keep the loop from vectorising.

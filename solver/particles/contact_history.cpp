@@ -17,25 +17,12 @@ std::uint64_t pair_key(std::int64_t a, std::int64_t b) {
 }  // namespace
 
 void DemSystem::collect_histories() {
-  // Contacts with a shear history, keyed by global ids so they survive reordering and rebuilds.
-  carry_a_.clear();
-  carry_b_.clear();
-  carry_h_.clear();
-  const std::size_t n = s_.size();
-  if (nl_.offsets.size() != n + 1) return;
-  // Only the pairs of the last contact list (or of the last restore) hold a history. They are
-  // in increasing slot order, so this visits the same slots in the same order as a scan of the
-  // whole list, at O(contacts).
-  for (std::size_t q = 0; q < prev_contacts_.size(); ++q) {
-    const double* hq = &contact_hist_[3 * q];
-    if (hq[0] == 0.0 && hq[1] == 0.0 && hq[2] == 0.0) continue;
-    const std::uint32_t p = prev_contacts_[q];
-    const std::int64_t a = s_.id[pair_i_[p]], b = s_.id[nl_.neighbors[p]];
-    const double sg = a < b ? 1.0 : -1.0;
-    carry_a_.push_back(std::min(a, b));
-    carry_b_.push_back(std::max(a, b));
-    carry_h_.insert(carry_h_.end(), {sg * hq[0], sg * hq[1], sg * hq[2]});
+  // Only the last evaluation's contacts (or the last restore's) hold a spring: O(contacts).
+  if (nl_.offsets.size() != s_.size() + 1) {
+    carry_.clear();
+    return;
   }
+  pair_hist_.collect(s_.id.data(), pair_i_.data(), nl_.neighbors.data(), carry_);
 }
 
 void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const std::vector<std::int64_t>& idb,
@@ -43,8 +30,7 @@ void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const st
   const std::size_t np = nl_.pair_count();
   // A new list: the pairs with a history (restored below, in slot order) stand for the last
   // evaluation's contacts, and the flat row index of each slot is refreshed.
-  prev_contacts_.clear();
-  contact_hist_.clear();
+  pair_hist_.clear();
   pair_i_.resize(np);
   for (std::size_t i = 0; i < s_.size(); ++i)
     for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p)
@@ -55,9 +41,7 @@ void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const st
 
 void DemSystem::restore_history(std::uint32_t p, std::size_t i, std::uint32_t j, const double* hq) {
   // The carried history is seen from the lower id; the list slot sees it from its row i.
-  const double sg = s_.id[i] < s_.id[j] ? 1.0 : -1.0;
-  contact_hist_.insert(contact_hist_.end(), {sg * hq[0], sg * hq[1], sg * hq[2]});
-  prev_contacts_.push_back(p);
+  pair_hist_.add(p, s_.id[i] < s_.id[j] ? 1.0 : -1.0, hq);
 }
 
 bool DemSystem::restore_histories_by_row(const std::vector<std::int64_t>& ida,
@@ -145,33 +129,6 @@ void DemSystem::rescan_wall_contacts() {
     for (std::size_t i = 0; i < whx_[w].size(); ++i)
       if (whx_[w][i] != 0.0 || why_[w][i] != 0.0 || whz_[w][i] != 0.0)
         prev_wall_contacts_[w].push_back(static_cast<std::uint32_t>(i));
-}
-
-void DemSystem::carry_histories_to_contacts(std::size_t nc) {
-  // Both lists are in increasing slot order: one merge, O(contacts), sequential in memory. A
-  // pair that separated is not carried (its spring is reset); one that has just touched starts
-  // at zero.
-  next_hist_.resize(3 * nc);
-  const std::uint32_t* __restrict cp = contact_p_.data();
-  const std::uint32_t* __restrict prev = prev_contacts_.data();
-  const double* __restrict from = contact_hist_.data();
-  double* __restrict to = next_hist_.data();
-  const std::size_t nprev = prev_contacts_.size();
-  std::size_t q = 0;
-  for (std::size_t k = 0; k < nc; ++k) {
-    while (q < nprev && prev[q] < cp[k]) ++q;
-    const bool kept = q < nprev && prev[q] == cp[k];
-    to[3 * k] = kept ? from[3 * q] : 0.0;
-    to[3 * k + 1] = kept ? from[3 * q + 1] : 0.0;
-    to[3 * k + 2] = kept ? from[3 * q + 2] : 0.0;
-  }
-  contact_hist_.swap(next_hist_);
-  prev_contacts_.assign(contact_p_.begin(), contact_p_.begin() + static_cast<std::ptrdiff_t>(nc));
-}
-
-const double* DemSystem::history_of_slot(std::uint32_t p, std::size_t& q) const {
-  while (q < prev_contacts_.size() && prev_contacts_[q] < p) ++q;
-  return q < prev_contacts_.size() && prev_contacts_[q] == p ? &contact_hist_[3 * q] : nullptr;
 }
 
 }  // namespace boycott::particles

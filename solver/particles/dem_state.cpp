@@ -79,10 +79,10 @@ DemState DemSystem::export_local() const {
   st.ref_y.assign(ref_y_.begin(), ref_y_.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
   st.ref_z.assign(ref_z_.begin(), ref_z_.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
   // The local rows' pairs with a history, in list order (the histories are kept in it).
-  for (std::size_t q = 0; q < prev_contacts_.size(); ++q) {
-    const std::uint32_t p = prev_contacts_[q];
+  for (std::size_t q = 0; q < pair_hist_.slots().size(); ++q) {
+    const std::uint32_t p = pair_hist_.slots()[q];
     if (pair_i_[p] >= s_.n_local) break;
-    const double* hq = &contact_hist_[3 * q];
+    const double* hq = pair_hist_.of_contact(q);
     if (hq[0] == 0.0 && hq[1] == 0.0 && hq[2] == 0.0) continue;
     const std::int64_t a = s_.id[pair_i_[p]], b = s_.id[nl_.neighbors[p]];
     const double sg = a < b ? 1.0 : -1.0;
@@ -170,13 +170,13 @@ void DemSystem::import_parallel(const DemState& st) {
   }
   for (auto& a : pred_) a.assign(n, 0.0);  // set by the next step's first kick
   set_cutoff_and_mass();
-  carry_a_ = st.pair_id_a;
-  carry_b_ = st.pair_id_b;
-  carry_h_.resize(3 * st.pair_id_a.size());
+  carry_.a = st.pair_id_a;
+  carry_.b = st.pair_id_b;
+  carry_.h.resize(3 * st.pair_id_a.size());
   for (std::size_t q = 0; q < st.pair_id_a.size(); ++q) {
-    carry_h_[3 * q] = st.pair_hx[q];
-    carry_h_[3 * q + 1] = st.pair_hy[q];
-    carry_h_[3 * q + 2] = st.pair_hz[q];
+    carry_.h[3 * q] = st.pair_hx[q];
+    carry_.h[3 * q + 1] = st.pair_hy[q];
+    carry_.h[3 * q + 2] = st.pair_hz[q];
   }
   if (same_layout) {
     // As the uninterrupted run left it: ghosts and list of its last rebuild, at the reference
@@ -195,7 +195,7 @@ void DemSystem::import_parallel(const DemState& st) {
     std::copy(now[1].begin(), now[1].end(), s_.y.begin());
     std::copy(now[2].begin(), now[2].end(), s_.z.begin());
     forward_ghosts();
-    restore_histories(carry_a_, carry_b_, carry_h_);
+    restore_histories(carry_.a, carry_.b, carry_.h);
     rescan_wall_contacts();
   } else {
     // Another number of ranks: a fresh rebuild at the current positions (the run continues, not

@@ -177,7 +177,7 @@ void DemSystem::rebuild() {
   wrap_periodic();
   sort_by_cell();
   nl_.build_binned(s_, cfg_.box, cutoff_m_);
-  restore_histories(carry_a_, carry_b_, carry_h_);
+  restore_histories(carry_.a, carry_.b, carry_.h);
   rescan_wall_contacts();
   ref_x_ = s_.x;
   ref_y_ = s_.y;
@@ -214,7 +214,7 @@ double DemSystem::spring_energy_j() const {
   for (std::size_t i = 0; i < s_.size(); ++i)
     for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
       const double ov = pair_overlap(i, nl_.neighbors[p]);
-      const double* h = history_of_slot(p, q);
+      const double* h = pair_hist_.of_slot(p, q);
       if (ov > 0.0)
         e += 0.5 * kn * ov * ov + (h ? 0.5 * kt * (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]) : 0.0);
     }

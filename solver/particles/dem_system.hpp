@@ -13,6 +13,7 @@
 #include "particles/contact_models.hpp"
 #include "particles/displacement_bound.hpp"
 #include "particles/neighbor_list.hpp"
+#include "particles/pair_histories.hpp"
 #include "particles/particle_store.hpp"
 #include "particles/slab_decomposition.hpp"
 #include "particles/walls.hpp"
@@ -181,14 +182,6 @@ class DemSystem {
   /// The particles (and their predictions and wall histories) stored cell by cell.
   void sort_by_cell();
   void collect_histories();
-  /// The shear histories of this evaluation's nc contacts (contact_p_), in contact order, from
-  /// those of the last one: a pair still in contact keeps its spring, a new one starts at zero,
-  /// and a pair that separated is dropped (its spring reset).
-  void carry_histories_to_contacts(std::size_t nc);
-  /// The history of list slot p (3 values, seen from its row), or null where p was not in
-  /// contact at the last evaluation; `q` walks contact_hist_ and must start at 0 for slots
-  /// visited in increasing order.
-  const double* history_of_slot(std::uint32_t p, std::size_t& q) const;
   /// Rebuilds prev_wall_contacts_ from the wall histories (after a reordering or a restart).
   void rescan_wall_contacts();
   void update_uniform_mass();
@@ -221,13 +214,11 @@ class DemSystem {
   std::vector<double> pred_[6];  ///< v, w (m/s, rad/s) seen by the forces: predicted to the force time
   std::vector<double> ref_x_, ref_y_, ref_z_;
   // This evaluation's contacts (particle i and list slot p of each, found by the first pass of
-  // the force loop, in increasing slot order) and the list slots in contact at the last one.
-  std::vector<std::uint32_t> contact_i_, contact_p_, prev_contacts_;
-  // Tangential spring displacement of each pair in contact (seen from its row's particle i), m,
-  // per contact: x, y, z of prev_contacts_[q] at 3q. Kept per contact, not per list slot, so the
-  // force loop reads it in order and nothing streams the 8 in 9 list pairs that are apart.
-  // next_hist_ is the scratch the next evaluation's histories are gathered into.
-  std::vector<double> contact_hist_, next_hist_;
+  // the force loop, in increasing slot order).
+  std::vector<std::uint32_t> contact_i_, contact_p_;
+  // The pairs' tangential springs, per contact: the force loop reads them in order, and nothing
+  // streams the 8 in 9 list pairs that are apart.
+  PairHistories pair_hist_;
   // Particle i of each list slot (the list's row, flattened; rebuilt with the list) and the
   // overlap test's result per slot (scratch).
   std::vector<std::uint32_t> pair_i_;
@@ -240,11 +231,10 @@ class DemSystem {
   // Particles touching each wall at the last evaluation, and this evaluation's (scratch).
   std::vector<std::vector<std::uint32_t>> prev_wall_contacts_;
   std::vector<std::uint32_t> wall_contact_;
-  std::vector<std::int64_t> carry_a_, carry_b_;
+  CarriedHistories carry_;  ///< the springs through the next rebuild (or from a checkpoint)
   // Scratch of restore_histories_by_row: storage slot of each id, and the carried entries per
   // list row (partner slot, entry index).
   std::vector<std::uint32_t> slot_of_id_, row_start_, row_fill_, row_partner_, row_entry_;
-  std::vector<double> carry_h_;
   double time_ = 0.0;
   std::int64_t steps_ = 0, rebuilds_ = 0, contacts_ = 0;
   bool initialized_ = false;

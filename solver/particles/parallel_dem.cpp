@@ -145,7 +145,7 @@ void DemSystem::rebuild_parallel(bool collect) {
   sort_by_cell();
   exchange_ghosts();
   nl_.build(s_, cfg_.box, cutoff_m_, s_.n_local);
-  restore_histories(carry_a_, carry_b_, carry_h_);
+  restore_histories(carry_.a, carry_.b, carry_.h);
   rescan_wall_contacts();
   ref_x_ = s_.x;
   ref_y_ = s_.y;
@@ -183,13 +183,13 @@ void DemSystem::migrate() {
     auto it = std::lower_bound(leaving.begin(), leaving.end(), std::pair<std::int64_t, int>{id, -1});
     return it != leaving.end() && it->first == id ? it->second : -1;
   };
-  for (std::size_t q = 0; q < carry_a_.size(); ++q) {
-    const int da = dest_of(carry_a_[q]), db = dest_of(carry_b_[q]);
+  for (std::size_t q = 0; q < carry_.a.size(); ++q) {
+    const int da = dest_of(carry_.a[q]), db = dest_of(carry_.b[q]);
     const auto send_to = [&](int r) {
       out_pairs[static_cast<std::size_t>(r)].insert(
           out_pairs[static_cast<std::size_t>(r)].end(),
-          {static_cast<double>(carry_a_[q]), static_cast<double>(carry_b_[q]), carry_h_[3 * q],
-           carry_h_[3 * q + 1], carry_h_[3 * q + 2]});
+          {static_cast<double>(carry_.a[q]), static_cast<double>(carry_.b[q]), carry_.h[3 * q],
+           carry_.h[3 * q + 1], carry_.h[3 * q + 2]});
     };
     if (da >= 0) send_to(da);
     if (db >= 0 && db != da) send_to(db);
@@ -215,9 +215,9 @@ void DemSystem::migrate() {
   }
   s_.n_local = s_.id.size();
   for (std::size_t at = 0; at + 5 <= in_pairs.size(); at += 5) {
-    carry_a_.push_back(static_cast<std::int64_t>(in_pairs[at]));
-    carry_b_.push_back(static_cast<std::int64_t>(in_pairs[at + 1]));
-    carry_h_.insert(carry_h_.end(), {in_pairs[at + 2], in_pairs[at + 3], in_pairs[at + 4]});
+    carry_.a.push_back(static_cast<std::int64_t>(in_pairs[at]));
+    carry_.b.push_back(static_cast<std::int64_t>(in_pairs[at + 1]));
+    carry_.h.insert(carry_.h.end(), {in_pairs[at + 2], in_pairs[at + 3], in_pairs[at + 4]});
   }
 }
 
