@@ -53,20 +53,20 @@ void FluidSolver::end_deposition() {
   // alpha_f = 1 - sum of deposited solid fractions.
   BC_PETSC(VecZeroEntries(R_));
   BC_PETSC(DMLocalToGlobal(da_, dep_solid_, ADD_VALUES, R_));
-  BC_PETSC(VecSet(alpha_[0], 1.0));
-  BC_PETSC(VecAXPY(alpha_[0], -1.0, R_));
+  BC_PETSC(VecSet(flow_.alpha[0], 1.0));
+  BC_PETSC(VecAXPY(flow_.alpha[0], -1.0, R_));
   PetscReal amin, amax;
-  BC_PETSC(VecMin(alpha_[0], nullptr, &amin));
-  BC_PETSC(VecMax(alpha_[0], nullptr, &amax));
+  BC_PETSC(VecMin(flow_.alpha[0], nullptr, &amin));
+  BC_PETSC(VecMax(flow_.alpha[0], nullptr, &amax));
   if (!(amin > 0.0) || !(amax <= 1.0))
     throw PhysicsError(
         fmt::format("fluid fraction outside (0, 1] after deposition: min {:.4g}, max {:.4g}", amin, amax));
-  if (!alpha_initialised_ && steps_ == 0) {
-    BC_PETSC(VecCopy(alpha_[0], alpha_[1]));
-    BC_PETSC(VecCopy(alpha_[0], alpha_[2]));
+  if (!alpha_initialised_ && flow_.steps == 0) {
+    BC_PETSC(VecCopy(flow_.alpha[0], flow_.alpha[1]));
+    BC_PETSC(VecCopy(flow_.alpha[0], flow_.alpha[2]));
   }
   alpha_initialised_ = true;
-  for (int l = 0; l < 3; ++l) halo_->fill(alpha_[l], alphal_[l]);
+  for (int l = 0; l < 3; ++l) halo_->fill(flow_.alpha[l], alphal_[l]);
   for (int c = 0; c < 3; ++c) {
     BC_PETSC(VecZeroEntries(S_[c]));
     BC_PETSC(VecZeroEntries(K_[c]));

@@ -27,16 +27,18 @@ FluidSolver::~FluidSolver() {
     if (v) VecDestroy(&v);
   };
   for (int c = 0; c < 3; ++c) {
-    for (Vec* v : {&U_[c], &Un_[c], &Unm1_[c], &alpha_[c], &D_[c], &S_[c], &K_[c], &KU_[c], &inv_diag_[c],
-                   &Ul_[c], &alphal_[c], &Dl_[c], &dep_S_[c], &dep_K_[c], &dep_KU_[c], &Fl_[c]})
+    for (Vec* v :
+         {&flow_.U[c], &flow_.Un[c], &flow_.Unm1[c], &flow_.alpha[c], &D_[c], &S_[c], &K_[c], &KU_[c],
+          &inv_diag_[c], &Ul_[c], &alphal_[c], &Dl_[c], &dep_S_[c], &dep_K_[c], &dep_KU_[c], &Fl_[c]})
       vd(*v);
   }
-  for (Vec* v : {&P_, &nut_, &rhs_, &sol_, &R_, &pc_, &Pl_, &nutl_, &pcl_, &dep_solid_, &nuel_}) vd(*v);
-  if (null_) MatNullSpaceDestroy(&null_);
-  if (ksp_m_) KSPDestroy(&ksp_m_);
-  if (ksp_p_) KSPDestroy(&ksp_p_);
-  spectral_pc_.reset();  // its vectors and scatter before the DM
-  if (ksp_p_fallback_) KSPDestroy(&ksp_p_fallback_);
+  for (Vec* v : {&flow_.P, &flow_.nut, &rhs_, &sol_, &R_, &pc_, &Pl_, &nutl_, &pcl_, &dep_solid_, &nuel_})
+    vd(*v);
+  if (solvers_.null_space) MatNullSpaceDestroy(&solvers_.null_space);
+  if (solvers_.momentum) KSPDestroy(&solvers_.momentum);
+  if (solvers_.pressure) KSPDestroy(&solvers_.pressure);
+  solvers_.spectral_pc.reset();  // its vectors and scatter before the DM
+  if (solvers_.pressure_fallback) KSPDestroy(&solvers_.pressure_fallback);
   if (A_) MatDestroy(&A_);
   for (int c = 0; c < 3; ++c) {
     opm_[c].reset();
@@ -100,28 +102,30 @@ void FluidSolver::create_layout() {
   auto gv = [&](Vec* v) { BC_PETSC(DMCreateGlobalVector(da_, v)); };
   auto lv = [&](Vec* v) { BC_PETSC(DMCreateLocalVector(da_, v)); };
   for (int c = 0; c < 3; ++c) {
-    for (Vec* v : {&U_[c], &Un_[c], &Unm1_[c], &alpha_[c], &D_[c], &S_[c], &K_[c], &KU_[c], &inv_diag_[c]})
+    for (Vec* v : {&flow_.U[c], &flow_.Un[c], &flow_.Unm1[c], &flow_.alpha[c], &D_[c], &S_[c], &K_[c],
+                   &KU_[c], &inv_diag_[c]})
       gv(v);
     for (Vec* v : {&Ul_[c], &alphal_[c], &Dl_[c], &dep_S_[c], &dep_K_[c], &dep_KU_[c], &Fl_[c]}) lv(v);
-    BC_PETSC(VecSet(alpha_[c], 1.0));
+    BC_PETSC(VecSet(flow_.alpha[c], 1.0));
   }
-  for (Vec* v : {&P_, &nut_, &rhs_, &sol_, &R_, &pc_}) gv(v);
+  for (Vec* v : {&flow_.P, &flow_.nut, &rhs_, &sol_, &R_, &pc_}) gv(v);
   for (Vec* v : {&Pl_, &nutl_, &pcl_, &dep_solid_, &nuel_}) lv(v);
 
-  ksp_m_ = create_momentum_ksp(comm_, &jacobi_inv_diag_, inexact_inner_solves());
-  BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-momentum_ksp_atol", &user_momentum_atol_));
+  solvers_.momentum = create_momentum_ksp(comm_, &jacobi_inv_diag_, inexact_inner_solves());
+  BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-momentum_ksp_atol", &solvers_.user_momentum_atol));
   // The spectral preconditioner unless the user names another (-pressure_pc_type).
-  if (!user_pc) spectral_pc_ = std::make_unique<SpectralPcShell>(dam_, g);
+  if (!user_pc) solvers_.spectral_pc = std::make_unique<SpectralPcShell>(dam_, g);
   // With the spectral preconditioner a tighter solve than the multigrid's is cheap (about one
   // Krylov iteration per decade). With one correction per SIMPLE iteration it saves iterations
   // (5.8 -> 5.0 per step on the fluid bench at 1e-3 against 1e-2; 1e-4: 5.0); with two it does
   // not (4.0 at both on the bench, 7.6 at both in the developed full-size case, where 1e-2 takes
   // 26 % fewer pressure Krylov iterations). PISO is not iterated: 1e-3.
-  ksp_p_ = create_pressure_ksp(comm_, spectral_pc_.get(), inexact_inner_solves() ? 1e-2 : 1e-3);
-  BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-pressure_ksp_atol", &user_pressure_atol_));
+  solvers_.pressure =
+      create_pressure_ksp(comm_, solvers_.spectral_pc.get(), inexact_inner_solves() ? 1e-2 : 1e-3);
+  BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-pressure_ksp_atol", &solvers_.user_pressure_atol));
   // Periodic x, z and walls (or periodicity) in y: pure Neumann, the constant is the null space.
-  BC_PETSC(MatNullSpaceCreate(comm_, PETSC_TRUE, 0, nullptr, &null_));
-  BC_PETSC(MatSetNullSpace(opP_->mat(), null_));
+  BC_PETSC(MatNullSpaceCreate(comm_, PETSC_TRUE, 0, nullptr, &solvers_.null_space));
+  BC_PETSC(MatSetNullSpace(opP_->mat(), solvers_.null_space));
   update_ghosts();
 }
 
@@ -132,7 +136,7 @@ Mat FluidSolver::aij_copy(const StencilOperator& op, Mat* M) {
     // an MPIAIJ matrix still set up the communication of off-process entries.
     BC_PETSC(MatSetOption(*M, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
     BC_PETSC(MatSetOption(*M, MAT_NO_OFF_PROC_ENTRIES, PETSC_TRUE));
-    if (M == &Ap_) BC_PETSC(MatSetNullSpace(*M, null_));
+    if (M == &Ap_) BC_PETSC(MatSetNullSpace(*M, solvers_.null_space));
     if (!writer_) writer_ = std::make_unique<StencilMatrixWriter>(dam_, *M);
   }
   op.copy_to(*M, *writer_);
@@ -152,16 +156,16 @@ GhostBox FluidSolver::ghost_box() const {
 }
 
 void FluidSolver::update_ghosts() {
-  for (int c = 0; c < 3; ++c) halo_->fill(alpha_[c], alphal_[c]);
-  halo_->fill(nut_, nutl_);
+  for (int c = 0; c < 3; ++c) halo_->fill(flow_.alpha[c], alphal_[c]);
+  halo_->fill(flow_.nut, nutl_);
   update_flow_ghosts();
 }
 
 // Within a step alpha_f and nu_t are fixed; only u and p change (a ghost fill of the bench mesh
 // cost ~0.3 ms with DMGlobalToLocal then, and a SIMPLE step did ~90 of them).
 void FluidSolver::update_flow_ghosts() {
-  for (int c = 0; c < 3; ++c) halo_->fill(U_[c], Ul_[c]);
-  halo_->fill(P_, Pl_);
+  for (int c = 0; c < 3; ++c) halo_->fill(flow_.U[c], Ul_[c]);
+  halo_->fill(flow_.P, Pl_);
 }
 
 }  // namespace boycott::fluid

@@ -121,8 +121,8 @@ class FluidSolver {
   /// Flux controller target (m/s) for the mean of alpha_f w; NaN switches it off.
   void set_target_mean_flux_z(double v) { s_.target_mean_flux_z_m_s = v; }
   /// Mean pressure gradient G in z (Pa/m); set by the controller or by hand when it is off.
-  double mean_pressure_gradient_pa_m() const { return G_; }
-  void set_mean_pressure_gradient_pa_m(double g) { G_ = g; }
+  double mean_pressure_gradient_pa_m() const { return flow_.G_pa_m; }
+  void set_mean_pressure_gradient_pa_m(double g) { flow_.G_pa_m = g; }
 
   /// Read access to ghosted u, v, w (c = 0..2), p (c = 3) and nu_t (c = 4), valid until the next
   /// step; restore with restore_read().
@@ -134,10 +134,10 @@ class FluidSolver {
   double stable_dt() const;
   /// Advances one step of size dt (s).
   StepReport step(double dt_s);
-  double time_s() const { return time_; }
-  int steps_done() const { return steps_; }
+  double time_s() const { return flow_.time_s; }
+  int steps_done() const { return flow_.steps; }
   /// Pressure solves that failed with the default solver and were redone by the fallback.
-  int pressure_fallbacks() const { return pressure_fallbacks_; }
+  int pressure_fallbacks() const { return counters_.pressure_fallbacks; }
 
   // ---- diagnostics ----
   /// Volume mean of alpha_f w over the domain (m/s).
@@ -178,14 +178,14 @@ class FluidSolver {
   /// (simple_piso.cpp); one corrector and PISO keep the tolerances they always had.
   bool inexact_inner_solves() const { return !s_.piso && s_.simple_correctors > 1; }
   void step_piso(double dt, const double c[3], StepReport& rep);
-  /// Solves component cc's momentum equations from the guess U_[cc]; the solution is left in sol_.
+  /// Solves component cc's momentum equations from the guess flow_.U[cc]; the solution is left in sol_.
   void solve_momentum(int cc, const StencilOperator& A, StepReport& rep);
   /// The AIJ copy of op in *M (created on first use), for preconditioners that need entries.
   Mat aij_copy(const StencilOperator& op, Mat* M);
   /// Pressure correction from the continuity residual in R_, then the velocity and pressure
   /// update (and their ghosts unless told otherwise).
   void solve_pressure_correction(StepReport& rep, bool refresh_ghosts = true);
-  /// max |d a/dt + div(a u)| h_min / U of U_ (also refreshes the ghosted velocities).
+  /// max |d a/dt + div(a u)| h_min / U of flow_.U (also refreshes the ghosted velocities).
   double relative_continuity_residual(double dt, const double c[3], double umax);
   double max_abs_velocity_all() const;
   /// PISO: one Jacobi sweep of the frozen momentum equations at the current pressure.
@@ -211,27 +211,49 @@ class FluidSolver {
   bool momentum_aij_ = false, pressure_aij_ = false;
   Mat A_ = nullptr, Ap_ = nullptr;
   std::unique_ptr<StencilMatrixWriter> writer_;
-  KSP ksp_m_ = nullptr, ksp_p_ = nullptr;
-  KSP ksp_p_fallback_ = nullptr;  // BoomerAMG, created on the first failed pressure solve
-  // The pressure preconditioner on one rank unless the user picks another (-pressure_pc_type).
-  std::unique_ptr<SpectralPcShell> spectral_pc_;
-  int pressure_fallbacks_ = 0;
-  // Absolute tolerance of the pressure solves (1/s), from the last continuity test's scale;
-  // a user's -pressure_ksp_atol replaces it.
-  double pressure_abs_tol_ = 0.0;
-  PetscBool user_pressure_atol_ = PETSC_FALSE;
-  PetscBool user_momentum_atol_ = PETSC_FALSE;
-  // whether the momentum floor is taken in the Jacobi-scaled norm: -1 until the first solve
-  int momentum_floor_jacobi_ = -1;
-  MatNullSpace null_ = nullptr;
+  /// The linear solvers of a step (linear_solvers.hpp) and how they are steered.
+  struct Solvers {
+    KSP momentum = nullptr, pressure = nullptr;
+    KSP pressure_fallback = nullptr;  // BoomerAMG, created on the first failed pressure solve
+    // The pressure preconditioner on one rank unless the user picks another (-pressure_pc_type).
+    std::unique_ptr<SpectralPcShell> spectral_pc;
+    // Absolute tolerance of the pressure solves (1/s), from the last continuity test's scale;
+    // a user's -pressure_ksp_atol replaces it.
+    double pressure_abs_tol = 0.0;
+    PetscBool user_pressure_atol = PETSC_FALSE;
+    PetscBool user_momentum_atol = PETSC_FALSE;
+    // whether the momentum floor is taken in the Jacobi-scaled norm: -1 until the first solve
+    int momentum_floor_jacobi = -1;
+    MatNullSpace null_space = nullptr;  // constants, the pressure's null space
+  };
+  Solvers solvers_;
+
+  /// The flow: what a checkpoint carries (fluid_state.cpp) and the level before it.
+  struct Flow {
+    Vec U[3]{}, Un[3]{}, Unm1[3]{}, P = nullptr;  // velocity at n+1, n, n-1 (m/s); pressure (Pa)
+    Vec alpha[3]{};                               // fluid fraction: [0] n+1, [1] n, [2] n-1
+    Vec nut = nullptr;                            // subgrid viscosity, m^2/s
+    double time_s = 0.0;
+    double dt_prev_s = 0.0;  // the last step's, for the second-order time derivative
+    int steps = 0;
+    double G_pa_m = 0.0;  // the mean pressure gradient driving the flow
+  };
+  Flow flow_;
+
+  /// What the last step did, for its report and the run's.
+  struct Counters {
+    int pressure_fallbacks = 0;
+    double last_dt_s = 0.0;
+    double last_defect = 0.0;
+    int momentum_its = 0;
+  };
+  Counters counters_;
 
   // global vectors
-  Vec U_[3]{}, Un_[3]{}, Unm1_[3]{}, P_ = nullptr, alpha_[3]{};  // alpha_[0]=n+1, [1]=n, [2]=n-1
   Vec D_[3]{};                     // a_face / (rho a_P') per face (SIMPLE correction coefficient)
   Vec inv_diag_[3]{};              // 1 / diagonal of each component's momentum matrix (Jacobi)
   Vec jacobi_inv_diag_ = nullptr;  // the one the momentum solve in progress uses
   Vec S_[3]{}, K_[3]{}, KU_[3]{};  // coupling fields on faces
-  Vec nut_ = nullptr;
   Vec rhs_ = nullptr, sol_ = nullptr, R_ = nullptr, pc_ = nullptr;
   // ghosted local vectors
   Vec Ul_[3]{}, Pl_ = nullptr, alphal_[3]{}, nutl_ = nullptr, pcl_ = nullptr, Dl_[3]{};
@@ -244,14 +266,7 @@ class FluidSolver {
   PetscScalar*** dep_arrays_[10]{};
   PetscScalar*** read_arrays_[5]{};
 
-  double time_ = 0.0;
-  double dt_prev_ = 0.0;
-  int steps_ = 0;
-  double G_ = 0.0;
   double last_c_[3] = {1.0, 1.0, 0.0};
-  double last_dt_ = 0.0;
-  double last_defect_ = 0.0;
-  int momentum_its_ = 0;
   std::vector<double> row_buffers_;  // momentum assembly, one (k, j) row of cells at a time
 };
 

@@ -20,7 +20,7 @@ void FluidSolver::set_velocity(int c, const std::function<double(double, double,
   const auto& g = s_.grid;
   const OwnedBox b = owned_box();
   PetscScalar*** u;
-  BC_PETSC(DMDAVecGetArray(da_, U_[c], &u));
+  BC_PETSC(DMDAVecGetArray(da_, flow_.U[c], &u));
   for (auto k = b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
     for (auto j = b.lo[1]; j < b.lo[1] + b.size[1]; ++j)
       for (auto i = b.lo[0]; i < b.lo[0] + b.size[0]; ++i) {
@@ -30,10 +30,10 @@ void FluidSolver::set_velocity(int c, const std::function<double(double, double,
         const bool wall = c == 1 && !g.periodic[1] && j == 0;
         u[k][j][i] = wall ? 0.0 : f(x[0], x[1], x[2]);
       }
-  BC_PETSC(DMDAVecRestoreArray(da_, U_[c], &u));
-  BC_PETSC(VecCopy(U_[c], Un_[c]));
-  BC_PETSC(VecCopy(U_[c], Unm1_[c]));
-  halo_->fill(U_[c], Ul_[c]);
+  BC_PETSC(DMDAVecRestoreArray(da_, flow_.U[c], &u));
+  BC_PETSC(VecCopy(flow_.U[c], flow_.Un[c]));
+  BC_PETSC(VecCopy(flow_.U[c], flow_.Unm1[c]));
+  halo_->fill(flow_.U[c], Ul_[c]);
 }
 
 void FluidSolver::set_fluid_fraction(const std::function<double(double, double, double)>& f) {
@@ -41,7 +41,7 @@ void FluidSolver::set_fluid_fraction(const std::function<double(double, double, 
   const OwnedBox b = owned_box();
   PetscScalar*** a;
   double amin = 1.0, amax = 0.0;
-  BC_PETSC(DMDAVecGetArray(da_, alpha_[0], &a));
+  BC_PETSC(DMDAVecGetArray(da_, flow_.alpha[0], &a));
   for (auto k = b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
     for (auto j = b.lo[1]; j < b.lo[1] + b.size[1]; ++j)
       for (auto i = b.lo[0]; i < b.lo[0] + b.size[0]; ++i) {
@@ -49,33 +49,33 @@ void FluidSolver::set_fluid_fraction(const std::function<double(double, double, 
         a[k][j][i] = v;
         amin = std::min(amin, v), amax = std::max(amax, v);
       }
-  BC_PETSC(DMDAVecRestoreArray(da_, alpha_[0], &a));
+  BC_PETSC(DMDAVecRestoreArray(da_, flow_.alpha[0], &a));
   if (!(amin > 0.0) || !(amax <= 1.0))
     throw PhysicsError(fmt::format("fluid fraction outside (0, 1]: min {:.4g}, max {:.4g}", amin, amax));
-  if (!alpha_initialised_ && steps_ == 0) {
-    BC_PETSC(VecCopy(alpha_[0], alpha_[1]));
-    BC_PETSC(VecCopy(alpha_[0], alpha_[2]));
+  if (!alpha_initialised_ && flow_.steps == 0) {
+    BC_PETSC(VecCopy(flow_.alpha[0], flow_.alpha[1]));
+    BC_PETSC(VecCopy(flow_.alpha[0], flow_.alpha[2]));
   }
   alpha_initialised_ = true;
-  for (int l = 0; l < 3; ++l) halo_->fill(alpha_[l], alphal_[l]);
+  for (int l = 0; l < 3; ++l) halo_->fill(flow_.alpha[l], alphal_[l]);
 }
 
 // ---------------------------------------------------------------- diagnostics
 
 double FluidSolver::mean_velocity(int c) const {
   PetscScalar sum;
-  VecSum(U_[c], &sum);
+  VecSum(flow_.U[c], &sum);
   return sum / static_cast<double>(s_.grid.cell_count());
 }
 
 double FluidSolver::max_abs_velocity(int c) const {
   PetscReal m;
-  VecNorm(U_[c], NORM_INFINITY, &m);
+  VecNorm(flow_.U[c], NORM_INFINITY, &m);
   return m;
 }
 
 double FluidSolver::max_continuity_defect() const {
-  return last_defect_;
+  return counters_.last_defect;
 }
 
 std::vector<double> FluidSolver::profile_y(int c) const {
@@ -83,11 +83,11 @@ std::vector<double> FluidSolver::profile_y(int c) const {
   const int ny = (int)s_.grid.n[1];
   std::vector<double> loc(ny, 0.0), glob(ny, 0.0);
   PetscScalar*** u;
-  DMDAVecGetArray(da_, U_[c], &u);
+  DMDAVecGetArray(da_, flow_.U[c], &u);
   for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
     for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j)
       for (int i = (int)b.lo[0]; i < b.lo[0] + b.size[0]; ++i) loc[j] += u[k][j][i];
-  DMDAVecRestoreArray(da_, U_[c], &u);
+  DMDAVecRestoreArray(da_, flow_.U[c], &u);
   MPI_Allreduce(loc.data(), glob.data(), ny, MPI_DOUBLE, MPI_SUM, comm_);
   const double nxz = static_cast<double>(s_.grid.n[0] * s_.grid.n[2]);
   for (auto& v : glob) v /= nxz;
@@ -95,7 +95,7 @@ std::vector<double> FluidSolver::profile_y(int c) const {
 }
 
 std::vector<double> FluidSolver::gather(int c) const {
-  Vec src = c < 3 ? U_[c] : (c == 3 ? P_ : (c == 4 ? nut_ : alpha_[1]));
+  Vec src = c < 3 ? flow_.U[c] : (c == 3 ? flow_.P : (c == 4 ? flow_.nut : flow_.alpha[1]));
   Vec nat, all;
   VecScatter sc;
   BC_PETSC(DMDACreateNaturalVector(da_, &nat));
@@ -121,14 +121,15 @@ std::vector<double> FluidSolver::gather(int c) const {
 FluidState FluidSolver::export_state() const {
   FluidState st;
   st.box = owned_box();
-  st.time_s = time_;
-  st.dt_prev_s = dt_prev_;
-  st.steps = steps_;
-  st.mean_pressure_gradient_pa_m = G_;
+  st.time_s = flow_.time_s;
+  st.dt_prev_s = flow_.dt_prev_s;
+  st.steps = flow_.steps;
+  st.mean_pressure_gradient_pa_m = flow_.G_pa_m;
   // nu_t too: it was computed from the previous level at the start of the last step, and the
   // coupling reads it before the next step recomputes it.
-  const Vec vs[11] = {U_[0], U_[1],     U_[2],     Unm1_[0],  Unm1_[1], Unm1_[2],
-                      P_,    alpha_[1], alpha_[2], alpha_[0], nut_};
+  const Vec vs[11] = {flow_.U[0],     flow_.U[1],     flow_.U[2], flow_.Unm1[0],
+                      flow_.Unm1[1],  flow_.Unm1[2],  flow_.P,    flow_.alpha[1],
+                      flow_.alpha[2], flow_.alpha[0], flow_.nut};
   for (Vec v : vs) {
     PetscInt nloc;
     VecGetLocalSize(v, &nloc);
@@ -144,21 +145,22 @@ void FluidSolver::import_state(const FluidState& st) {
   const OwnedBox b = owned_box();
   if (st.box.lo != b.lo || st.box.size != b.size || st.fields.size() != 11)
     throw std::invalid_argument("fluid state from another layout");
-  Vec vs[11] = {U_[0], U_[1], U_[2], Unm1_[0], Unm1_[1], Unm1_[2], P_, alpha_[1], alpha_[2], alpha_[0], nut_};
+  Vec vs[11] = {flow_.U[0], flow_.U[1],     flow_.U[2],     flow_.Unm1[0],  flow_.Unm1[1], flow_.Unm1[2],
+                flow_.P,    flow_.alpha[1], flow_.alpha[2], flow_.alpha[0], flow_.nut};
   for (int f = 0; f < 11; ++f) {
     PetscScalar* a;
     BC_PETSC(VecGetArray(vs[f], &a));
     std::copy(st.fields[f].begin(), st.fields[f].end(), a);
     BC_PETSC(VecRestoreArray(vs[f], &a));
   }
-  for (int c = 0; c < 3; ++c) BC_PETSC(VecCopy(U_[c], Un_[c]));
-  time_ = st.time_s;
-  dt_prev_ = st.dt_prev_s;
-  steps_ = st.steps;
-  G_ = st.mean_pressure_gradient_pa_m;
+  for (int c = 0; c < 3; ++c) BC_PETSC(VecCopy(flow_.U[c], flow_.Un[c]));
+  flow_.time_s = st.time_s;
+  flow_.dt_prev_s = st.dt_prev_s;
+  flow_.steps = st.steps;
+  flow_.G_pa_m = st.mean_pressure_gradient_pa_m;
   alpha_initialised_ = true;
-  for (int l = 0; l < 3; ++l) halo_->fill(alpha_[l], alphal_[l]);
-  halo_->fill(nut_, nutl_);
+  for (int l = 0; l < 3; ++l) halo_->fill(flow_.alpha[l], alphal_[l]);
+  halo_->fill(flow_.nut, nutl_);
   update_ghosts();
 }
 

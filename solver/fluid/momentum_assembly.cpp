@@ -109,8 +109,8 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
   for (int l = 0; l < 3; ++l) BC_PETSC(VecGetArrayRead(alphal_[l], &al[l]));
   BC_PETSC(VecGetArrayRead(Pl_, &p));
   BC_PETSC(VecGetArrayRead(nuel_, &nue));
-  BC_PETSC(VecGetArrayRead(Un_[c], &un));
-  BC_PETSC(VecGetArrayRead(Unm1_[c], &unm1));
+  BC_PETSC(VecGetArrayRead(flow_.Un[c], &un));
+  BC_PETSC(VecGetArrayRead(flow_.Unm1[c], &unm1));
   BC_PETSC(VecGetArrayRead(S_[c], &S));
   BC_PETSC(VecGetArrayRead(K_[c], &K));
   BC_PETSC(VecGetArrayRead(KU_[c], &KU));
@@ -129,7 +129,7 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
     if (!wall) return true;
     return c == 1 ? (jx >= 0 && jx <= n1) : (jx >= 0 && jx <= n1 - 1);
   };
-  const double body = s_.body_acceleration_m_s2[c] - (c == 2 ? G_ / rho : 0.0);
+  const double body = s_.body_acceleration_m_s2[c] - (c == 2 ? flow_.G_pa_m / rho : 0.0);
   const double ih[3] = {1.0 / h[0], 1.0 / h[1], 1.0 / h[2]};
   const double ih2[3] = {ih[0] * ih[0], ih[1] * ih[1], ih[2] * ih[2]};
   const double inv_dt = 1.0 / dt, inv_rho = 1.0 / rho, inv_lam = 1.0 / lam;
@@ -310,8 +310,8 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
   for (int l = 0; l < 3; ++l) BC_PETSC(VecRestoreArrayRead(alphal_[l], &al[l]));
   BC_PETSC(VecRestoreArrayRead(Pl_, &p));
   BC_PETSC(VecRestoreArrayRead(nuel_, &nue));
-  BC_PETSC(VecRestoreArrayRead(Un_[c], &un));
-  BC_PETSC(VecRestoreArrayRead(Unm1_[c], &unm1));
+  BC_PETSC(VecRestoreArrayRead(flow_.Un[c], &un));
+  BC_PETSC(VecRestoreArrayRead(flow_.Unm1[c], &unm1));
   BC_PETSC(VecRestoreArrayRead(S_[c], &S));
   BC_PETSC(VecRestoreArrayRead(K_[c], &K));
   BC_PETSC(VecRestoreArrayRead(KU_[c], &KU));

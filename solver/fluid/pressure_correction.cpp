@@ -95,15 +95,15 @@ void FluidSolver::assemble_pressure() {
       }
   for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecRestoreArray(da_, Dl_[d], &D[d]));
   BC_PETSC(DMDAVecRestoreArray(da_, alphal_[0], &al));
-  if (spectral_pc_) {
+  if (solvers_.spectral_pc) {
     double gsum[6];
     MPI_Allreduce(csum, gsum, 6, MPI_DOUBLE, MPI_SUM, comm_);
     double c[3];
     for (int d = 0; d < 3; ++d) c[d] = gsum[3 + d] > 0.0 ? gsum[d] / gsum[3 + d] : 0.0;
-    spectral_pc_->set_coefficients(c[0], c[1], c[2]);
+    solvers_.spectral_pc->set_coefficients(c[0], c[1], c[2]);
   }
   const Mat A = pressure_aij_ ? aij_copy(*opP_, &Ap_) : opP_->mat();
-  BC_PETSC(KSPSetOperators(ksp_p_, A, A));
+  BC_PETSC(KSPSetOperators(solvers_.pressure, A, A));
 }
 
 void FluidSolver::correct(Vec pcorr) {
@@ -116,7 +116,7 @@ void FluidSolver::correct(Vec pcorr) {
   PetscScalar ***pc, ***U[3], ***D[3];
   BC_PETSC(DMDAVecGetArray(da_, pcl_, &pc));
   for (int d = 0; d < 3; ++d) {
-    BC_PETSC(DMDAVecGetArray(da_, U_[d], &U[d]));
+    BC_PETSC(DMDAVecGetArray(da_, flow_.U[d], &U[d]));
     BC_PETSC(DMDAVecGetArray(da_, D_[d], &D[d]));
   }
   for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
@@ -129,19 +129,19 @@ void FluidSolver::correct(Vec pcorr) {
         }
   BC_PETSC(DMDAVecRestoreArray(da_, pcl_, &pc));
   for (int d = 0; d < 3; ++d) {
-    BC_PETSC(DMDAVecRestoreArray(da_, U_[d], &U[d]));
+    BC_PETSC(DMDAVecRestoreArray(da_, flow_.U[d], &U[d]));
     BC_PETSC(DMDAVecRestoreArray(da_, D_[d], &D[d]));
   }
-  BC_PETSC(VecAXPY(P_, s_.simplec ? 1.0 : s_.pressure_relaxation, pcorr));
+  BC_PETSC(VecAXPY(flow_.P, s_.simplec ? 1.0 : s_.pressure_relaxation, pcorr));
 }
 
 void FluidSolver::solve_pressure_correction(StepReport& rep, bool refresh_ghosts) {
   BC_PETSC(VecScale(R_, -1.0));
-  BC_PETSC(MatNullSpaceRemove(null_, R_));
+  BC_PETSC(MatNullSpaceRemove(solvers_.null_space, R_));
   const auto res = solve_pressure(
-      comm_, ksp_p_, &ksp_p_fallback_, [this] { return aij_copy(*opP_, &Ap_); }, R_, pc_,
-      user_pressure_atol_ ? -1.0 : pressure_abs_tol_);
-  if (res.used_fallback) ++pressure_fallbacks_;
+      comm_, solvers_.pressure, &solvers_.pressure_fallback, [this] { return aij_copy(*opP_, &Ap_); }, R_,
+      pc_, solvers_.user_pressure_atol ? -1.0 : solvers_.pressure_abs_tol);
+  if (res.used_fallback) ++counters_.pressure_fallbacks;
   rep.pressure_krylov_iterations += (int)res.iterations;
   correct(pc_);
   if (refresh_ghosts) update_flow_ghosts();
@@ -150,12 +150,12 @@ void FluidSolver::solve_pressure_correction(StepReport& rep, bool refresh_ghosts
 double FluidSolver::relative_continuity_residual(double dt, const double c[3], double umax) {
   const auto& g = s_.grid;
   const double hmin = std::min({g.dx(0), g.dx(1), g.dx(2)});
-  for (int cc = 0; cc < 3; ++cc) halo_->fill(U_[cc], Ul_[cc]);
+  for (int cc = 0; cc < 3; ++cc) halo_->fill(flow_.U[cc], Ul_[cc]);
   const double rmax = continuity_residual(dt, c[0], c[1], c[2], R_);
   const double uref = std::max(
       {umax, std::abs(std::isfinite(s_.target_mean_flux_z_m_s) ? s_.target_mean_flux_z_m_s : 0.0), 1e-30});
   if (!std::isfinite(rmax) || !std::isfinite(umax))
-    throw PhysicsError(fmt::format("fluid velocity became NaN at t = {:.6g} s", time_));
+    throw PhysicsError(fmt::format("fluid velocity became NaN at t = {:.6g} s", flow_.time_s));
   // The pressure correction need not reduce a residual far below what SIMPLE's test accepts
   // (rmax h / U < simple_tolerance): without a floor, a residual at round-off level (a flow
   // that already satisfies continuity, as plane Poiseuille does) can never be reduced by the
@@ -164,7 +164,7 @@ double FluidSolver::relative_continuity_residual(double dt, const double c[3], d
   // of a constant alpha_f is not exactly zero, and a fluid at rest has no velocity scale at all.
   const double noise = 16.0 * std::numeric_limits<double>::epsilon() *
                        std::sqrt(static_cast<double>(g.cell_count())) * (c[0] + c[1] + c[2]) / dt;
-  pressure_abs_tol_ = std::max(1e-4 * s_.simple_tolerance * uref / hmin, noise);
+  solvers_.pressure_abs_tol = std::max(1e-4 * s_.simple_tolerance * uref / hmin, noise);
   return rmax * hmin / uref;
 }
 

@@ -67,8 +67,8 @@ void FluidSolver::step_simple(double dt, const double c[3], StepReport& rep) {
   if (correctors > 1) keep_momentum_operators();
   for (int it = 0; it < s_.simple_max_iterations; ++it) {
     const bool first = it == 0;
-    const double G_asm = G_;
-    if (correctors > 1) BC_PETSC(VecCopy(P_, P_asm_));
+    const double G_asm = flow_.G_pa_m;
+    if (correctors > 1) BC_PETSC(VecCopy(flow_.P, P_asm_));
     // max |u* - u| and max |u*| over the components: one pass each and one reduction for all
     double loc[2] = {0.0, 0.0};
     compute_face_fluxes();
@@ -77,13 +77,13 @@ void FluidSolver::step_simple(double dt, const double c[3], StepReport& rep) {
       assemble_momentum(cc, dt, c[0], c[1], c[2], first, A);
       if (correctors > 1) BC_PETSC(VecCopy(rhs_, bm_[cc]));
       solve_momentum(cc, A, rep);
-      // the new iterate (in sol_) replaces the old one in U_ in the pass that measures the change
+      // the new iterate (in sol_) replaces the old one in flow_.U in the pass that measures the change
       const double* un;
       double* u;
       PetscInt n;
-      BC_PETSC(VecGetLocalSize(U_[cc], &n));
+      BC_PETSC(VecGetLocalSize(flow_.U[cc], &n));
       BC_PETSC(VecGetArrayRead(sol_, &un));
-      BC_PETSC(VecGetArray(U_[cc], &u));
+      BC_PETSC(VecGetArray(flow_.U[cc], &u));
       double d = loc[0], m = loc[1];
       bool nan = false;
       for (PetscInt q = 0; q < n; ++q) {
@@ -97,7 +97,7 @@ void FluidSolver::step_simple(double dt, const double c[3], StepReport& rep) {
       const double inf = std::numeric_limits<double>::infinity();
       loc[0] = nan ? inf : d, loc[1] = nan ? inf : m;
       BC_PETSC(VecRestoreArrayRead(sol_, &un));
-      BC_PETSC(VecRestoreArray(U_[cc], &u));
+      BC_PETSC(VecRestoreArray(flow_.U[cc], &u));
     }
     double glob[2];
     MPI_Allreduce(loc, glob, 2, MPI_DOUBLE, MPI_MAX, comm_);
@@ -146,19 +146,20 @@ void FluidSolver::step_piso(double dt, const double c[3], StepReport& rep) {
   // The equations are linearised once, about u^n + (dt/dt_prev)(u^n - u^(n-1)): the face fluxes,
   // QUICK's deferred correction and the transposed stress are then O(dt^2) from their values
   // at u^(n+1), which keeps the step second order in time (about u^n it would be first order).
-  if (steps_ > 0) {
-    const double r = dt / dt_prev_;
-    for (int cc = 0; cc < 3; ++cc) BC_PETSC(VecAXPBYPCZ(U_[cc], 1.0 + r, -r, 0.0, Un_[cc], Unm1_[cc]));
+  if (flow_.steps > 0) {
+    const double r = dt / flow_.dt_prev_s;
+    for (int cc = 0; cc < 3; ++cc)
+      BC_PETSC(VecAXPBYPCZ(flow_.U[cc], 1.0 + r, -r, 0.0, flow_.Un[cc], flow_.Unm1[cc]));
     update_flow_ghosts();
   }
   compute_face_fluxes();
-  BC_PETSC(VecCopy(P_, P_asm_));
-  const double G_asm = G_;
+  BC_PETSC(VecCopy(flow_.P, P_asm_));
+  const double G_asm = flow_.G_pa_m;
   for (int cc = 0; cc < 3; ++cc) {
     assemble_momentum(cc, dt, c[0], c[1], c[2], true, *opm_[cc]);
     BC_PETSC(VecCopy(rhs_, bm_[cc]));
     solve_momentum(cc, *opm_[cc], rep);
-    BC_PETSC(VecCopy(sol_, U_[cc]));
+    BC_PETSC(VecCopy(sol_, flow_.U[cc]));
   }
   if (std::isfinite(s_.target_mean_flux_z_m_s)) apply_flux_controller();
   for (int k = 0; k < s_.piso_correctors; ++k) {
@@ -187,7 +188,7 @@ void FluidSolver::step_piso(double dt, const double c[3], StepReport& rep) {
 void FluidSolver::momentum_sweep(double G_asm) {
   const LogScope log_scope(fluid_events().momentum_sweep);
   // p - p_asm, ghosted: the pressure the frozen right-hand sides b were assembled with
-  BC_PETSC(VecWAXPY(pc_, -1.0, P_asm_, P_));
+  BC_PETSC(VecWAXPY(pc_, -1.0, P_asm_, flow_.P));
   halo_->fill(pc_, pcl_);
   const auto& g = s_.grid;
   const bool wall = !g.periodic[1];
@@ -199,17 +200,17 @@ void FluidSolver::momentum_sweep(double G_asm) {
   BC_PETSC(VecGetArrayRead(alphal_[0], &al));
   BC_PETSC(VecGetArrayRead(pcl_, &dp));
   for (int cc = 0; cc < 3; ++cc) {
-    opm_[cc]->apply(U_[cc], sol_);  // A u
+    opm_[cc]->apply(flow_.U[cc], sol_);  // A u
     const double *Au, *bv, *aP;
     double* u;
     BC_PETSC(VecGetArrayRead(sol_, &Au));
     BC_PETSC(VecGetArrayRead(bm_[cc], &bv));
     aP = opm_[cc]->coef(0);
-    BC_PETSC(VecGetArray(U_[cc], &u));
+    BC_PETSC(VecGetArray(flow_.U[cc], &u));
     const std::int64_t oc = off[cc];
     const double igrad = inv_rho / g.dx(cc);
     // the mean gradient G acts like a pressure gradient on w: its change since the assembly too
-    const double dbody = cc == 2 ? -(G_ - G_asm) * inv_rho : 0.0;
+    const double dbody = cc == 2 ? -(flow_.G_pa_m - G_asm) * inv_rho : 0.0;
     std::int64_t o = 0;
     for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
       for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j) {
@@ -230,7 +231,7 @@ void FluidSolver::momentum_sweep(double G_asm) {
       }
     BC_PETSC(VecRestoreArrayRead(sol_, &Au));
     BC_PETSC(VecRestoreArrayRead(bm_[cc], &bv));
-    BC_PETSC(VecRestoreArray(U_[cc], &u));
+    BC_PETSC(VecRestoreArray(flow_.U[cc], &u));
   }
   BC_PETSC(VecRestoreArrayRead(alphal_[0], &al));
   BC_PETSC(VecRestoreArrayRead(pcl_, &dp));
@@ -239,34 +240,34 @@ void FluidSolver::momentum_sweep(double G_asm) {
 void FluidSolver::solve_momentum(int cc, const StencilOperator& op, StepReport& rep) {
   jacobi_inv_diag_ = inv_diag_[cc];
   const Mat A = momentum_aij_ ? aij_copy(op, &A_) : op.mat();
-  BC_PETSC(KSPSetOperators(ksp_m_, A, A));
-  if (inexact_inner_solves() && !user_momentum_atol_) {
+  BC_PETSC(KSPSetOperators(solvers_.momentum, A, A));
+  if (inexact_inner_solves() && !solvers_.user_momentum_atol) {
     // 1e-2 of the initial residual, but never further than the 1e-8 of |b| of the exact solves:
     // at a fixed point the initial residual is round-off, which no solve can reduce 100x. The
     // floor is in the norm the test uses: BiCGStab's left-preconditioned one, |b / a_P| with the
     // Jacobi shell. The norm type is resolved by the first set-up and fixed from then on.
-    if (momentum_floor_jacobi_ < 0) {
+    if (solvers_.momentum_floor_jacobi < 0) {
       KSPNormType norm;
-      BC_PETSC(KSPSetUp(ksp_m_));
-      BC_PETSC(KSPGetNormType(ksp_m_, &norm));
-      momentum_floor_jacobi_ = norm == KSP_NORM_PRECONDITIONED && !momentum_aij_ ? 1 : 0;
+      BC_PETSC(KSPSetUp(solvers_.momentum));
+      BC_PETSC(KSPGetNormType(solvers_.momentum, &norm));
+      solvers_.momentum_floor_jacobi = norm == KSP_NORM_PRECONDITIONED && !momentum_aij_ ? 1 : 0;
     }
-    if (momentum_floor_jacobi_ == 1)
+    if (solvers_.momentum_floor_jacobi == 1)
       BC_PETSC(VecPointwiseMult(sol_, rhs_, inv_diag_[cc]));
     else
       BC_PETSC(VecCopy(rhs_, sol_));
     PetscReal bnorm;
     BC_PETSC(VecNorm(sol_, NORM_2, &bnorm));
-    set_abs_tol(ksp_m_, 1e-8 * bnorm);
+    set_abs_tol(solvers_.momentum, 1e-8 * bnorm);
   }
-  BC_PETSC(VecCopy(U_[cc], sol_));
-  BC_PETSC(KSPSolve(ksp_m_, rhs_, sol_));
+  BC_PETSC(VecCopy(flow_.U[cc], sol_));
+  BC_PETSC(KSPSolve(solvers_.momentum, rhs_, sol_));
   KSPConvergedReason reason;
-  BC_PETSC(KSPGetConvergedReason(ksp_m_, &reason));
+  BC_PETSC(KSPGetConvergedReason(solvers_.momentum, &reason));
   if (reason < 0)
     throw PhysicsError(fmt::format("momentum solve (component {}) diverged: reason {}", cc, (int)reason));
   PetscInt its;
-  BC_PETSC(KSPGetIterationNumber(ksp_m_, &its));
+  BC_PETSC(KSPGetIterationNumber(solvers_.momentum, &its));
   rep.momentum_krylov_iterations += (int)its;
 }
 
@@ -282,8 +283,8 @@ StepReport FluidSolver::step(double dt) {
   StepReport rep;
   rep.dt_s = dt;
   double c[3];
-  bdf_weights(dt, steps_ > 0 ? dt_prev_ : 0.0, c);
-  for (int l = 0; l < 3; ++l) halo_->fill(alpha_[l], alphal_[l]);
+  bdf_weights(dt, flow_.steps > 0 ? flow_.dt_prev_s : 0.0, c);
+  for (int l = 0; l < 3; ++l) halo_->fill(flow_.alpha[l], alphal_[l]);
   compute_subgrid_viscosity();  // also refreshes nu_t's ghosts
   compute_effective_viscosity();
   update_flow_ghosts();
@@ -292,22 +293,22 @@ StepReport FluidSolver::step(double dt) {
   } else {
     step_simple(dt, c, rep);
   }
-  rep.mean_pressure_gradient_pa_m = G_;
+  rep.mean_pressure_gradient_pa_m = flow_.G_pa_m;
   // continuity defect of the accepted fields (for diagnostics and tests)
   last_c_[0] = c[0], last_c_[1] = c[1], last_c_[2] = c[2];
-  last_dt_ = dt;
-  last_defect_ = continuity_residual(dt, c[0], c[1], c[2], R_);
+  counters_.last_dt_s = dt;
+  counters_.last_defect = continuity_residual(dt, c[0], c[1], c[2], R_);
   // rotate time levels
   for (int cc = 0; cc < 3; ++cc) {
-    BC_PETSC(VecCopy(Un_[cc], Unm1_[cc]));
-    BC_PETSC(VecCopy(U_[cc], Un_[cc]));
+    BC_PETSC(VecCopy(flow_.Un[cc], flow_.Unm1[cc]));
+    BC_PETSC(VecCopy(flow_.U[cc], flow_.Un[cc]));
   }
-  BC_PETSC(VecCopy(alpha_[1], alpha_[2]));
-  BC_PETSC(VecCopy(alpha_[0], alpha_[1]));
-  for (int l = 1; l < 3; ++l) halo_->fill(alpha_[l], alphal_[l]);
-  time_ += dt;
-  dt_prev_ = dt;
-  ++steps_;
+  BC_PETSC(VecCopy(flow_.alpha[1], flow_.alpha[2]));
+  BC_PETSC(VecCopy(flow_.alpha[0], flow_.alpha[1]));
+  for (int l = 1; l < 3; ++l) halo_->fill(flow_.alpha[l], alphal_[l]);
+  flow_.time_s += dt;
+  flow_.dt_prev_s = dt;
+  ++flow_.steps;
   return rep;
 }
 

@@ -19,8 +19,8 @@ namespace boycott::fluid {
 void FluidSolver::compute_subgrid_viscosity() {
   const LogScope log_scope(fluid_events().subgrid);
   if (!s_.vreman) {
-    BC_PETSC(VecZeroEntries(nut_));
-    halo_->fill(nut_, nutl_);
+    BC_PETSC(VecZeroEntries(flow_.nut));
+    halo_->fill(flow_.nut, nutl_);
     return;
   }
   const auto& g = s_.grid;
@@ -35,7 +35,7 @@ void FluidSolver::compute_subgrid_viscosity() {
   const double* u[3];
   double* nt;
   for (int c = 0; c < 3; ++c) BC_PETSC(VecGetArrayRead(Ul_[c], &u[c]));
-  BC_PETSC(VecGetArray(nut_, &nt));
+  BC_PETSC(VecGetArray(flow_.nut, &nt));
   const int nx = (int)b.size[0];
   row_buffers_.assign(static_cast<std::size_t>(9) * nx, 0.0);
   double* G[3][3];  // G[i][j] = d u_j / d x_i over the row
@@ -104,8 +104,8 @@ void FluidSolver::compute_subgrid_viscosity() {
       }
     }
   for (int c = 0; c < 3; ++c) BC_PETSC(VecRestoreArrayRead(Ul_[c], &u[c]));
-  BC_PETSC(VecRestoreArray(nut_, &nt));
-  halo_->fill(nut_, nutl_);
+  BC_PETSC(VecRestoreArray(flow_.nut, &nt));
+  halo_->fill(flow_.nut, nutl_);
 }
 
 }  // namespace boycott::fluid
