@@ -45,7 +45,12 @@ std::string shell_quote(const std::string& s) {
 
 std::string words_quoted(const std::vector<std::string>& words) {
   std::string s;
-  for (const auto& w : words) s += (s.empty() ? "" : " ") + shell_quote(w);
+  // Appended in two steps: GCC 12 warns (-Wrestrict, a false positive) about the inlined
+  // const char* + std::string&& it would otherwise build.
+  for (const auto& w : words) {
+    if (!s.empty()) s += ' ';
+    s += shell_quote(w);
+  }
   return s;
 }
 
