@@ -142,14 +142,18 @@ std::string TextTable::str() const {
   return s;
 }
 
+std::string csv_line(const std::vector<std::string>& cells) {
+  std::string s;
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    if (c) s += ',';
+    s += csv_field(cells[c]);
+  }
+  return s + "\n";
+}
+
 std::string TextTable::csv() const {
-  auto line = [](const std::vector<std::string>& cells) {
-    std::string s;
-    for (std::size_t c = 0; c < cells.size(); ++c) s += (c ? "," : "") + csv_field(cells[c]);
-    return s + "\n";
-  };
-  std::string s = line(header_);
-  for (const auto& r : rows_) s += line(r);
+  std::string s = csv_line(header_);
+  for (const auto& r : rows_) s += csv_line(r);
   return s;
 }
 

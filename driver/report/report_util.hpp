@@ -21,6 +21,8 @@ const char* color(std::size_t i);
 const char* marker_kind(std::size_t i);
 /// A CSV field, quoted when it holds a comma, quote or line break (e.g. domain.cells=[200, 6, 100]).
 std::string csv_field(const std::string& s);
+/// One CSV line of the cells (each through csv_field), ending in a newline.
+std::string csv_line(const std::vector<std::string>& cells);
 
 /// "key=value; key=value" of swept values, "-" when there are none.
 std::string join_values(const std::vector<SweptValue>& v);

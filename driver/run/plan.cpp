@@ -141,15 +141,14 @@ std::string plan_csv(const nlohmann::json& rows) {
   for (const char* c : cols) out += fmt::format("{}{}", out.empty() ? "" : ",", c);
   out += "\n";
   for (const auto& r : rows) {
-    std::string line;
+    std::vector<std::string> cells;
     for (const char* c : cols) {
       const auto v = r.value(c, nlohmann::json());
-      const std::string cell = v.is_string() ? v.get<std::string>()
-                               : v.is_null() ? ""
-                                             : fmt::format("{:.6g}", v.get<double>());
-      line += (c == cols[0] ? "" : ",") + report::csv_field(cell);
+      cells.push_back(v.is_string() ? v.get<std::string>()
+                      : v.is_null() ? ""
+                                    : fmt::format("{:.6g}", v.get<double>()));
     }
-    out += line + "\n";
+    out += report::csv_line(cells);
   }
   return out;
 }

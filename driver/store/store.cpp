@@ -322,8 +322,7 @@ std::map<std::string, int> adaptive_stage_one(Database& db, const std::string& s
   st.bind(1, study);
   if (!st.step()) return out;
   try {
-    const Study s = expand_study_string(st.text(0), study);
-    for (const auto& [grp, plan] : s.replica_plans)
+    for (const auto& [grp, plan] : study_replica_plans(st.text(0), study))
       if (plan.target_rel_error) out[grp] = plan.replicas;
   } catch (const std::exception&) {
   }

@@ -410,16 +410,19 @@ Study expand_study(const toml::table& root, const std::string& text, const std::
   return s;
 }
 
-}  // namespace
-
-Study expand_study_string(const std::string& text, const std::string& origin) {
-  toml::table root;
+toml::table parse_study(const std::string& text, const std::string& origin) {
   try {
-    root = toml::parse(text, origin);
+    return toml::parse(text, origin);
   } catch (const toml::parse_error& e) {
     throw InputError(fmt::format("{}:{}:{}: malformed TOML: {}", origin, e.source().begin.line,
                                  e.source().begin.column, e.description()));
   }
+}
+
+}  // namespace
+
+Study expand_study_string(const std::string& text, const std::string& origin) {
+  const toml::table root = parse_study(text, origin);
   std::optional<std::size_t> at_group;
   try {
     return expand_study(root, text, origin, at_group);
@@ -450,6 +453,16 @@ std::string readable_value(const std::string& toml_text) {
   if (end != toml_text.c_str() && *end == '\0' && toml_text.find_first_of(".eE") != std::string::npos)
     return fmt::format("{}", d);
   return toml_text;
+}
+
+std::map<std::string, ReplicaPlan> study_replica_plans(const std::string& text, const std::string& origin) {
+  const toml::table root = parse_study(text, origin);
+  const ReplicaKeys study_replicas = read_replica_keys(root, origin);
+  std::optional<std::size_t> at_group;
+  std::map<std::string, ReplicaPlan> plans;
+  for (const auto& g : read_groups(root, origin, at_group))
+    plans[g.name] = resolve_replicas(study_replicas, g.replicas, fmt::format("group '{}'", g.name));
+  return plans;
 }
 
 Study expand_study_file(const std::string& path) {

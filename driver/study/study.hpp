@@ -52,6 +52,10 @@ StudyCase replica_of(const StudyCase& replica0, int k);
 /// lengths, two cases with one id) is an InputError naming the key.
 Study expand_study_string(const std::string& toml_text, const std::string& origin = "<string>");
 Study expand_study_file(const std::string& path);
+/// The replica plan of each group of a study, read without expanding (or checking) its cases:
+/// for readers of a stored study that need only the plans.
+std::map<std::string, ReplicaPlan> study_replica_plans(const std::string& toml_text,
+                                                       const std::string& origin = "<string>");
 
 /// The file a study gives its solver in each run folder: the case as data, its canonical JSON
 /// (`boycott case run FILE.runs/<id>/case.json` reads it back to the same id, unchanged).
