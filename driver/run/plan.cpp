@@ -1,5 +1,6 @@
 #include "driver/run/plan.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include "driver/report/listing_format.hpp"
 #include "driver/report/report_util.hpp"
 #include "driver/run/progress.hpp"
+#include "driver/run/run_tree.hpp"
 #include "driver/store/store.hpp"
 #include "driver/study/cost_model.hpp"
 
@@ -40,8 +42,16 @@ std::vector<MeasuredCost> measured(Database& db) {
   return out;
 }
 
-CaseWork work_of(const StudyCase& c) {
-  return case_work(to_json(c.params), 0.0, c.params.time.end_s);
+CaseWork work_of(const StudyCase& c, double from_s = 0.0) {
+  return case_work(to_json(c.params), from_s, c.params.time.end_s);
+}
+
+/// The simulated time a case's run folder has reached (its time series' last row), s; 0 where
+/// it has none. An interrupted case resumes from its last checkpoint, at most an output
+/// interval or a checkpoint interval before this.
+double reached_s(const fs::path& runs_root, const StudyCase& c) {
+  if (runs_root.empty()) return 0.0;
+  return std::clamp(simulated_time_s(runs_root / c.id), 0.0, c.params.time.end_s);
 }
 
 std::string swept_text(const StudyCase& c) {
@@ -53,7 +63,7 @@ std::string swept_text(const StudyCase& c) {
 }  // namespace
 
 PlanEstimate plan_estimate(Database& db, const Study& study, const std::vector<std::string>& to_run_ids,
-                           int jobs, int ranks) {
+                           int jobs, int ranks, const fs::path& runs_root) {
   const CostModel model(measured(db));
   std::map<std::string, const StudyCase*> by_id;
   for (const auto& c : study.cases) by_id[c.id] = &c;
@@ -61,7 +71,7 @@ PlanEstimate plan_estimate(Database& db, const Study& study, const std::vector<s
   std::map<std::string, bool> scenes;
   for (const auto& id : to_run_ids)
     if (const auto it = by_id.find(id); it != by_id.end()) {
-      costs.push_back(model.core_s(work_of(*it->second)));
+      costs.push_back(model.core_s(work_of(*it->second, reached_s(runs_root, *it->second))));
       scenes[it->second->params.scene] = true;
     }
   std::string basis;
@@ -101,14 +111,15 @@ PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<st
     const CaseStatus st = it == states.end() ? CaseStatus::kPending : it->second.status;
     const double est = model.core_s(work_of(c));
     out.total_core_s += est;
-    if (st != CaseStatus::kDone) out.pending_costs.push_back(est);
-    nlohmann::json row = {{"group", c.group},
-                          {"swept", swept_text(c)},
-                          {"case_id", c.id},
-                          {"state", to_string(st)},
-                          {"estimated_core_s", est},
-                          {"scene", c.params.scene},
-                          {"cost_basis", model.basis(c.params.scene)}};
+    // A case that has run part of its time needs only the rest.
+    const double reached =
+        st == CaseStatus::kDone || opt.db_path.empty() ? 0.0 : reached_s(fs::path(runs_root(opt.db_path)), c);
+    const double left = st == CaseStatus::kDone ? 0.0 : model.core_s(work_of(c, reached));
+    if (st != CaseStatus::kDone) out.pending_costs.push_back(left);
+    nlohmann::json row = {
+        {"group", c.group},         {"swept", swept_text(c)},  {"case_id", c.id},
+        {"state", to_string(st)},   {"estimated_core_s", est}, {"reached_s", reached},
+        {"remaining_core_s", left}, {"scene", c.params.scene}, {"cost_basis", model.basis(c.params.scene)}};
     const auto m = measured_by_id.find(c.id);
     if (m != measured_by_id.end()) row["measured_core_s"] = m->second->core_s;
     if (opt.check_model && m != measured_by_id.end()) {
@@ -118,7 +129,10 @@ PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<st
         if (f.case_id != c.id) others.push_back(f);
       row["predicted_by_others_core_s"] = CostModel(others).core_s(m->second->work);
     }
-    std::vector<std::string> cells{c.group, swept_text(c), c.id, to_string(st), duration(est)};
+    std::vector<std::string> cells{
+        c.group, swept_text(c), c.id, to_string(st),
+        reached > 0.0 ? fmt::format("{} ({} left from t = {:g} s)", duration(est), duration(left), reached)
+                      : duration(est)};
     if (opt.check_model)
       cells.push_back(row.contains("predicted_by_others_core_s")
                           ? fmt::format("measured {}, from the others {}", duration(m->second->core_s),
@@ -135,6 +149,7 @@ std::string plan_csv(const nlohmann::json& rows) {
   const char* cols[] = {"group",           "swept",
                         "case_id",         "state",
                         "scene",           "estimated_core_s",
+                        "reached_s",       "remaining_core_s",
                         "measured_core_s", "predicted_by_others_core_s",
                         "cost_basis"};
   std::string out;
@@ -161,7 +176,7 @@ std::string plan_per_group(const Study& study, const nlohmann::json& rows) {
     g[0] += 1;
     if (rows[i]["state"] != "done") {
       g[1] += 1;
-      g[2] += rows[i]["estimated_core_s"].get<double>();
+      g[2] += rows[i]["remaining_core_s"].get<double>();
     }
   }
   report::TextTable per_group({"group", "cases", "to run", "core time to run"}, {false, true, true, true});

@@ -2,6 +2,7 @@
 // `boycott study plan`: the cases of a study, their state and their estimated cost, and the
 // study's wall time on J jobs of N ranks, from the cost model calibrated on the database's
 // finished runs (cost_model.hpp). Runs nothing; reads the database only if it exists.
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -31,7 +32,9 @@ struct PlanEstimate {
   std::string line;
   double mean_case_wall_s = 0.0;
 };
+/// A case with a run folder under `runs_root` that has reached some time counts only the work
+/// from there to its end.
 PlanEstimate plan_estimate(Database& db, const Study& study, const std::vector<std::string>& to_run_ids,
-                           int jobs, int ranks);
+                           int jobs, int ranks, const std::filesystem::path& runs_root);
 
 }  // namespace boycott::driver

@@ -62,7 +62,7 @@ int study_run(const StudyRunOptions& opt) {
   std::vector<std::string> to_run;
   for (const auto& s : states)
     if (s.status != CaseStatus::kDone && s.status != CaseStatus::kFailed) to_run.push_back(s.id);
-  const PlanEstimate plan = plan_estimate(db, study, to_run, opt.jobs, opt.ranks);
+  const PlanEstimate plan = plan_estimate(db, study, to_run, opt.jobs, opt.ranks, root);
   if (!to_run.empty()) std::fprintf(stderr, "%s\n", plan.line.c_str());
   Scheduler scheduler(db, study, states, opt, root, solver);
   scheduler.set_planned_case_wall_s(plan.mean_case_wall_s);

@@ -2,7 +2,8 @@
 # `study plan`: before any run it lists the cases as pending and creates no database; after the
 # study ran, each finished case's cost (its CPU time) predicted by the model fitted to the other
 # five (leave one out) is within 30 % of its measured cost in at least one of two identical
-# studies; swept numbers are shown as written; bad --jobs exits 2; `study run` prints
+# studies; a case that has run part of its time counts only the rest; swept numbers are shown as
+# written; bad --jobs exits 2; `study run` prints
 # the plan line before it starts and writes the tree of readable names beside the run folders.
 #   plan_study.sh BOYCOTT_BIN STUDY.toml
 set -euo pipefail
@@ -16,6 +17,33 @@ grep -q 'cost model inclined_settling: default' "$work/plan0.txt" || { cat "$wor
 [ ! -e "$db" ] || { echo "study plan created a database"; exit 1; }
 # Swept numbers as written, not as their binary expansion (0.029999999999999999).
 grep -q 'particles.volume_fraction=0.03 ' "$work/plan0.txt" || { cat "$work/plan0.txt"; exit 1; }
+# A case whose run folder has reached part of its time counts only the rest (the model's work
+# from there to the end: the start-up plus stepping linear in the time left).
+"$bin" study plan "$study" --db "$db" --format json > "$work/plan_fresh.json"
+first=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["cases"][0]["case_id"])' "$work/plan_fresh.json")
+mkdir -p "$db.runs/$first"
+printf 't_s,mean_w_p_m_s\n0.1,-0.01\n0.15,-0.01\n' > "$db.runs/$first/timeseries.csv"
+"$bin" study plan "$study" --db "$db" --format json > "$work/plan_half.json"
+printf '0.225,-0.01\n' >> "$db.runs/$first/timeseries.csv"
+"$bin" study plan "$study" --db "$db" --format json > "$work/plan_part.json"
+"$bin" study plan "$study" --db "$db" > "$work/plan_part.txt"
+python3 - "$work/plan_fresh.json" "$work/plan_half.json" "$work/plan_part.json" <<'PY'
+import json, sys
+fresh, half, part = (json.load(open(f)) for f in sys.argv[1:])
+c, h = part["cases"][0], half["cases"][0]
+assert fresh["cases"][0]["reached_s"] == 0 and h["reached_s"] == 0.15 and c["reached_s"] == 0.225, (fresh, h, c)
+est = c["estimated_core_s"]
+assert est > h["remaining_core_s"] > c["remaining_core_s"] > 0, (h, c)
+# time.end = 0.3 s: from 0.15 s half the stepping is left, from 0.225 s a quarter (the start-up
+# is paid again either way), so the first half costs twice the next quarter.
+ratio = (est - h["remaining_core_s"]) / (h["remaining_core_s"] - c["remaining_core_s"])
+assert abs(ratio - 2.0) < 1e-6, ratio
+assert part["estimated_wall_s"] < fresh["estimated_wall_s"], (part["estimated_wall_s"], fresh["estimated_wall_s"])
+for a, b in zip(fresh["cases"][1:], part["cases"][1:]):
+    assert a["remaining_core_s"] == b["remaining_core_s"] == a["estimated_core_s"], (a, b)
+PY
+grep -q 'left from t = 0.225 s' "$work/plan_part.txt" || { cat "$work/plan_part.txt"; exit 1; }
+rm -rf "$db.runs"
 if "$bin" study plan "$study" --jobs 0 > /dev/null 2>&1; then echo "--jobs 0 accepted"; exit 1; else rc=$?; fi
 [ "$rc" -eq 2 ] || { echo "--jobs 0 exited $rc, not 2"; exit 1; }
 # One case at a time, so that the measured costs are not two runs sharing the cores; a tiny run
