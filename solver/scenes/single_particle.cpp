@@ -66,6 +66,16 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   while (!reached_end(run.time_s(), end)) {
     const coupling::CoupledStep st = run.step();
     const double t = run.time_s();
+    // A stop inside the step dropped it: nothing new to record.
+    if (st.interrupted || ctx.should_stop()) {
+      sb.status = kStatusInterrupted;
+      exit_code = kExitInterrupted;
+      if (output_rank())
+        std::fprintf(stderr,
+                     "interrupted at t = %g s; single_particle writes no checkpoint, a rerun starts over\n",
+                     t);
+      break;
+    }
     const double vx = particle(s.vx), vy = particle(s.vy), vz = particle(s.vz);
     if (run.steps() == 1) acc0 = vz / st.dt_s;
     if (t > p.time.average_from.time_s + 1e-12) wp_avg.add(vz);
@@ -74,15 +84,6 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
     csv.row({t, vz, vx, vy, run.mean_fluid_velocity_z(), run.slurry_velocity_z(),
              run.fluid().mean_pressure_gradient_pa_m(), slip * d / nu});
     if (ctx.progress) ctx.progress(t);
-    if (ctx.should_stop()) {
-      sb.status = kStatusInterrupted;
-      exit_code = kExitFailure;
-      if (output_rank())
-        std::fprintf(stderr,
-                     "interrupted at t = %g s; single_particle writes no checkpoint, a rerun starts over\n",
-                     t);
-      break;
-    }
   }
   csv.flush();
   run.report_timers(timers);
