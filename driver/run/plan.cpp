@@ -106,14 +106,14 @@ PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<st
   if (opt.check_model) header.emplace_back("leave one out");
   PlanRows out{
       nlohmann::json::array(), report::TextTable(header, {false, false, false, false, true, false}), {}, 0.0};
+  const fs::path root = opt.db_path.empty() ? fs::path() : fs::path(runs_root(opt.db_path));
   for (const auto& c : study.cases) {
     const auto it = states.find(c.id);
     const CaseStatus st = it == states.end() ? CaseStatus::kPending : it->second.status;
     const double est = model.core_s(work_of(c));
     out.total_core_s += est;
     // A case that has run part of its time needs only the rest.
-    const double reached =
-        st == CaseStatus::kDone || opt.db_path.empty() ? 0.0 : reached_s(fs::path(runs_root(opt.db_path)), c);
+    const double reached = st == CaseStatus::kDone ? 0.0 : reached_s(root, c);
     const double left = st == CaseStatus::kDone ? 0.0 : model.core_s(work_of(c, reached));
     if (st != CaseStatus::kDone) out.pending_costs.push_back(left);
     nlohmann::json row = {

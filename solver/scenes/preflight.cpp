@@ -43,7 +43,8 @@ double collision_time_s(double mass_kg, double stiffness_n_m, double restitution
   return kPi / (w0 * std::sqrt(std::max(1.0 - zeta * zeta, 1e-300)));
 }
 
-double machine_memory_bytes() {
+namespace {
+double read_machine_memory_bytes() {
   double bytes = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
   // A container's limit (cgroup v2), where there is one.
   std::ifstream in("/sys/fs/cgroup/memory.max");
@@ -55,10 +56,17 @@ double machine_memory_bytes() {
   }
   return bytes;
 }
+}  // namespace
+
+double machine_memory_bytes() {
+  // Read once: a study checks every case, and the machine does not change under it.
+  static const double bytes = read_machine_memory_bytes();
+  return bytes;
+}
 
 double memory_estimate_bytes(const CaseParams& p, int ranks) {
   // Per particle: ~40 arrays of the store, predicted velocities and reference positions (~0.4
-  // kB), and ~20 list pairs of ~110 B (indices, shear history, the per-contact force arrays).
+  // kB), and ~20 list pairs of ~110 B (indices and flags; the contacts' springs and force arrays).
   // Per cell: ~110 fluid and coupling arrays and ~60 Krylov work vectors of 8 B. Rank 0 also
   // holds the gathered checkpoint twice while writing it (~0.45 kB per particle, ~0.2 per cell).
   constexpr double kPerParticle = 2600.0, kPerCell = 1400.0, kCheckpointParticle = 900.0,
