@@ -47,13 +47,15 @@ std::vector<SceneSpec> make_specs() {
        {{"gravity.angle_deg", "0.0"}, {"domain.top_wall", "\"slip\""}, {"particles.insertion", "\"bed\""}},
        true,
        a3});
-  s.push_back({"single_particle",
-               "terminal velocity of one sphere against the drag law's",
-               {"fluid.", "particles.diameter", "particles.density", "contact.", "domain.", "gravity.",
-                "time.dt_cfd", "time.dt_dem", "time.end", "time.average_from", "forces.", "numerics."},
-               {},
-               false,
-               0.0});
+  s.push_back(
+      {"single_particle",
+       "terminal velocity of one sphere against the drag law's",
+       {"fluid.", "particles.diameter", "particles.density", "contact.", "domain.", "gravity.", "time.dt_cfd",
+        "time.dt_dem", "time.end", "time.average_from", "time.checkpoint_every", "forces.", "numerics.",
+        "output.timeseries_every", "output.keep_checkpoints", "output.snapshot_times", "output.image_times"},
+       {},
+       false,
+       0.0});
   s.push_back({"ergun",
                "f* against Re*_p through a packed, frozen bed, beside the Ergun equation",
                {"seed", "fluid.", "particles.", "contact.", "domain.", "time.dt_cfd", "time.dt_dem",

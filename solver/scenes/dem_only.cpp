@@ -96,9 +96,10 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
       if (ctx.progress) ctx.progress(dem.time_s());
     }
     if (ctx.should_stop()) {
-      // No checkpoint is written by this scene yet: say so instead of claiming a resumable stop.
+      // Exit 75 as every scene's stop (a study runs it again, not counting a failure), but no
+      // checkpoint is written by this scene yet: say so instead of claiming a resumable stop.
       sb.status = kStatusInterrupted;
-      exit_code = kExitFailure;
+      exit_code = kExitInterrupted;
       std::fprintf(stderr,
                    "interrupted at t = %g s; dem_only writes no checkpoint yet, a rerun starts over\n",
                    dem.time_s());

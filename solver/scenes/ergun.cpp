@@ -75,7 +75,8 @@ int run_ergun(const CaseParams& p, RunContext& ctx) {
     const int steps = run_to_steady(run, 1e-7, 20, 20000, ctx);
     if (steps < 0) {
       sb.status = kStatusInterrupted;
-      exit_code = kExitFailure;
+      // Exit 75 as every scene's stop, not a failure a study would count against its retries.
+      exit_code = kExitInterrupted;
       std::fprintf(stderr, "interrupted; ergun writes no checkpoint, a rerun starts over\n");
       break;
     }

@@ -9,6 +9,10 @@
 // on cells only a few diameters wide that biases the slip velocity. This scene does not correct
 // for it: keep cells several diameters wide (the summary reports dx/d and the test shows how the
 // error falls as dx/d grows).
+//
+// It runs the coupled scenes' time loop (scenes/coupled_output.hpp): rows every
+// output.timeseries_every (every step when unset), checkpoints, pictures, and a stop that
+// checkpoints and resumes.
 #include <cmath>
 #include <cstdio>
 
@@ -20,6 +24,10 @@
 #include "core/statistics.hpp"
 #include "coupling/coupled_system.hpp"
 #include "coupling/drag_laws.hpp"
+#include "io/checkpoint_file.hpp"
+#include "io/state_io.hpp"
+#include "scenes/coupled_checkpoint.hpp"
+#include "scenes/coupled_output.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scenes_list.hpp"
 
@@ -29,12 +37,29 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   WallClock clock;
   ModelTimers timers;
   coupling::CoupledSystem run(p, coupling::CoupledOptions{true, true});
-  const auto& box = run.dem().config().box;
-  run.dem().add_particle(0, box.lo[0] + 0.5 * box.len[0], box.lo[1] + 0.5 * box.len[1],
-                         box.lo[2] + 0.5 * box.len[2], 0.5 * p.particles.diameter_m,
-                         p.particles.density_kg_m3);
-  run.start();
+  const auto& s = run.dem().particles();
+  BatchMeans wp_avg;
+  double acc0 = kUnset, next_out = 0.0, wall_before = 0.0;  // next_out: the resumed output's, s
+
+  const auto resumed = resume_coupled(
+      run, ctx.out_dir, ctx.quiet,
+      [&](const io::CheckpointReader& r) {
+        io::load(r, "stats.wp.", wp_avg);
+        acc0 = r.scalar("stats.initial_acceleration");
+        next_out = r.scalar("stats.next_out");
+      },
+      ctx.branch_checkpoint);
+  if (resumed) {
+    wall_before = *resumed;
+  } else {
+    const auto& box = run.dem().config().box;
+    run.dem().add_particle(0, box.lo[0] + 0.5 * box.len[0], box.lo[1] + 0.5 * box.len[1],
+                           box.lo[2] + 0.5 * box.len[2], 0.5 * p.particles.diameter_m,
+                           p.particles.density_kg_m3);
+    run.start();
+  }
   run.activate_models(timers);
+  run.set_interrupt([&ctx] { return ctx.should_stop(); });
 
   // Without drag there is no terminal velocity (the reference is then left unset).
   const double vt =
@@ -49,48 +74,49 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   const double rp = p.particles.density_kg_m3, rf = p.fluid.density_kg_m3;
   const double cam = p.forces.added_mass ? 0.5 : 0.0;
   const double acc_ref = (p.forces.pressure_gradient ? (rp - rf) : rp) * g[2] / (rp + cam * rf);
-
-  CsvWriter csv(ctx.out_dir / "timeseries.csv",
-                {"time_s", "wp_m_s", "up_m_s", "vp_m_s", "mean_wf_m_s", "slurry_velocity_m_s",
-                 "driving_gradient_pa_m", "reynolds_number"},
-                false);
-  const auto& s = run.dem().particles();
-  // The particle lives on one rank: its values as every rank sees them.
-  const auto particle = [&](const std::vector<double>& a) { return run.global_sum(s.n_local ? a[0] : 0.0); };
-  BatchMeans wp_avg;
-  double acc0 = kUnset;
-  int exit_code = kExitOk;
-  SummaryBase sb;
-  const double end = p.time.end_s;
   const double d = p.particles.diameter_m, nu = p.fluid.viscosity_pa_s / rf;
-  while (!reached_end(run.time_s(), end)) {
-    const coupling::CoupledStep st = run.step();
+
+  CoupledSceneOutput out(run, ctx, timers,
+                         {"time_s", "wp_m_s", "up_m_s", "vp_m_s", "mean_wf_m_s", "slurry_velocity_m_s",
+                          "driving_gradient_pa_m", "reynolds_number"},
+                         resumed.has_value(), next_out);
+  auto write_checkpoint = [&] {
+    ModelTimers::Scope sc(timers, "checkpoints");
+    checkpoint_coupled(run, ctx.out_dir, wall_before + clock.seconds(), [&](io::CheckpointWriter& w) {
+      io::save(w, "stats.wp.", wp_avg);
+      w.put("stats.initial_acceleration", acc0);
+      w.put("stats.next_out", out.next_out_s());
+    });
+  };
+  // The particle lives on one rank: its values as every rank sees them (collective).
+  const auto particle = [&](const std::vector<double>& a) { return run.global_sum(s.n_local ? a[0] : 0.0); };
+  const auto measure = [&](const coupling::CoupledStep& st, bool&) {
     const double t = run.time_s();
-    // A stop inside the step dropped it: nothing new to record.
-    if (st.interrupted || ctx.should_stop()) {
-      sb.status = kStatusInterrupted;
-      exit_code = kExitInterrupted;
-      if (output_rank())
-        std::fprintf(stderr,
-                     "interrupted at t = %g s; single_particle writes no checkpoint, a rerun starts over\n",
-                     t);
-      break;
-    }
     const double vx = particle(s.vx), vy = particle(s.vy), vz = particle(s.vz);
     if (run.steps() == 1) acc0 = vz / st.dt_s;
     if (t > p.time.average_from.time_s + 1e-12) wp_avg.add(vz);
     const double slip = std::sqrt(std::pow(vx - particle(s.ufx), 2) + std::pow(vy - particle(s.ufy), 2) +
                                   std::pow(vz - particle(s.ufz), 2));
-    csv.row({t, vz, vx, vy, run.mean_fluid_velocity_z(), run.slurry_velocity_z(),
-             run.fluid().mean_pressure_gradient_pa_m(), slip * d / nu});
-    if (ctx.progress) ctx.progress(t);
-  }
-  csv.flush();
+    return [&run, t, vx, vy, vz, re = slip * d / nu]() -> std::vector<double> {
+      return {t,
+              vz,
+              vx,
+              vy,
+              run.mean_fluid_velocity_z(),
+              run.slurry_velocity_z(),
+              run.fluid().mean_pressure_gradient_pa_m(),
+              re};
+    };
+  };
+  SummaryBase sb;
+  const int exit_code = run_coupled_steps(
+      run, out, [] {}, measure, write_checkpoint, sb);
+  out.flush();
   run.report_timers(timers);
 
   const double wt = wp_avg.count() ? wp_avg.mean() : particle(s.vz);
   sb.simulated_time_s = run.time_s();
-  sb.wall_time_s = clock.seconds();
+  sb.wall_time_s = wall_before + clock.seconds();
   sb.particle_steps = static_cast<double>(run.dem().steps());
   sb.mean_settling_velocity_m_s = wt;
   sb.settling_velocity_stderr_m_s = wp_avg.stderr_of_mean();
@@ -105,6 +131,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   j["initial_acceleration_reference_z_m_s2"] = acc_ref;
   j["response_time_s"] = rp * d * d / (18.0 * p.fluid.viscosity_pa_s);
   j["dt_dem_over_response_time"] = p.time.dt_dem_s / (rp * d * d / (18.0 * p.fluid.viscosity_pa_s));
+  j["resumed_from_checkpoint"] = resumed.has_value();
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   return exit_code;
 }
