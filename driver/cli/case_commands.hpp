@@ -1,4 +1,6 @@
 #pragma once
+// The `boycott case` subcommands (run, check, summarize, keys), each one case in this process:
+// what case_cli.cpp calls once the command line is parsed.
 #include <string>
 #include <vector>
 
@@ -23,8 +25,7 @@ int case_check(const std::string& file, const std::vector<std::string>& sets);
 /// (scenes/summarize.hpp); summary.json rewritten (the previous kept as summary.previous.json) and,
 /// with `db`, the run's result row updated. Exit 2 naming the folder when one cannot be.
 int case_summarize(const std::vector<std::string>& run_dirs, const std::string& db);
-/// `boycott case keys`: every key with its default.
-/// The case keys with their defaults: every key, or those `scene` reads at its defaults.
+/// `boycott case keys`: every key with its default, or those `scene` reads at its defaults.
 int case_keys(const std::string& scene, const std::string& format = "table");
 
 }  // namespace boycott::driver
