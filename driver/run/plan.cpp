@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "core/scene_specs.hpp"
 #include "driver/report/listing_format.hpp"
 #include "driver/report/report_util.hpp"
 #include "driver/run/progress.hpp"
@@ -47,10 +48,11 @@ CaseWork work_of(const StudyCase& c, double from_s = 0.0) {
 }
 
 /// The simulated time a case's run folder has reached (its time series' last row), s; 0 where
-/// it has none. An interrupted case resumes from its last checkpoint, at most an output
-/// interval or a checkpoint interval before this.
+/// it has none, and for a scene that keeps no checkpoints (it does not read
+/// time.checkpoint_every), whose rerun starts over. An interrupted case resumes from its last
+/// checkpoint, at most an output interval or a checkpoint interval before this.
 double reached_s(const fs::path& runs_root, const StudyCase& c) {
-  if (runs_root.empty()) return 0.0;
+  if (runs_root.empty() || !scene_reads(scene_spec(c.params.scene), "time.checkpoint_every")) return 0.0;
   return std::clamp(simulated_time_s(runs_root / c.id), 0.0, c.params.time.end_s);
 }
 

@@ -2,7 +2,8 @@
 # `study plan`: before any run it lists the cases as pending and creates no database; after the
 # study ran, each finished case's cost (its CPU time) predicted by the model fitted to the other
 # five (leave one out) is within 30 % of its measured cost in at least one of two identical
-# studies; a case that has run part of its time counts only the rest; swept numbers are shown as
+# studies; a case that has run part of its time counts only the rest (all of it in a scene that
+# keeps no checkpoints: its rerun starts over); swept numbers are shown as
 # written; bad --jobs exits 2; `study run` prints
 # the plan line before it starts and writes the tree of readable names beside the run folders.
 #   plan_study.sh BOYCOTT_BIN STUDY.toml
@@ -44,6 +45,19 @@ for a, b in zip(fresh["cases"][1:], part["cases"][1:]):
 PY
 grep -q 'left from t = 0.225 s' "$work/plan_part.txt" || { cat "$work/plan_part.txt"; exit 1; }
 rm -rf "$db.runs"
+# A scene that keeps no checkpoints (dem_only) starts over: its time series does not count.
+printf 'name = "plan_restart"\n[base]\nscene = "dem_only"\n[base.domain]\nlength_x = 0.01\nheight_z = 0.01\n[base.time]\nend = 0.3\naverage_from = 0.05\n' \
+  > "$work/dem_study.toml"
+"$bin" study plan "$work/dem_study.toml" --db "$work/dem.db" --format json > "$work/dem_fresh.json"
+dem=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["cases"][0]["case_id"])' "$work/dem_fresh.json")
+mkdir -p "$work/dem.db.runs/$dem"
+printf 'time_s,mean_up_m_s\n0.15,-0.01\n' > "$work/dem.db.runs/$dem/timeseries.csv"
+"$bin" study plan "$work/dem_study.toml" --db "$work/dem.db" --format json > "$work/dem_part.json"
+python3 - "$work/dem_fresh.json" "$work/dem_part.json" <<'PY'
+import json, sys
+fresh, part = (json.load(open(f))["cases"][0] for f in sys.argv[1:])
+assert part["reached_s"] == 0 and part["remaining_core_s"] == fresh["estimated_core_s"] > 0, (fresh, part)
+PY
 if "$bin" study plan "$study" --jobs 0 > /dev/null 2>&1; then echo "--jobs 0 accepted"; exit 1; else rc=$?; fi
 [ "$rc" -eq 2 ] || { echo "--jobs 0 exited $rc, not 2"; exit 1; }
 # One case at a time, so that the measured costs are not two runs sharing the cores; a tiny run
