@@ -16,7 +16,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.footer(
       "Exit codes: 0 done; 2 bad input or usage; 3 unphysical state; 4 unusable checkpoint or run folder; 74 "
-      "storage error (nothing lost); 75 interrupted after a checkpoint (run again to resume); 1 other "
+      "storage error (nothing lost); 75 interrupted (run again: it resumes from its checkpoint, or starts "
+      "over in a scene that keeps none); 1 other "
       "failure.");
   app.set_version_flag("--version", fmt::format("boycott {}+{}", boycott::kVersion, boycott::kGitRevision));
 
