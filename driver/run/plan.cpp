@@ -116,7 +116,9 @@ PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<st
     out.total_core_s += est;
     // A case that has run part of its time needs only the rest.
     const double reached = st == CaseStatus::kDone ? 0.0 : reached_s(root, c);
-    const double left = st == CaseStatus::kDone ? 0.0 : model.core_s(work_of(c, reached));
+    const double left = st == CaseStatus::kDone ? 0.0
+                        : reached > 0.0         ? model.core_s(work_of(c, reached))
+                                                : est;
     if (st != CaseStatus::kDone) out.pending_costs.push_back(left);
     nlohmann::json row = {
         {"group", c.group},         {"swept", swept_text(c)},  {"case_id", c.id},
