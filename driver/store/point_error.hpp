@@ -2,12 +2,14 @@
 // The error bar of a curve point and of r_acc: a half-width that covers the true value about 68 %
 // of the time (core/distributions.hpp: kOneSigmaCoverage) however few numbers it rests on.
 //
-// - One run: its own covering error (summary.json settling_velocity_error_m_s: the standard error
-//   from the autocorrelation times Student's t at that estimate's degrees of freedom).
+// - One run: its own covering error (summary.json settling_velocity_error_m_s: its standard error,
+//   from the autocorrelation or from the window's two halves, times Student's t at that estimate's
+//   degrees of freedom; core/statistics.hpp, MeanError).
 // - n >= 2 replicas: t_{n-1} s / sqrt(n) (s: the replicas' sample standard deviation); where every
-//   replica states its own error, a chi-square test of the scatter against those errors: when the
-//   two disagree (two-sided, 5 %), the larger of the between-replica and the pooled within-run
-//   error is shown and the basis says so.
+//   replica states its own error, an F test of the scatter against those errors (which are
+//   themselves estimates, with their own degrees of freedom): when the two disagree (two-sided,
+//   5 %), the larger of the between-replica and the pooled within-run error is shown and the basis
+//   says so.
 // - Adaptive replicas (replicas_target_rel_error): Stein's two-stage rule (C. Stein, Ann. Math.
 //   Stat. 16, 243 (1945)): the first n0 replicas' s0 fixes how many replicas the point needs, n,
 //   and the error is t_{n0-1} s0 / sqrt(n), which covers exactly whatever n s0 led to; the plain

@@ -104,4 +104,11 @@ double chi_square_cdf(double x, double k) {
   return incomplete_gamma(0.5 * k, 0.5 * x);
 }
 
+double f_cdf(double x, double d1, double d2) {
+  if (!(d1 > 0.0) || !(d2 > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  if (!(x > 0.0)) return 0.0;
+  if (std::isinf(d2)) return chi_square_cdf(d1 * x, d1);
+  return incomplete_beta(0.5 * d1, 0.5 * d2, d1 * x / (d1 * x + d2));
+}
+
 }  // namespace boycott

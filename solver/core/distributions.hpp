@@ -1,6 +1,7 @@
 #pragma once
-// The two sampling distributions an error bar needs: Student's t (the mean of a few numbers over
-// their own scatter) and chi-square (a scatter against stated errors). Regularised incomplete beta
+// The sampling distributions an error bar needs: Student's t (the mean of a few numbers over
+// their own scatter), chi-square (a scatter against known errors) and F (a scatter against
+// errors that are themselves estimated). Regularised incomplete beta
 // and gamma functions by their continued fractions and series (Abramowitz & Stegun 26.5.8,
 // 6.5.29, 6.5.31), evaluated with the modified Lentz method (Thompson & Barnett, J. Comput. Phys.
 // 64, 490 (1986)).
@@ -23,5 +24,9 @@ double one_sigma_t_factor(double nu);
 
 /// P(X <= x) for chi-square with k > 0 degrees of freedom.
 double chi_square_cdf(double x, double k);
+
+/// P(F <= x) for Fisher's F with d1 > 0 and d2 > 0 degrees of freedom (infinite d2: chi-square
+/// with d1 over d1).
+double f_cdf(double x, double d1, double d2);
 
 }  // namespace boycott

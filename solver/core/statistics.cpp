@@ -99,6 +99,44 @@ AutocorrelationError autocorrelation_error(const std::vector<double>& x) {
   return e;
 }
 
+MeanError mean_error(const std::vector<double>& x, const AutocorrelationError& e) {
+  MeanError m;
+  m.stderr_of_mean = m.dof = m.covering_error = std::numeric_limits<double>::quiet_NaN();
+  const std::size_t n = x.size();
+  if (n < 8) return m;
+  if (!e.doubtful() && std::isfinite(e.covering_error)) {
+    m.basis = MeanError::Basis::autocorrelation;
+    m.stderr_of_mean = e.stderr_of_mean;
+    m.dof = e.dof;
+    m.covering_error = e.covering_error;
+    return m;
+  }
+  const auto gap = static_cast<std::size_t>(MeanError::kHalvesGap * static_cast<double>(n));
+  const std::size_t half = (n - gap) / 2;
+  double a = 0.0, b = 0.0;
+  for (std::size_t i = 0; i < half; ++i) {
+    a += x[i];
+    b += x[n - half + i];
+  }
+  m.basis = MeanError::Basis::two_halves;
+  m.stderr_of_mean = std::abs(a - b) / (2.0 * static_cast<double>(half));
+  m.dof = 1.0;
+  m.covering_error = m.stderr_of_mean * one_sigma_t_factor(m.dof);
+  return m;
+}
+
+const char* error_method_name(MeanError::Basis b) {
+  switch (b) {
+    case MeanError::Basis::autocorrelation:
+      return "sokal_autocorrelation";
+    case MeanError::Basis::two_halves:
+      return "two_halves";
+    case MeanError::Basis::none:
+      break;
+  }
+  return "none";
+}
+
 TransientEnd transient_end(const std::vector<double>& x) {
   TransientEnd best;
   best.effective_samples = std::numeric_limits<double>::quiet_NaN();

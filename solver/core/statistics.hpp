@@ -82,6 +82,36 @@ struct AutocorrelationError {
 /// error 0.
 AutocorrelationError autocorrelation_error(const std::vector<double>& x);
 
+/// The error one run reports for the mean of its series, and what it rests on.
+///
+/// Where Sokal's estimate can be trusted (not doubtful(): a closed window and at least
+/// kWarnCorrelationTimes correlation times) it is that estimate, covering_error included. Below
+/// that it cannot: in a short series tau_int is estimated low exactly where the mean has wandered
+/// (the autocovariances are taken about the wandered mean), so its error covers only ~0.57 at 10
+/// correlation times, and no floor on the estimated count helps (a floor keeps the worst runs). The
+/// error then comes from the series' two halves, which asks nothing of the correlation time: with
+/// a and b the means of its first and last (N - gap) / 2 samples, the standard error is |a - b| / 2
+/// with one degree of freedom, and Student's t at 1 (1.84) makes it cover. The halves'
+/// means correlate through the samples either side of their border (by ~tau_int / (N - 2 tau_int)
+/// for an exponential decay: 0.125 at 10 correlation times, which shrinks |a - b|); a gap of
+/// kHalvesGap of the series between them damps that. On AR(1) series (tau_int 3, 10 and 30 steps)
+/// the rule covers 0.66-0.67 at 10 correlation times, 0.68-0.69 at 20, 0.71 at 100 and 0.63 at
+/// 5; with no gap 0.64-0.66 at 10 and with a fifth 0.71 at 20 (docs/validation.md, "Error bars").
+/// A single run shorter than ~7 correlation times cannot tell how far its mean has wandered: it
+/// covers 0.59 at 3 and 0.45 at 1, and the count that would tell is itself the estimate that fails.
+struct MeanError {
+  enum class Basis { none, autocorrelation, two_halves };
+  Basis basis = Basis::none;
+  double stderr_of_mean = 0.0;  ///< NaN with basis none (fewer than 8 samples)
+  double dof = 0.0;             ///< degrees of freedom of stderr_of_mean
+  double covering_error = 0.0;  ///< stderr_of_mean * t_dof, covering ~68 %
+  static constexpr double kHalvesGap = 0.1;
+};
+/// `e` is autocorrelation_error(x).
+MeanError mean_error(const std::vector<double>& x, const AutocorrelationError& e);
+/// summary.json's error_method: "sokal_autocorrelation", "two_halves" or "none".
+const char* error_method_name(MeanError::Basis b);
+
 /// Where a series' start-up transient ends: the truncation that leaves the most effective samples,
 /// max over t0 of (N - t0) / (2 tau_int(x[t0..])) (J. D. Chodera, J. Chem. Theory Comput. 12,
 /// 1799 (2016): a transient inflates the variance and the correlation time of what follows it, so

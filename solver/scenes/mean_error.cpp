@@ -15,6 +15,7 @@ namespace boycott::scenes {
 WindowError window_error(const std::vector<double>& series, double window_from_s, double now_s) {
   WindowError w;
   w.e = autocorrelation_error(series);
+  w.err = mean_error(series, w.e);
   w.from_s = window_from_s;
   w.window_s = std::max(0.0, now_s - window_from_s);
   w.sample_s = series.empty() ? 0.0 : w.window_s / static_cast<double>(series.size());
@@ -34,24 +35,28 @@ void report_window_error(nlohmann::json& j, const std::string& prefix, const std
                          const WindowError& w, bool warn, double transient_end_s) {
   const auto& e = w.e;
   auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
-  j[prefix + "stderr_m_s"] = num(e.stderr_of_mean);
-  j[prefix + "error_m_s"] = num(e.covering_error);
-  j[prefix + "error_dof"] = num(e.dof);
+  j[prefix + "stderr_m_s"] = num(w.err.stderr_of_mean);
+  j[prefix + "error_m_s"] = num(w.err.covering_error);
+  j[prefix + "error_dof"] = num(w.err.dof);
   j[prefix + "correlation_time_s"] = num(w.correlation_time_s());
   j[prefix + "correlation_time_upper_s"] = num(w.correlation_time_upper_s());
   j[prefix + "effective_samples"] = num(e.effective_samples);
   j[prefix + "window_correlation_times"] = num(e.correlation_times);
-  j[prefix + "error_method"] = "sokal_autocorrelation";
+  j[prefix + "error_method"] = error_method_name(w.err.basis);
   if (e.samples == 0 || !warn) return;
+  const std::string rests_on =
+      w.err.basis == MeanError::Basis::two_halves
+          ? "its error comes from the difference of the window's two halves (1 degree of freedom; it "
+            "covers ~2/3 of the time from ~10 correlation times on, less in shorter windows)"
+          : "its error is not reported (fewer than 8 samples)";
   if (!std::isfinite(e.tau_int)) {
     add_warning(
         j, fmt::format("the averaging window ({:.4g} s, {} samples) gives no estimate of the correlation "
-                       "time of {}: its error is not reported",
-                       w.window_s, e.samples, what));
+                       "time of {}: {}",
+                       w.window_s, e.samples, what, rests_on));
     return;
   }
   if (!e.doubtful()) return;
-  const bool na = !std::isfinite(e.stderr_of_mean);
   std::string advice = "run longer or average from earlier";
   if (std::isfinite(transient_end_s))
     advice =
@@ -63,16 +68,12 @@ void report_window_error(nlohmann::json& j, const std::string& prefix, const std
                   "earlier would take it in)",
                   transient_end_s);
   add_warning(
-      j,
-      fmt::format(
-          "the averaging window ({:.4g} s) holds only {:.1f} correlation times of {} (tau_int "
-          "{:.3g} s, at most {:.3g} s{}); {}: {}",
-          w.window_s, e.correlation_times, what, w.correlation_time_s(), w.correlation_time_upper_s(),
-          e.window_closed ? "" : ", the autocorrelation window did not close",
-          na ? fmt::format("below {:g} its error is not reported", AutocorrelationError::kMinCorrelationTimes)
-             : fmt::format("below {:g} its error is itself uncertain",
-                           AutocorrelationError::kWarnCorrelationTimes),
-          advice));
+      j, fmt::format(
+             "the averaging window ({:.4g} s) holds only {:.1f} correlation times of {} (tau_int "
+             "{:.3g} s, at most {:.3g} s{}); {}: {}",
+             w.window_s, e.correlation_times, what, w.correlation_time_s(), w.correlation_time_upper_s(),
+             e.window_closed ? "" : ", the autocorrelation window did not close",
+             fmt::format("below {:g} {}", AutocorrelationError::kWarnCorrelationTimes, rests_on), advice));
 }
 
 ChosenWindow cut_at_transient(const StepSeries& s, const std::vector<double>& window, double collected_from_s,
@@ -174,8 +175,8 @@ void report_settling_statistics(nlohmann::json& j, const StepSeries& s, const st
   auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   const double transient_s = report_transient(j, "<w_p>", s, window, window_from_s, warn);
   report_window_error(j, "settling_velocity_", "<w_p>", w, warn, transient_s);
-  report_time_weighted(j, "settling_velocity_", "<<w_p>>", window, s, w.e.covering_error, warn);
-  j["settling_velocity_rel_stderr"] = num(std::abs(w.e.stderr_of_mean / w.e.mean));
+  report_time_weighted(j, "settling_velocity_", "<<w_p>>", window, s, w.err.covering_error, warn);
+  j["settling_velocity_rel_stderr"] = num(std::abs(w.err.stderr_of_mean / w.e.mean));
 }
 
 bool is_settling_statistics_warning(const std::string& text) {
@@ -198,7 +199,7 @@ bool PrecisionTarget::reached(const std::vector<double>& series, double window_f
   const std::vector<double>& x = cut_transient_ ? cut.window : series;
   if (cut_transient_) window_from_s = cut.from_s;
   const WindowError w = window_error(x, window_from_s, now_s);
-  const double rel = std::abs(w.e.covering_error / w.e.mean);
+  const double rel = std::abs(w.err.covering_error / w.e.mean);
   last_rel_error_ = rel;
   const bool met = std::isfinite(rel) && rel < target_ && w.e.correlation_times >= kMinCorrelationTimes;
   if (!met) {

@@ -14,9 +14,12 @@
 
 namespace boycott::scenes {
 
-/// The error of the mean of `series`, the per-step samples over [window_from_s, now_s].
+/// The error of the mean of `series`, the per-step samples over [window_from_s, now_s]: Sokal's
+/// estimate and its diagnostics (e), and the error the run reports (err: e where it can be
+/// trusted, else from the window's two halves; core/statistics.hpp, MeanError).
 struct WindowError {
   AutocorrelationError e;
+  MeanError err;
   double from_s = 0.0;    ///< window_from_s
   double window_s = 0.0;  ///< now_s - window_from_s
   double sample_s = 0.0;  ///< window_s / samples, the mean step (s)
@@ -26,11 +29,11 @@ struct WindowError {
 WindowError window_error(const std::vector<double>& series, double window_from_s, double now_s);
 
 /// The summary keys of a time average's error, `prefix` + stderr_m_s, error_m_s (the covering
-/// half-width, AutocorrelationError::covering_error), error_dof, correlation_time_s,
-/// correlation_time_upper_s, effective_samples, window_correlation_times, error_method
-/// ("sokal_autocorrelation"); null where not available. With `warn` (a finished run), a warning
-/// goes to j["warnings"] and stderr when the window holds fewer than ~20 correlation times,
-/// saying when the error is not reported at all (fewer than ~5). `what` names the quantity.
+/// half-width), error_dof (all three from WindowError::err), error_method ("sokal_autocorrelation"
+/// or "two_halves"), correlation_time_s, correlation_time_upper_s, effective_samples,
+/// window_correlation_times (Sokal's diagnostics); null where not available. With `warn` (a
+/// finished run), a warning goes to j["warnings"] and stderr when the window holds fewer than ~20
+/// correlation times, saying what the error then rests on. `what` names the quantity.
 /// `transient_end_s` (NaN: not known) shapes the advice: average from where the detected transient
 /// ends when that is before the window, else run longer.
 void report_window_error(nlohmann::json& j, const std::string& prefix, const std::string& what,
@@ -92,7 +95,7 @@ bool is_settling_statistics_warning(const std::string& text);
 void add_warning(nlohmann::json& j, const std::string& text);
 
 /// time.target_rel_error: a run may stop once the covering error of <<w_p>> over its window
-/// (AutocorrelationError::covering_error, the one summary.json reports as error_m_s) is below
+/// (WindowError::err, the one summary.json reports as error_m_s) is below
 /// target |<<w_p>>|, the window holds at least kMinCorrelationTimes correlation times
 /// (counted conservatively, AutocorrelationError::correlation_times), and the target has been
 /// met at every check over at least kConfirmCorrelationTimes correlation times and over

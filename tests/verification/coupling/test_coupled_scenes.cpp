@@ -109,14 +109,17 @@ TEST(InclinedSettling, SmokeRunHoldsTheSlurryVelocityAtZero) {
   EXPECT_EQ(j["status"], "completed");
   EXPECT_LE(j["max_abs_slurry_velocity_m_s"].get<double>(), 1e-8);
   EXPECT_LT(j["mean_settling_velocity_m_s"].get<double>(), 0.0);
-  // The error is reported once the window holds >= 5 correlation times of <w_p>, else n/a (null)
-  // with a warning that says so.
+  // An error is always reported: from the autocorrelation where the window holds >= 20
+  // correlation times of <w_p>, else from the window's two halves, with a warning that says so.
   const double windows = j["settling_velocity_window_correlation_times"].get<double>();
   EXPECT_GT(j["settling_velocity_correlation_time_s"].get<double>(), 0.0);
-  if (windows >= 5.0)
-    EXPECT_TRUE(std::isfinite(j["settling_velocity_stderr_m_s"].get<double>()));
-  else
-    EXPECT_TRUE(j["settling_velocity_stderr_m_s"].is_null() && !j["warnings"].empty());
+  EXPECT_TRUE(std::isfinite(j["settling_velocity_stderr_m_s"].get<double>()));
+  EXPECT_TRUE(std::isfinite(j["settling_velocity_error_m_s"].get<double>()));
+  if (windows < 20.0) {
+    EXPECT_EQ(j["settling_velocity_error_method"], "two_halves");
+    EXPECT_EQ(j["settling_velocity_error_dof"], 1.0);
+    EXPECT_NE(j["warnings"].dump().find("two halves"), std::string::npos) << j["warnings"].dump();
+  }
   EXPECT_GT(j["mean_fluid_velocity_m_s"].get<double>(), 0.0);  // the fluid goes up as particles go down
   EXPECT_TRUE(j["models"].contains("saffman_mei_lift"));       // the default lift law
   std::printf("[ report ] smoke: <<w_p>> = %.4g m/s +- %s, %.1f correlation times, max |slurry| %.2e m/s\n",
