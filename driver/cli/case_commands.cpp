@@ -218,11 +218,12 @@ int case_summarize(const std::vector<std::string>& run_dirs, const std::string& 
       return j.contains(k) && j[k].is_number() ? fmt::format("{:.6g}", j[k].get<double>())
                                                : std::string("n/a");
     };
+    const std::string dof = num("settling_velocity_error_dof");
     std::printf(
-        "%s: <<w_p>> %s m/s +- %s (covering, %s degrees of freedom; plain %s), transient ends at %s s, "
+        "%s: <<w_p>> %s m/s +- %s (covering, %s %s of freedom; plain %s), transient ends at %s s, "
         "window from %s s%s\n",
         dir.string().c_str(), num("mean_settling_velocity_m_s").c_str(),
-        num("settling_velocity_error_m_s").c_str(), num("settling_velocity_error_dof").c_str(),
+        num("settling_velocity_error_m_s").c_str(), dof.c_str(), dof == "1" ? "degree" : "degrees",
         num("settling_velocity_stderr_m_s").c_str(), num("transient_end_s").c_str(),
         num("average_from_s").c_str(),
         db ? (updated ? "; database row updated" : "; no row of this case in the database") : "");

@@ -2,8 +2,10 @@
 
 #include "core/distributions.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace boycott {
 
@@ -137,29 +139,78 @@ const char* error_method_name(MeanError::Basis b) {
   return "none";
 }
 
-TransientEnd transient_end(const std::vector<double>& x) {
-  TransientEnd best;
-  best.effective_samples = std::numeric_limits<double>::quiet_NaN();
-  const auto n = static_cast<std::int64_t>(x.size());
-  if (n < 16) return best;
-  const std::int64_t block = (n + TransientEnd::kMaxBlocks - 1) / TransientEnd::kMaxBlocks;
-  std::vector<double> b(static_cast<std::size_t>(n / block));
+namespace {
+
+// Batch means of x: `block` samples each, the incomplete last one left out.
+std::vector<double> batch_means(const std::vector<double>& x, std::int64_t block) {
+  std::vector<double> b(x.size() / static_cast<std::size_t>(block));
   for (std::size_t i = 0; i < b.size(); ++i) {
     double s = 0.0;
     for (std::int64_t k = 0; k < block; ++k) s += x[i * block + k];
     b[i] = s / static_cast<double>(block);
   }
+  return b;
+}
+
+// The start in [0, b.size() / 2] with the most effective samples, (n - t0) / (2 tau_int), on a
+// grid of kCandidates starts; none where no start gives an estimate.
+std::optional<std::int64_t> most_effective_samples_start(const std::vector<double>& b) {
   const auto nb = static_cast<std::int64_t>(b.size());
+  double best = std::numeric_limits<double>::quiet_NaN();
+  std::optional<std::int64_t> start;
   for (int c = 0; c <= TransientEnd::kCandidates; ++c) {
     const std::int64_t t0 = nb / 2 * c / TransientEnd::kCandidates;
-    const auto e = autocorrelation_error(std::vector<double>(b.begin() + t0, b.end()));
-    const double neff = e.effective_samples;
-    if (std::isfinite(neff) && !(neff <= best.effective_samples)) {
-      best.effective_samples = neff;
-      best.start = t0 * block;
+    const double neff = autocorrelation_error(std::vector<double>(b.begin() + t0, b.end())).effective_samples;
+    if (std::isfinite(neff) && !(neff <= best)) {
+      best = neff;
+      start = t0;
     }
   }
-  return best;
+  return start;
+}
+
+// MSER: the start in [0, b.size() / 2] with the least marginal standard error,
+// sum over i >= t0 of (b_i - mean)^2 / (n - t0)^2, from suffix sums in O(n).
+std::int64_t mser_start(const std::vector<double>& b) {
+  const auto nb = static_cast<std::int64_t>(b.size());
+  std::vector<double> s1(b.size() + 1, 0.0), s2(b.size() + 1, 0.0);
+  for (std::int64_t i = nb - 1; i >= 0; --i) {
+    s1[i] = s1[i + 1] + b[i];
+    s2[i] = s2[i + 1] + b[i] * b[i];
+  }
+  double best = std::numeric_limits<double>::infinity();
+  std::int64_t start = 0;
+  for (std::int64_t t0 = 0; t0 <= nb / 2; ++t0) {
+    const double m = static_cast<double>(nb - t0), mean = s1[t0] / m;
+    const double mser = std::max(0.0, s2[t0] / m - mean * mean) / m;
+    if (mser < best) {
+      best = mser;
+      start = t0;
+    }
+  }
+  return start;
+}
+
+}  // namespace
+
+TransientEnd transient_end(const std::vector<double>& x) {
+  TransientEnd cut;
+  cut.effective_samples = std::numeric_limits<double>::quiet_NaN();
+  const auto n = static_cast<std::int64_t>(x.size());
+  if (n < 16) return cut;
+  // The correlation time survives blocking to kMaxBlocks; MSER-5 batches at least 5 samples.
+  const std::int64_t block = (n + TransientEnd::kMaxBlocks - 1) / TransientEnd::kMaxBlocks;
+  const std::int64_t batch = std::max(TransientEnd::kBatch, block);
+  const std::vector<double> b = batch_means(x, block);
+  const auto effective_start = most_effective_samples_start(b);
+  if (!effective_start) return cut;
+  const std::int64_t start_block =
+      std::max(*effective_start, mser_start(batch_means(x, batch)) * batch / block);
+  cut.start = start_block * block;
+  // Counted on the blocks (blocking keeps the count): no second pass over the whole series.
+  cut.effective_samples =
+      autocorrelation_error(std::vector<double>(b.begin() + start_block, b.end())).effective_samples;
+  return cut;
 }
 
 bool transient_biases_mean(const std::vector<double>& x, std::int64_t from, std::int64_t start) {
