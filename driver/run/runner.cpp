@@ -164,22 +164,32 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
     header.push_back("slurm_job");
     numeric.push_back(false);
   }
-  header.push_back("last_error");
-  numeric.push_back(false);
+  // How far each started case has got, from its run folder's time series (a running case's
+  // progress; where an interrupted one resumes, at most a checkpoint interval earlier).
+  header.insert(header.end(), {"reached_s", "last_error"});
+  numeric.insert(numeric.end(), {true, false});
   report::TextTable table(header, numeric);
+  const fs::path runs = runs_root(db_path);
   for (const auto& c : study.cases) {
     auto it = known.find(c.id);
     const char* st = it == known.end() ? "pending" : to_string(it->second.status);
     const auto job = jobs.find(c.id);
     ++counts[st];
     if ((it == known.end() || it->second.status != CaseStatus::kDone) &&
-        finished_summary_in(fs::path(runs_root(db_path)) / c.id, c.id))
+        finished_summary_in(runs / c.id, c.id))
       ++uncollected;
     std::vector<std::string> row = {
         c.id, c.group, fmt::format("{:.1f}", c.params.gravity.angle_deg), st,
         it != known.end() && it->second.ranks > 0 ? std::to_string(it->second.ranks) : "-"};
     if (!jobs.empty()) row.push_back(job == jobs.end() ? "-" : job->second);
-    row.push_back(it != known.end() && it->second.status != CaseStatus::kDone ? it->second.last_error : "");
+    const double reached = it == known.end() ? 0.0 : simulated_time_s(runs / c.id);
+    row.push_back(reached > 0.0 ? fmt::format("{:.3f}", reached) : "-");
+    // A running case's last error is its previous attempt's, not what it is doing now.
+    const bool shown =
+        it != known.end() && it->second.status != CaseStatus::kDone && !it->second.last_error.empty();
+    row.push_back(!shown                                      ? ""
+                  : it->second.status == CaseStatus::kRunning ? "previous attempt: " + it->second.last_error
+                                                              : it->second.last_error);
     table.add(std::move(row));
   }
   const char* kStates[] = {"done", "running", "failed", "interrupted", "pending"};

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `study run --ranks 2` on a coupled case, stopped with SIGINT after the case's first checkpoint:
 # the attempt is recorded as interrupted (exit 75; mpirun itself exits 1 on a forwarded signal),
-# `study status` shows the case's 2 ranks, and the same command resumes the case to the end.
+# `study status` shows the case's 2 ranks and the simulated time it reached (reached_s, past its first
+# checkpoint and short of its end), and the same command resumes the case to the end.
 set -euo pipefail
 bin=$1; case_file=$2
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
@@ -45,5 +46,6 @@ rows = sqlite3.connect(w / "s.db").execute("select ranks, exit_status from attem
 assert rows == [(2, 75), (2, 0)], rows
 status = (w / "status.txt").read_text().splitlines()
 assert "ranks" in status[1] and status[2].split()[4] == "2", status
+assert status[1].split()[5] == "reached_s" and 0.05 <= float(status[2].split()[5]) < 0.3, status
 print(f"[ report ] attempts {rows}: the stop under mpirun recorded as interrupted, resumed to the end on 2 ranks")
 PY

@@ -41,7 +41,7 @@ fake="python3 $(cd "$(dirname "$0")/../driver" && pwd)/fake_solver.py"
 python3 -c "import json,sys; j=json.load(open(sys.argv[1])); assert j['counts']['done'] == 12 and len(j['cases']) == 12 and j['cases'][0]['angle_deg'] == 30, j" "$work/status.json" ||
   fail "study status --format json: $(cat "$work/status.json")"
 "$bin" study status "$(dirname "$case_file")/../demo.toml" --db "$work/empty.db" --format csv > "$work/status.csv"
-[ "$(head -1 "$work/status.csv")" = 'case,group,angle_deg,status,ranks,last_error' ] ||
+[ "$(head -1 "$work/status.csv")" = 'case,group,angle_deg,status,ranks,reached_s,last_error' ] ||
   fail "study status --format csv has no header row: $(head -2 "$work/status.csv")"
 "$bin" case keys --format csv > "$work/keys.csv"
 grep -q '^fluid.viscosity,0.001,Pa s,' "$work/keys.csv" || fail "case keys --format csv"
