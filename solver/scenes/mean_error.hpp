@@ -102,7 +102,9 @@ void add_warning(nlohmann::json& j, const std::string& text);
 /// kConfirmWindowFraction of the window it was first met at (two checks that far apart, none
 /// failing between). Confirming over 10 correlation times alone let the error at the stop cover
 /// 0.65 (the stop came where tau was under-estimated); over 30 % of the window it covers
-/// 0.66-0.69 at three targets, for runs ~25 % longer (docs/validation.md, "Error bars"). Checks fall on a
+/// 0.665-0.677 at five targets where the target decides the stop, and 0.658-0.659 where the
+/// floor of kMinCorrelationTimes does (10 000 series each), for runs ~25 % longer
+/// (docs/validation.md, "Error bars"). Checks fall on a
 /// fixed schedule of sample counts, so a resumed run checks where the uninterrupted one did; the state goes
 /// into checkpoints.
 class PrecisionTarget {
