@@ -249,7 +249,10 @@ TEST(ErrorCoverage, SingleRunErrorCoversTwoThirdsAt10And20CorrelationTimesAndAtL
   // where that estimate can be trusted (>= 20 correlation times counted conservatively, a closed
   // window), else the two halves' difference with t at 1. Every run reports one. At 100 tau_int
   // Sokal's errs a little on the safe side (0.70-0.71; the plain standard error covers 0.69).
-  for (double window : {10.0, 20.0, 100.0}) {
+  // At 40-100 it over-covers by up to 0.01 (0.70-0.715 over seeds): the runs whose tau_int was
+  // estimated low clear the 20-correlation-time bar first and under-cover (Sokal's covers 0.63 of
+  // them at 40), the rest take the halves, whose gap widens them (docs/validation.md).
+  for (double window : {10.0, 20.0, 40.0, 70.0, 100.0}) {
     const auto c = single_run_coverage(kTau, window, 4000 + static_cast<int>(window)).front();
     EXPECT_GE(c.coverage, 0.66) << window << " tau";
     if (window <= 20.0) {
