@@ -204,8 +204,9 @@ TransientEnd transient_end(const std::vector<double>& x) {
   const std::vector<double> b = batch_means(x, block);
   const auto effective_start = most_effective_samples_start(b);
   if (!effective_start) return cut;
-  const std::int64_t start_block =
-      std::max(*effective_start, mser_start(batch_means(x, batch)) * batch / block);
+  const std::int64_t mser =
+      batch == block ? mser_start(b) : mser_start(batch_means(x, batch)) * batch / block;
+  const std::int64_t start_block = std::max(*effective_start, mser);
   cut.start = start_block * block;
   // Counted on the blocks (blocking keeps the count): no second pass over the whole series.
   cut.effective_samples =
