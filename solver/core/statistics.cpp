@@ -168,20 +168,20 @@ std::vector<double> batch_means(const std::vector<double>& x, std::int64_t block
 }
 
 // The start in [0, b.size() / 2] with the most effective samples, (n - t0) / (2 tau_int), on a
-// grid of kCandidates starts; none where no start gives an estimate.
-std::optional<std::int64_t> most_effective_samples_start(const std::vector<double>& b) {
+// grid of kCandidates starts, and that count; none where no start gives an estimate.
+struct EffectiveStart {
+  std::int64_t start = 0;
+  double effective_samples = 0.0;
+};
+std::optional<EffectiveStart> most_effective_samples_start(const std::vector<double>& b) {
   const auto nb = static_cast<std::int64_t>(b.size());
-  double best = std::numeric_limits<double>::quiet_NaN();
-  std::optional<std::int64_t> start;
+  std::optional<EffectiveStart> best;
   for (int c = 0; c <= TransientEnd::kCandidates; ++c) {
     const std::int64_t t0 = nb / 2 * c / TransientEnd::kCandidates;
     const double neff = autocorrelation_error(std::vector<double>(b.begin() + t0, b.end())).effective_samples;
-    if (std::isfinite(neff) && !(neff <= best)) {
-      best = neff;
-      start = t0;
-    }
+    if (std::isfinite(neff) && !(best && neff <= best->effective_samples)) best = EffectiveStart{t0, neff};
   }
-  return start;
+  return best;
 }
 
 // MSER: the start in [0, b.size() / 2] with the least marginal standard error,
@@ -221,11 +221,13 @@ TransientEnd transient_end(const std::vector<double>& x) {
   if (!effective_start) return cut;
   const std::int64_t mser =
       batch == block ? mser_start(b) : mser_start(batch_means(x, batch)) * batch / block;
-  const std::int64_t start_block = std::max(*effective_start, mser);
+  const std::int64_t start_block = std::max(effective_start->start, mser);
   cut.start = start_block * block;
-  // Counted on the blocks (blocking keeps the count): no second pass over the whole series.
+  // Counted on the blocks (blocking keeps the count); MSER's later cut is counted anew.
   cut.effective_samples =
-      autocorrelation_error(std::vector<double>(b.begin() + start_block, b.end())).effective_samples;
+      start_block == effective_start->start
+          ? effective_start->effective_samples
+          : autocorrelation_error(std::vector<double>(b.begin() + start_block, b.end())).effective_samples;
   return cut;
 }
 
