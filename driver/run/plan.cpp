@@ -17,6 +17,7 @@
 #include "driver/report/report_util.hpp"
 #include "driver/run/progress.hpp"
 #include "driver/run/run_tree.hpp"
+#include "driver/run/runner.hpp"
 #include "driver/store/store.hpp"
 #include "driver/study/cost_model.hpp"
 
@@ -216,7 +217,9 @@ int study_plan(const PlanOptions& opt) {
   std::map<std::string, CaseState> states;
   std::vector<MeasuredCost> finished;
   if (db) {
-    for (auto& s : case_states(*db, study.name, 2)) states[s.id] = s;
+    // As `study status` sees them: an open attempt nobody holds (its driver was killed) is
+    // interrupted, not running.
+    for (auto& s : case_states_now(*db, opt.db_path, study.name, 2)) states[s.id] = s;
     finished = measured(*db);
   }
   const CostModel model(finished);

@@ -236,6 +236,11 @@ TEST(StudyRun, KillNineAtRandomMomentsThenRerunEndsWithTheUninterruptedResults) 
     status = run(ask, d.path);
   }
   EXPECT_NE(status.out.find(" 0 running"), std::string::npos) << status.out;
+  // The plan reads the states the same way.
+  const auto plan =
+      run({"study", "plan", (d.path / "s.toml").string(), "--db", db.string(), "--format", "csv"}, d.path);
+  ASSERT_EQ(plan.rc, 0) << plan.err;
+  EXPECT_EQ(plan.out.find(",running,"), std::string::npos) << plan.out;
   const auto r = run(study_run(d.path / "s.toml", db), d.path);
   ASSERT_EQ(r.rc, 0) << r.err;
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
