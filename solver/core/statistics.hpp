@@ -82,34 +82,49 @@ struct AutocorrelationError {
 /// error 0.
 AutocorrelationError autocorrelation_error(const std::vector<double>& x);
 
-/// The error one run reports for the mean of its series, and what it rests on.
+/// The error one run reports for the mean of its series, and what it rests on: batch means with
+/// Student's t at k - 1 degrees of freedom (Schmeiser, Oper. Res. 30, 556 (1982); Law & Kelton).
+/// The series is cut into k batches of equal length with gaps between them, and the standard error
+/// is sd(batch means) / sqrt(k). Batch means are nearly independent when each batch is much longer
+/// than the correlation time: neighbours correlate through the samples either side of their
+/// border (by ~tau_int / (2 b) for an exponential decay), so one correlation time (the upper end
+/// of its estimate) is left out at each border, at most a tenth of the series (kGapFraction; a
+/// tenth too where no count could be made). k is as many batches of kCorrelationTimesPerBatch
+/// correlation times as the conservative count (AutocorrelationError::correlation_times) allows,
+/// two at least: the two halves of the series (basis two_halves, 1 degree of freedom, t = 1.84)
+/// in runs of fewer than 60 counted correlation times, where no count could be made, and always
+/// in short series.
 ///
-/// Where Sokal's estimate can be trusted (not doubtful(): a closed window and at least
-/// kWarnCorrelationTimes correlation times) it is that estimate, covering_error included. Below
-/// that it cannot: in a short series tau_int is estimated low exactly where the mean has wandered
-/// (the autocovariances are taken about the wandered mean), so its error covers only ~0.57 at 10
-/// correlation times, and no floor on the estimated count helps (a floor keeps the worst runs). The
-/// error then comes from the series' two halves, which asks nothing of the correlation time: with
-/// a and b the means of its first and last (N - gap) / 2 samples, the standard error is |a - b| / 2
-/// with one degree of freedom, and Student's t at 1 (1.84) makes it cover. The halves'
-/// means correlate through the samples either side of their border (by ~tau_int / (N - 2 tau_int)
-/// for an exponential decay: 0.125 at 10 correlation times, which shrinks |a - b|); a gap of
-/// kHalvesGap of the series between them damps that. On AR(1) series (tau_int 3, 10 and 30 steps)
-/// the rule covers 0.66-0.67 at 10 correlation times, 0.68-0.69 at 20, 0.71 at 100 and 0.63 at
-/// 5; with no gap 0.64-0.66 at 10 and with a fifth 0.71 at 20 (docs/validation.md, "Error bars").
+/// Why not Sokal's error itself: in a short series tau_int is estimated low exactly where the
+/// mean has wandered (the autocovariances are taken about the wandered mean), so its error covers
+/// only ~0.57 at 10 correlation times, and switching to it above a count picks the runs whose tau
+/// was estimated low (Sokal times t covers 0.61 of those at 40 correlation times, 0.69 at 70,
+/// while the halves cover 0.83-0.92 of the rest: 0.70-0.715 in all at 40-100). The count here
+/// only sets how many batches and gaps; the batches' own scatter makes the error. On AR(1) series
+/// (tau_int 3, 10 and 30 steps) the rule covers 0.66-0.69 from 10 to 500 correlation times; its
+/// half-width is 1.3-1.5 times the true standard error at 10-100 (few degrees of freedom), 1.08 at
+/// 200, 1.02 at 500 (docs/validation.md, "One run"). Batches of 10 correlation times cover 0.65
+/// at 50; a tenth of the series as gaps at every k, 0.70-0.705 at 200-500 (the error of the mean
+/// of less than the whole series).
 /// A single run shorter than ~7 correlation times cannot tell how far its mean has wandered: it
 /// covers 0.59 at 3 and 0.45 at 1, and the count that would tell is itself the estimate that fails.
 struct MeanError {
-  enum class Basis { none, autocorrelation, two_halves };
+  enum class Basis { none, autocorrelation, two_halves, batch_means };
   Basis basis = Basis::none;
+  int batches = 0;              ///< k
   double stderr_of_mean = 0.0;  ///< NaN with basis none (fewer than 8 samples)
-  double dof = 0.0;             ///< degrees of freedom of stderr_of_mean
+  double dof = 0.0;             ///< degrees of freedom of stderr_of_mean, k - 1
   double covering_error = 0.0;  ///< stderr_of_mean * t_dof, covering ~68 %
-  static constexpr double kHalvesGap = 0.1;
+  static constexpr double kGapFraction = 0.1;
+  static constexpr double kCorrelationTimesPerBatch = 20.0;
 };
 /// `e` is autocorrelation_error(x).
 MeanError mean_error(const std::vector<double>& x, const AutocorrelationError& e);
-/// summary.json's error_method: "sokal_autocorrelation", "two_halves" or "none".
+/// Sokal's estimate as a MeanError (basis autocorrelation, N / (2M + 1) degrees of freedom): the
+/// error of a run that time.target_rel_error stopped, the one its stop was judged on
+/// (scenes/mean_error.hpp, PrecisionTarget).
+MeanError sokal_mean_error(const AutocorrelationError& e);
+/// summary.json's error_method: "gapped_batch_means", "two_halves", "sokal_autocorrelation" or "none".
 const char* error_method_name(MeanError::Basis b);
 
 /// Where a series' start-up transient ends: the later of two cuts, each searched in the first

@@ -240,7 +240,8 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   sb.mean_settling_velocity_m_s = wp_avg.count() ? wp_avg.mean() : kUnset;
   const bool chose = p.time.average_from.automatic && wp_series_whole;
   const ChosenWindow chosen = averaging_window(p.time.average_from, steps, wp_series, run.time_s());
-  const WindowError wp_err = window_error(chosen.window, chosen.from_s, run.time_s());
+  const WindowError wp_err =
+      window_error(chosen.window, chosen.from_s, run.time_s(), sb.status == kStatusConverged);
   if (chose && !chosen.window.empty()) sb.mean_settling_velocity_m_s = wp_err.e.mean;
   sb.settling_velocity_stderr_m_s = wp_series_whole ? wp_err.err.stderr_of_mean : wp_avg.stderr_of_mean();
   auto j = make_summary(p, sb, timers);
@@ -265,8 +266,8 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   if (target.active()) {
     j["target_rel_error"] = p.time.target_rel_error;
     // Met: it stopped the run, or the whole window meets it at the end.
-    // Judged as the run judged it: on the covering error.
-    const double covering_rel = std::abs(wp_err.err.covering_error / sb.mean_settling_velocity_m_s);
+    // Judged as the run judges it (PrecisionTarget): on Sokal's covering error.
+    const double covering_rel = std::abs(wp_err.e.covering_error / sb.mean_settling_velocity_m_s);
     j["target_met"] = sb.status == kStatusConverged ||
                       (wp_series_whole && covering_rel < p.time.target_rel_error &&
                        wp_err.e.correlation_times >= PrecisionTarget::kMinCorrelationTimes);

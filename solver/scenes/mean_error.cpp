@@ -12,10 +12,11 @@
 
 namespace boycott::scenes {
 
-WindowError window_error(const std::vector<double>& series, double window_from_s, double now_s) {
+WindowError window_error(const std::vector<double>& series, double window_from_s, double now_s,
+                         bool stopped_by_target) {
   WindowError w;
   w.e = autocorrelation_error(series);
-  w.err = mean_error(series, w.e);
+  w.err = stopped_by_target ? sokal_mean_error(w.e) : mean_error(series, w.e);
   w.from_s = window_from_s;
   w.window_s = std::max(0.0, now_s - window_from_s);
   w.sample_s = series.empty() ? 0.0 : w.window_s / static_cast<double>(series.size());
@@ -43,6 +44,7 @@ void report_window_error(nlohmann::json& j, const std::string& prefix, const std
   j[prefix + "effective_samples"] = num(e.effective_samples);
   j[prefix + "window_correlation_times"] = num(e.correlation_times);
   j[prefix + "error_method"] = error_method_name(w.err.basis);
+  j[prefix + "error_batches"] = w.err.batches;
   if (e.samples == 0 || !warn) return;
   const std::string rests_on =
       w.err.basis == MeanError::Basis::two_halves
@@ -198,7 +200,7 @@ bool PrecisionTarget::reached(const std::vector<double>& series, double window_f
     cut = cut_at_transient(StepSeries{{}, {}, {}, true, false}, series, window_from_s, now_s);
   const std::vector<double>& x = cut_transient_ ? cut.window : series;
   if (cut_transient_) window_from_s = cut.from_s;
-  const WindowError w = window_error(x, window_from_s, now_s);
+  const WindowError w = window_error(x, window_from_s, now_s, true);
   const double rel = std::abs(w.err.covering_error / w.e.mean);
   last_rel_error_ = rel;
   const bool met = std::isfinite(rel) && rel < target_ && w.e.correlation_times >= kMinCorrelationTimes;

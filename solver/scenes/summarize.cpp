@@ -6,6 +6,7 @@
 
 #include "core/case_params.hpp"
 #include "core/error.hpp"
+#include "core/run_status.hpp"
 #include "core/version.hpp"
 #include "scenes/mean_error.hpp"
 
@@ -64,7 +65,8 @@ nlohmann::json resummarize_run(const std::filesystem::path& run_dir) {
     j["warnings"] = kept;
   }
   const ChosenWindow chosen = averaging_window(p.time.average_from, steps, window, now_s);
-  const WindowError w = window_error(chosen.window, chosen.from_s, now_s);
+  const WindowError w =
+      window_error(chosen.window, chosen.from_s, now_s, j.value("status", "") == kStatusConverged);
   report_settling_statistics(j, chosen.steps, chosen.window, w, true);
   if (p.time.average_from.automatic) {
     j["mean_settling_velocity_m_s"] = w.e.mean;

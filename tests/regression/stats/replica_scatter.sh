@@ -17,9 +17,9 @@ curve = json.load(open(work / "curve.json"))
 assert len(curve) == 1, curve
 p = curve[0]
 assert p["n_replicas"] == 8, p
-# Each run's own error: from its autocorrelation, or (below 20 correlation times, counted
-# conservatively) from its window's two halves; never the batch means of older builds.
-assert p["error_method"] in ("sokal_autocorrelation", "two_halves", "mixed"), p["error_method"]
+# Each run's own error: gapped batch means, or (below 60 correlation times, counted
+# conservatively) its window's two halves; never the ungapped batch means of older builds.
+assert p["error_method"] in ("gapped_batch_means", "two_halves", "mixed"), p["error_method"]
 for cid in p["replica_case_ids"]:
     s = json.load(open(work / "s.sqlite.runs" / cid / "summary.json"))
     seed = json.load(open(work / "s.sqlite.runs" / cid / "params.json")).get("seed", "?")
