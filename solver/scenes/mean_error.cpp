@@ -46,11 +46,16 @@ void report_window_error(nlohmann::json& j, const std::string& prefix, const std
   j[prefix + "error_method"] = error_method_name(w.err.basis);
   j[prefix + "error_batches"] = w.err.batches;
   if (e.samples == 0 || !warn) return;
-  const std::string rests_on =
-      w.err.basis == MeanError::Basis::two_halves
-          ? "its error comes from the difference of the window's two halves (1 degree of freedom; it "
-            "covers ~2/3 of the time from ~10 correlation times on, less in shorter windows)"
-          : "its error is not reported (fewer than 8 samples)";
+  std::string rests_on = "its error is not reported (fewer than 8 samples)";
+  if (w.err.basis == MeanError::Basis::two_halves)
+    rests_on =
+        "its error comes from the difference of the window's two halves (1 degree of freedom; it "
+        "covers ~2/3 of the time from ~10 correlation times on, less in shorter windows)";
+  else if (w.err.basis == MeanError::Basis::batch_means)
+    rests_on = fmt::format("its error comes from {} batch means ({} degrees of freedom)", w.err.batches,
+                           w.err.batches - 1);
+  else if (w.err.basis == MeanError::Basis::autocorrelation)
+    rests_on = "its error is Sokal's, on which the run's target stopped it";
   if (!std::isfinite(e.tau_int)) {
     add_warning(
         j, fmt::format("the averaging window ({:.4g} s, {} samples) gives no estimate of the correlation "
@@ -69,13 +74,17 @@ void report_window_error(nlohmann::json& j, const std::string& prefix, const std
                   "run longer (the detected start-up transient ends at {:.3g} s: averaging from "
                   "earlier would take it in)",
                   transient_end_s);
+  // Doubtful with enough correlation times: only the autocorrelation window failed to close.
+  const bool few = !(e.correlation_times >= AutocorrelationError::kWarnCorrelationTimes);
   add_warning(
-      j, fmt::format(
-             "the averaging window ({:.4g} s) holds only {:.1f} correlation times of {} (tau_int "
-             "{:.3g} s, at most {:.3g} s{}); {}: {}",
-             w.window_s, e.correlation_times, what, w.correlation_time_s(), w.correlation_time_upper_s(),
-             e.window_closed ? "" : ", the autocorrelation window did not close",
-             fmt::format("below {:g} {}", AutocorrelationError::kWarnCorrelationTimes, rests_on), advice));
+      j, fmt::format("the averaging window ({:.4g} s) holds {}{:.1f} correlation times of {} (tau_int "
+                     "{:.3g} s, at most {:.3g} s{}); {}: {}",
+                     w.window_s, few ? "only " : "", e.correlation_times, what, w.correlation_time_s(),
+                     w.correlation_time_upper_s(),
+                     e.window_closed ? "" : ", the autocorrelation window did not close",
+                     few ? fmt::format("below {:g} {}", AutocorrelationError::kWarnCorrelationTimes, rests_on)
+                         : rests_on,
+                     advice));
 }
 
 ChosenWindow cut_at_transient(const StepSeries& s, const std::vector<double>& window, double collected_from_s,

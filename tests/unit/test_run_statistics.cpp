@@ -166,3 +166,40 @@ TEST(TransientReport, AnAutomaticWindowStartsWhereTheTransientEndsAndReportsNoTr
   EXPECT_EQ(tiny.window.size(), 3u);
   EXPECT_EQ(tiny.from_s, 1.0);
 }
+
+TEST(WindowErrorReport, AWarningSaysWhatTheErrorRestsOnAndCallsNoLongWindowShort) {
+  // A long window whose autocorrelation window did not close: the error comes from its batches,
+  // and the warning names them without calling 80 correlation times "below 20".
+  scenes::WindowError w;
+  w.e.samples = 8000;
+  w.e.tau_int = w.e.tau_int_upper = 100.0;
+  w.e.correlation_times = 80.0;
+  w.e.window_closed = false;
+  w.err.basis = MeanError::Basis::batch_means;
+  w.err.batches = 4;
+  w.err.dof = 3.0;
+  w.window_s = 80.0;
+  w.sample_s = 0.01;
+  nlohmann::json j;
+  scenes::report_window_error(j, "settling_velocity_", "<w_p>", w, true, std::nan(""));
+  ASSERT_EQ(j["warnings"].size(), 1u);
+  const auto text = j["warnings"][0].get<std::string>();
+  EXPECT_NE(text.find("holds 80.0 correlation times"), std::string::npos) << text;
+  EXPECT_NE(text.find("did not close"), std::string::npos) << text;
+  EXPECT_NE(text.find("4 batch means (3 degrees of freedom)"), std::string::npos) << text;
+  EXPECT_EQ(text.find("below 20"), std::string::npos) << text;
+  EXPECT_EQ(j["settling_velocity_error_batches"], 4);
+  EXPECT_EQ(j["settling_velocity_error_method"], "gapped_batch_means");
+  // A short window: "only", and the halves.
+  w.e.correlation_times = 8.0;
+  w.e.window_closed = true;
+  w.err.basis = MeanError::Basis::two_halves;
+  w.err.batches = 2;
+  nlohmann::json short_window;
+  scenes::report_window_error(short_window, "settling_velocity_", "<w_p>", w, true, std::nan(""));
+  const auto short_text = short_window["warnings"][0].get<std::string>();
+  EXPECT_NE(short_text.find("holds only 8.0 correlation times"), std::string::npos) << short_text;
+  EXPECT_NE(short_text.find("below 20 its error comes from the difference of the window's two halves"),
+            std::string::npos)
+      << short_text;
+}
