@@ -112,6 +112,7 @@ struct NumericsParams {
   /// diagonal, so under-relaxation only slows SIMPLE (8.5 -> 5 iterations per step on the bench
   /// mesh at 0.8) and moves the converged step by less than simple_tolerance.
   double velocity_relaxation = 1.0;  ///< SIMPLE only
+  /// Only this value is accepted: SIMPLEC applies its pressure correction whole (case_rules.cpp).
   double pressure_relaxation = 0.5;
   /// "simple" (the paper's, iterated to simple_tolerance) or "piso" (Issa 1986: one momentum
   /// solve and piso_correctors pressure corrections per step, not iterated; faster, its

@@ -188,6 +188,17 @@ void check_case(CaseParams& p) {
                       "most {:g} (a stop drops the unfinished fluid step; the paper's cases take 50)",
                       ratio, kMaxSubsteps));
   }
+  // The SIMPLE iteration is SIMPLEC (fluid/pressure_correction.cpp), whose pressure correction
+  // is consistent with its velocity correction and is applied whole: a relaxation factor would be
+  // silently ignored, yet change the case id. The key stays for case files that spell out its
+  // default.
+  if (reads("numerics.pressure_relaxation") &&
+      p.numerics.pressure_relaxation != NumericsParams{}.pressure_relaxation)
+    throw InputError(fmt::format(
+        "numerics.pressure_relaxation = {}: must be {} (its default). The pressure-velocity coupling is "
+        "SIMPLEC, which applies its pressure correction whole; to damp the iteration use "
+        "numerics.velocity_relaxation",
+        fmt_num(p.numerics.pressure_relaxation), fmt_num(NumericsParams{}.pressure_relaxation)));
   // A step so small that the run would not end in any time a machine has.
   constexpr double kMaxSteps = 1e12;
   for (auto [key, dt] : {std::pair{"time.dt_dem", p.time.dt_dem_s}, {"time.dt_cfd", p.time.dt_cfd_s}})

@@ -98,7 +98,7 @@ AutocorrelationError autocorrelation_error(const std::vector<double>& x);
 /// Why not Sokal's error itself: in a short series tau_int is estimated low exactly where the
 /// mean has wandered (the autocovariances are taken about the wandered mean), so its error covers
 /// only ~0.57 at 10 correlation times, and switching to it above a count picks the runs whose tau
-/// was estimated low (Sokal times t covers 0.61 of those at 40 correlation times, 0.69 at 70,
+/// was estimated low (Sokal times t covers 0.61-0.63 of those at 40 correlation times, 0.69 at 70,
 /// while the halves cover 0.83-0.92 of the rest: 0.70-0.715 in all at 40-100). The count here
 /// only sets how many batches and gaps; the batches' own scatter makes the error. On AR(1) series
 /// (tau_int 3, 10 and 30 steps) the rule covers 0.66-0.69 from 10 to 500 correlation times; its

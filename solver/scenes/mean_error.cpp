@@ -44,7 +44,7 @@ void report_window_error(nlohmann::json& j, const std::string& prefix, const std
   j[prefix + "effective_samples"] = num(e.effective_samples);
   j[prefix + "window_correlation_times"] = num(e.correlation_times);
   j[prefix + "error_method"] = error_method_name(w.err.basis);
-  j[prefix + "error_batches"] = w.err.batches;
+  j[prefix + "error_batches"] = w.err.batches > 0 ? nlohmann::json(w.err.batches) : nlohmann::json(nullptr);
   if (e.samples == 0 || !warn) return;
   std::string rests_on = "its error is not reported (fewer than 8 samples)";
   if (w.err.basis == MeanError::Basis::two_halves)

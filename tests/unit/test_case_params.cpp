@@ -101,6 +101,13 @@ TEST(CaseParams, ValidationNamesFieldValueAndLimit) {
   p = CaseParams{};
   apply_override(p, "particles.count=10000000");
   expect_message(p, "overfills the box");
+  // A key the scheme does not use is refused at any value but its default, not ignored.
+  p = CaseParams{};
+  p.numerics.pressure_relaxation = 0.8;
+  expect_message(p, "numerics.pressure_relaxation = 0.8: must be 0.5");
+  p = CaseParams{};
+  p.numerics.pressure_relaxation = 0.5;
+  EXPECT_NO_THROW(validate(p));
 }
 
 TEST(CaseParams, IdIsStableAndDistinguishesParameters) {
