@@ -2,9 +2,11 @@
 // then each contact's force and torques through the stateless kernels of contact_kernels.hpp,
 // then the walls. Contact histories are kept by contact_history.cpp.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <type_traits>
+#include <utility>
 
 #include "core/timers.hpp"
 #include "particles/contact_kernels.hpp"
@@ -18,12 +20,13 @@ namespace {
 /// First pass of the force loop: appends (i, list slot) of each overlapping list pair to ci, cp
 /// and returns their number. The test runs over the flat pair arrays (pair_i, nb) so that it
 /// vectorises (gathers) into a byte per pair; the append is a second pass (flag_compress.hpp).
-/// The periodic directions are template flags so that the loop body has no branch at all.
-template <bool PX, bool PY, bool PZ>
+/// The periodic directions are template flags so that the loop body has no branch at all; so is
+/// UR, all radii equal (their sum rsum_u then replaces two gathers per pair).
+template <bool PX, bool PY, bool PZ, bool UR>
 std::size_t find_contacts(std::size_t np, const std::uint32_t* __restrict pair_i,
                           const std::uint32_t* __restrict nb, const double* __restrict x,
                           const double* __restrict y, const double* __restrict z,
-                          const double* __restrict rad, const std::array<double, 3>& len,
+                          const double* __restrict rad, double rsum_u, const std::array<double, 3>& len,
                           std::uint8_t* __restrict flag, std::uint32_t* __restrict ci,
                           std::uint32_t* __restrict cp) {
   const double Lx = len[0], Ly = len[1], Lz = len[2];
@@ -34,7 +37,8 @@ std::size_t find_contacts(std::size_t np, const std::uint32_t* __restrict pair_i
     if constexpr (PX) dx = min_image(dx, Lx, iLx);
     if constexpr (PY) dy = min_image(dy, Ly, iLy);
     if constexpr (PZ) dz = min_image(dz, Lz, iLz);
-    const double rsum = rad[i] + rad[j];
+    double rsum = rsum_u;
+    if constexpr (!UR) rsum = rad[i] + rad[j];
     flag[p] = dx * dx + dy * dy + dz * dz < rsum * rsum;
   }
   return compress_flagged(np, flag, pair_i, ci, cp);
@@ -67,14 +71,15 @@ std::size_t find_wall_contacts(std::size_t n, const PlaneWall& W, const double* 
 }
 
 using FindContactsFn = std::size_t (*)(std::size_t, const std::uint32_t*, const std::uint32_t*, const double*,
-                                       const double*, const double*, const double*,
+                                       const double*, const double*, const double*, double,
                                        const std::array<double, 3>&, std::uint8_t*, std::uint32_t*,
                                        std::uint32_t*);
-// Indexed by periodic x | y << 1 | z << 2.
-constexpr FindContactsFn kFindContacts[8] = {
-    find_contacts<false, false, false>, find_contacts<true, false, false>, find_contacts<false, true, false>,
-    find_contacts<true, true, false>,   find_contacts<false, false, true>, find_contacts<true, false, true>,
-    find_contacts<false, true, true>,   find_contacts<true, true, true>};
+// Indexed by periodic x | y << 1 | z << 2 | uniform radii << 3.
+constexpr auto kFindContacts = []<std::size_t... B>(std::index_sequence<B...>) {
+  return std::array<FindContactsFn, sizeof...(B)>{
+      find_contacts<(B & 1) != 0, (B & 2) != 0, (B & 4) != 0, (B & 8) != 0>...};
+}
+(std::make_index_sequence<16>{});
 }  // namespace
 
 template <class Rolling>
@@ -126,10 +131,14 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   contact_p_.resize(np);
   std::uint32_t* __restrict ci = contact_i_.data();
   std::uint32_t* __restrict cp = contact_p_.data();
-  const int periodic_bits = (px ? 1 : 0) | (py ? 2 : 0) | (pz ? 4 : 0);
+  // Equal radii (and moments of inertia): the usual monodisperse case, where the loops below take
+  // them as constants (the same values, so the same bits) instead of gathering them per pair.
+  const double Ru = uniform_radius_m_, Iu = uniform_inertia_kg_m2_;
+  const bool same_r = Ru > 0.0;
+  const int variant = (px ? 1 : 0) | (py ? 2 : 0) | (pz ? 4 : 0) | (same_r ? 8 : 0);
   pair_flag_.resize(np);
-  const std::size_t nc = kFindContacts[periodic_bits](np, pair_i_.data(), nb, x, y, z, rad, cfg_.box.len,
-                                                      pair_flag_.data(), ci, cp);
+  const std::size_t nc = kFindContacts[variant](np, pair_i_.data(), nb, x, y, z, rad, Ru + Ru, cfg_.box.len,
+                                                pair_flag_.data(), ci, cp);
   pair_hist_.carry_to_contacts(cp, nc);
   contacts = static_cast<std::int64_t>(nc);
 
@@ -159,11 +168,15 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   const double damping_factor = cm.damping_factor;
   // Equal masses (the usual case) and mixed ones are separate loops: a select between them would
   // turn the mass loads into masked gathers, which do not vectorise.
-  auto contact_loop = [&](auto uniform_masses, std::size_t k0, std::size_t k1) {
+  const double Ru_over_Iu = same_r ? Ru / Iu : 0.0;
+  auto contact_loop = [&](auto uniform_masses, auto uniform_radii, std::size_t k0, std::size_t k1) {
+    constexpr bool UR = decltype(uniform_radii)::value;
 #pragma GCC ivdep
     for (std::size_t k = k0; k < k1; ++k) {
       const std::uint32_t i = ci[k], p = cp[k], j = nb[p];
-      const double ri = rad[i], rj = rad[j], mi = mass[i], mj = mass[j];
+      const double mi = mass[i], mj = mass[j];
+      double ri = Ru, rj = Ru;
+      if constexpr (!UR) ri = rad[i], rj = rad[j];
       double dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
       dx = min_image(dx, Pxl, iLx);
       dy = min_image(dy, Pyl, iLy);
@@ -191,9 +204,10 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       const double mx = ny * ftz - nz * fty, my = nz * ftx - nx * ftz, mz = nx * fty - ny * ftx;
       double rtx = 0.0, rty = 0.0, rtz = 0.0;
       if constexpr (Rolling::enabled) {
-        rolling_resistance(spx[i] - spx[j], spy[i] - spy[j], spz[i] - spz[j], nx, ny, nz, mx, my, mz,
-                           ri / inertia[i], rj / inertia[j], inv_dt, rolling.mu_r * std::abs(fn), rtx, rty,
-                           rtz);
+        double ai = Ru_over_Iu, aj = Ru_over_Iu;  // R / I of each sphere, 1/(kg m)
+        if constexpr (!UR) ai = ri / inertia[i], aj = rj / inertia[j];
+        rolling_resistance(spx[i] - spx[j], spy[i] - spy[j], spz[i] - spz[j], nx, ny, nz, mx, my, mz, ai, aj,
+                           inv_dt, rolling.mu_r * std::abs(fn), rtx, rty, rtz);
       }
       oTix[k - k0] = -ri * mx - ri * rtx;
       oTiy[k - k0] = -ri * my - ri * rty;
@@ -205,10 +219,14 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   };
   for (std::size_t k0 = 0; k0 < nc; k0 += kBlock) {
     const std::size_t k1 = std::min(nc, k0 + kBlock);
-    if (uniform)
-      contact_loop(std::true_type{}, k0, k1);
+    if (uniform && same_r)
+      contact_loop(std::true_type{}, std::true_type{}, k0, k1);
+    else if (uniform)
+      contact_loop(std::true_type{}, std::false_type{}, k0, k1);
+    else if (same_r)
+      contact_loop(std::false_type{}, std::true_type{}, k0, k1);
     else
-      contact_loop(std::false_type{}, k0, k1);
+      contact_loop(std::false_type{}, std::false_type{}, k0, k1);
     // Pass 2b: add them to the particles, in contact order.
     for (std::size_t k = k0; k < k1; ++k) {
       const std::uint32_t i = ci[k], j = nb[cp[k]];

@@ -90,6 +90,10 @@ void DemSystem::update_uniform_mass() {
   uniform_mass_kg_ = s_.size() ? s_.mass[0] : 0.0;
   for (double m : s_.mass)
     if (m != uniform_mass_kg_) uniform_mass_kg_ = 0.0;
+  uniform_radius_m_ = s_.size() ? s_.radius[0] : 0.0;
+  uniform_inertia_kg_m2_ = s_.size() ? s_.inertia[0] : 0.0;
+  for (std::size_t i = 0; i < s_.size(); ++i)
+    if (s_.radius[i] != uniform_radius_m_ || s_.inertia[i] != uniform_inertia_kg_m2_) uniform_radius_m_ = 0.0;
 }
 
 void DemSystem::set_particle_properties(double r, double rho) {

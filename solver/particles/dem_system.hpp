@@ -73,6 +73,10 @@ class DemSystem {
   /// from what they have, and rebuilds the neighbour list for them (a run branched from another
   /// with smaller or lighter particles). Collective.
   void set_particle_properties(double radius_m, double density_kg_m3);
+  /// After writing radius, mass or inertia into particles() directly (a packing that grows the
+  /// particles step by step): the contact loops stop taking one radius for all particles until
+  /// the next initialize() or import_state() finds them equal again.
+  void particle_sizes_changed() { uniform_radius_m_ = 0.0; }
   /// Adds a particle (before `initialize`, or followed by `force_rebuild`).
   void add_particle(std::int64_t gid, double x, double y, double z, double radius_m, double density_kg_m3);
   /// Random non-overlapping insertion of `count` spheres with centres in [lo, hi] (m), at least
@@ -184,6 +188,7 @@ class DemSystem {
   void collect_histories();
   /// Rebuilds prev_wall_contacts_ from the wall histories (after a reordering or a restart).
   void rescan_wall_contacts();
+  /// uniform_mass_kg_ and uniform_radius_m_ from this rank's stored particles.
   void update_uniform_mass();
   /// r_i + r_j - |x_i - x_j| (minimum image), m; positive when the pair overlaps.
   double pair_overlap(std::size_t i, std::size_t j) const;
@@ -210,6 +215,9 @@ class DemSystem {
   NeighborList nl_;
   double cutoff_m_ = 0.0;
   double uniform_mass_kg_ = 0.0;
+  /// The radius (m) every particle has, with one moment of inertia too (the usual monodisperse
+  /// case), else 0: the contact loops then take both as constants instead of gathering them.
+  double uniform_radius_m_ = 0.0, uniform_inertia_kg_m2_ = 0.0;
   std::vector<double> vz_end_;   ///< v_z (m/s) after a fused pass's closing kick (advance's sums)
   std::vector<double> pred_[6];  ///< v, w (m/s, rad/s) seen by the forces: predicted to the force time
   std::vector<double> ref_x_, ref_y_, ref_z_;

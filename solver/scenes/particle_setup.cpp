@@ -21,6 +21,7 @@ void grow_packing(particles::DemSystem& dem, double r0, double r1, double rho, i
       s.mass[i] = m;
       s.inertia[i] = 0.4 * m * r * r;
     }
+    dem.particle_sizes_changed();
   };
   // Strong linear damping toward rest through the implicit drag hook: beta dt / m ~ 0.5.
   const double m1 = rho * (4.0 / 3.0) * kPi * r1 * r1 * r1;
