@@ -77,6 +77,8 @@ class DemSystem {
   /// particles step by step): the contact loops stop taking one radius for all particles until
   /// the next initialize() or import_state() finds them equal again.
   void particle_sizes_changed() { uniform_radius_m_ = 0.0; }
+  /// Whether the contact loops take one radius and moment of inertia for all particles.
+  bool equal_radii() const { return uniform_radius_m_ > 0.0; }
   /// Adds a particle (before `initialize`, or followed by `force_rebuild`).
   void add_particle(std::int64_t gid, double x, double y, double z, double radius_m, double density_kg_m3);
   /// Random non-overlapping insertion of `count` spheres with centres in [lo, hi] (m), at least

@@ -335,3 +335,43 @@ TEST(DemSystem, FusedStepsReportEachStepsVzSumBitwise) {
     EXPECT_NE(stepped.front(), stepped.back());  // the particles fall: the sums move
   }
 }
+
+TEST(DemSystem, EqualRadiusPathEqualsTheGatheredOneBitwise) {
+  // Equal radii are taken as constants by the contact search and loop (rolling friction on, so
+  // R / I is too); a system told its sizes changed gathers them per pair. A bed forms on the
+  // lower wall, so thousands of contacts are evaluated both ways.
+  auto make = [] {
+    DemSystem d(channel_config());
+    d.insert_random(300, kR, kRho, {0, 0, 0}, {6e-3, 3.6e-3, 7.8e-3}, 4);
+    d.initialize();
+    return d;
+  };
+  DemSystem a = make(), b = make();
+  b.particle_sizes_changed();
+  EXPECT_TRUE(a.equal_radii());
+  EXPECT_FALSE(b.equal_radii());
+  std::int64_t contacts = 0;
+  for (int n = 0; n < 3000; ++n) {
+    a.step();
+    b.step();
+    contacts += a.contact_count();
+  }
+  EXPECT_GT(contacts, 10000);
+  EXPECT_FALSE(b.equal_radii());  // nothing but initialize() or import_state() turns it back on
+  EXPECT_EQ(a.particles().x, b.particles().x);
+  EXPECT_EQ(a.particles().y, b.particles().y);
+  EXPECT_EQ(a.particles().vz, b.particles().vz);
+  EXPECT_EQ(a.particles().wx, b.particles().wx);
+  EXPECT_EQ(a.particles().tz, b.particles().tz);
+}
+
+TEST(DemSystem, AParticleOfAnotherSizeEndsTheEqualRadiusPath) {
+  DemSystem d(channel_config());
+  d.insert_random(50, kR, kRho, {0, 0, 0}, {6e-3, 3.6e-3, 7.8e-3}, 4);
+  d.initialize();
+  EXPECT_TRUE(d.equal_radii());
+  d.add_particle(1000, 3e-3, 1.8e-3, 7.0e-3, 0.5 * kR, kRho);
+  EXPECT_FALSE(d.equal_radii());
+  d.initialize();
+  EXPECT_FALSE(d.equal_radii());
+}
