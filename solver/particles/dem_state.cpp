@@ -120,7 +120,7 @@ void DemSystem::import_state(const DemState& st) {
   double rmax = 0.0;
   for (double r : s_.radius) rmax = std::max(rmax, r);
   cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
-  update_uniform_mass();
+  update_uniform_properties();
   // Build the list at the stored reference positions, so that the next rebuild happens at the
   // same step as in the uninterrupted run, then restore the histories onto it.
   ParticleStore at_ref = s_;
@@ -169,7 +169,7 @@ void DemSystem::import_parallel(const DemState& st) {
     }
   }
   for (auto& a : pred_) a.assign(n, 0.0);  // set by the next step's first kick
-  set_cutoff_and_mass();
+  set_cutoff_and_uniform_properties();
   carry_.a = st.pair_id_a;
   carry_.b = st.pair_id_b;
   carry_.h.resize(3 * st.pair_id_a.size());

@@ -68,7 +68,7 @@ void DemSystem::initialize() {
             "DemConfig::dry is set but a particle has a fluid force, velocity or added mass");
   if (dd_.parallel()) {
     // The ghosts carry their owner's velocities at the force time, so those come first.
-    set_cutoff_and_mass();
+    set_cutoff_and_uniform_properties();
     predict_velocities();
     rebuild_parallel(!carry_ready_);
     carry_ready_ = false;
@@ -79,14 +79,14 @@ void DemSystem::initialize() {
   double rmax = 0.0;
   for (double r : s_.radius) rmax = std::max(rmax, r);
   cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
-  update_uniform_mass();
+  update_uniform_properties();
   rebuild();
   predict_velocities();
   compute_forces();
   initialized_ = true;
 }
 
-void DemSystem::update_uniform_mass() {
+void DemSystem::update_uniform_properties() {
   uniform_mass_kg_ = s_.size() ? s_.mass[0] : 0.0;
   for (double m : s_.mass)
     if (m != uniform_mass_kg_) uniform_mass_kg_ = 0.0;
@@ -107,7 +107,7 @@ void DemSystem::set_particle_properties(double r, double rho) {
   if (dd_.parallel()) {
     MPI_Allreduce(MPI_IN_PLACE, &changed, 1, MPI_INT, MPI_MAX, dd_.comm);
     if (!changed) return;
-    set_cutoff_and_mass();
+    set_cutoff_and_uniform_properties();
     rebuild_parallel();
     return;
   }
@@ -115,7 +115,7 @@ void DemSystem::set_particle_properties(double r, double rho) {
   double rmax = 0.0;
   for (double v : s_.radius) rmax = std::max(rmax, v);
   cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
-  update_uniform_mass();
+  update_uniform_properties();
   rebuild();
 }
 

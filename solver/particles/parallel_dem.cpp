@@ -85,7 +85,7 @@ void DemSystem::select_particles(const std::vector<std::size_t>& keep) {
     for (auto& a : *wh) compact_increasing(a, keep);
 }
 
-void DemSystem::set_cutoff_and_mass() {
+void DemSystem::set_cutoff_and_uniform_properties() {
   const double inf = std::numeric_limits<double>::infinity();
   double rmin = inf, rmax = 0.0, mmin = inf, mmax = -inf, imin = inf, imax = -inf;
   for (std::size_t i = 0; i < s_.n_local; ++i) {
