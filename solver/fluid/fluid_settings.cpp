@@ -16,7 +16,6 @@ FluidSettings FluidSettings::from_case(const CaseParams& p) {
   s.simple_max_iterations = static_cast<int>(p.numerics.simple_max_iterations);
   s.simple_tolerance = p.numerics.simple_tolerance;
   s.velocity_relaxation = p.numerics.velocity_relaxation;
-  s.pressure_relaxation = p.numerics.pressure_relaxation;
   s.cfl_max = p.numerics.cfl_max;
   s.dt_max_s = p.time.dt_cfd_s;
   s.piso = p.numerics.pressure_velocity_coupling == "piso";

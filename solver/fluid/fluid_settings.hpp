@@ -25,11 +25,6 @@ struct FluidSettings {
   int simple_max_iterations = 30;
   double simple_tolerance = 1.0e-6;
   double velocity_relaxation = 1.0;  ///< see CaseParams::Numerics
-  double pressure_relaxation = 0.5;  ///< used by plain SIMPLE; SIMPLEC corrects p fully
-  /// SIMPLEC correction coefficient a/(rho (a_P - sum a_nb)) instead of SIMPLE's a/(rho a_P):
-  /// plain SIMPLE diverges for diffusion-dominated cells of high aspect ratio (nu dt/h_y^2 >> 1
-  /// with h_x >> h_y, as on the paper's 1 x 1 x 1 mm grid with 6 cells across a 6 mm gap).
-  bool simplec = true;
   double cfl_max = 0.5;
   double dt_max_s = 1.0e-3;
   bool quick = true;  ///< false: first-order upwind convection (for comparisons)
@@ -41,10 +36,10 @@ struct FluidSettings {
   int simple_correctors = 1;
   /// Builds the settings of a case: grid, fluid, numerics, `[flow]` forcing.
   static FluidSettings from_case(const CaseParams& p);
-  /// Pressure-velocity coupling in words ("SIMPLEC", "SIMPLE" or "PISO, 2 correctors").
+  /// Pressure-velocity coupling in words ("SIMPLEC", "SIMPLEC, 2 correctors" or "PISO, 2 correctors").
   std::string coupling_name() const {
     if (piso) return "PISO, " + std::to_string(piso_correctors) + " correctors";
-    const std::string name = simplec ? "SIMPLEC" : "SIMPLE";
+    const std::string name = "SIMPLEC";
     return simple_correctors > 1 ? name + ", " + std::to_string(simple_correctors) + " correctors" : name;
   }
 };

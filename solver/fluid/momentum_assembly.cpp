@@ -133,7 +133,7 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
   const double ih[3] = {1.0 / h[0], 1.0 / h[1], 1.0 / h[2]};
   const double ih2[3] = {ih[0] * ih[0], ih[1] * ih[1], ih[2] * ih[2]};
   const double inv_dt = 1.0 / dt, inv_rho = 1.0 / rho, inv_lam = 1.0 / lam;
-  const bool simplec = s_.simplec, top_slip = s_.top_slip;
+  const bool top_slip = s_.top_slip;
 
   // row buffers: a_P, right-hand side, a_face, transpose stress, sum |a_nb|, 6 neighbour coefficients
   const int nx = (int)b.size[0];
@@ -287,11 +287,13 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
           rh[i] = b_ + (aPr - aP[i]) * uP_[i];
           aP[i] = aPr;
         }
-        // SIMPLE: u' = -(a/(rho a_P)) grad p'; SIMPLEC (Van Doormaal and Raithby 1984) subtracts
-        // the neighbour sum, which keeps diffusion-dominated, high-aspect cells convergent.
+        // SIMPLEC (Van Doormaal and Raithby 1984): u' = -(a/(rho (a_P - sum a_nb))) grad p'.
+        // SIMPLE's a/(rho a_P) diverges for diffusion-dominated cells of high aspect ratio
+        // (nu dt/h_y^2 >> 1 with h_x >> h_y, as on the paper's 1 mm grid with 6 cells across a
+        // 6 mm gap).
         if (first_iteration)
 #pragma GCC ivdep
-          for (int i = 0; i < nx; ++i) Dd[i] = a1v[i] / (rho * (simplec ? aP[i] - snb[i] : aP[i]));
+          for (int i = 0; i < nx; ++i) Dd[i] = a1v[i] / (rho * (aP[i] - snb[i]));
         double* __restrict id = idg + o0;
 #pragma GCC ivdep
         for (int i = 0; i < nx; ++i) id[i] = 1.0 / aP[i];

@@ -132,7 +132,8 @@ void FluidSolver::correct(Vec pcorr) {
     BC_PETSC(DMDAVecRestoreArray(da_, flow_.U[d], &U[d]));
     BC_PETSC(DMDAVecRestoreArray(da_, D_[d], &D[d]));
   }
-  BC_PETSC(VecAXPY(flow_.P, s_.simplec ? 1.0 : s_.pressure_relaxation, pcorr));
+  // SIMPLEC: the pressure correction is consistent with the velocity correction and applied whole
+  BC_PETSC(VecAXPY(flow_.P, 1.0, pcorr));
 }
 
 void FluidSolver::solve_pressure_correction(StepReport& rep, bool refresh_ghosts) {
