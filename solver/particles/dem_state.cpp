@@ -117,10 +117,7 @@ void DemSystem::import_state(const DemState& st) {
       whz_[w][i] = st.wall_h[3 * (w * n + i) + 2];
     }
   }
-  double rmax = 0.0;
-  for (double r : s_.radius) rmax = std::max(rmax, r);
-  cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
-  update_uniform_properties();
+  set_cutoff_and_uniform_properties();
   // Build the list at the stored reference positions, so that the next rebuild happens at the
   // same step as in the uninterrupted run, then restore the histories onto it.
   ParticleStore at_ref = s_;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -76,24 +77,40 @@ void DemSystem::initialize() {
     initialized_ = true;
     return;
   }
-  double rmax = 0.0;
-  for (double r : s_.radius) rmax = std::max(rmax, r);
-  cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
-  update_uniform_properties();
+  set_cutoff_and_uniform_properties();
   rebuild();
   predict_velocities();
   compute_forces();
   initialized_ = true;
 }
 
-void DemSystem::update_uniform_properties() {
-  uniform_mass_kg_ = s_.size() ? s_.mass[0] : 0.0;
-  for (double m : s_.mass)
-    if (m != uniform_mass_kg_) uniform_mass_kg_ = 0.0;
-  uniform_radius_m_ = s_.size() ? s_.radius[0] : 0.0;
-  uniform_inertia_kg_m2_ = s_.size() ? s_.inertia[0] : 0.0;
-  for (std::size_t i = 0; i < s_.size(); ++i)
-    if (s_.radius[i] != uniform_radius_m_ || s_.inertia[i] != uniform_inertia_kg_m2_) uniform_radius_m_ = 0.0;
+void DemSystem::set_cutoff_and_uniform_properties() {
+  // On several ranks over the local particles only (the ghosts may still be copies from before
+  // the change), their extremes reduced over the ranks; one rank keeps no ghosts.
+  const std::size_t n = dd_.parallel() ? s_.n_local : s_.size();
+  const double inf = std::numeric_limits<double>::infinity();
+  double rmin = inf, rmax = 0.0, mmin = inf, mmax = -inf, imin = inf, imax = -inf;
+  for (std::size_t i = 0; i < n; ++i) {
+    rmin = std::min(rmin, s_.radius[i]);
+    rmax = std::max(rmax, s_.radius[i]);
+    mmin = std::min(mmin, s_.mass[i]);
+    mmax = std::max(mmax, s_.mass[i]);
+    imin = std::min(imin, s_.inertia[i]);
+    imax = std::max(imax, s_.inertia[i]);
+  }
+  if (dd_.parallel()) {
+    rmin = global_min(dd_.comm, rmin);
+    rmax = global_max(dd_.comm, rmax);
+    mmin = global_min(dd_.comm, mmin);
+    mmax = global_max(dd_.comm, mmax);
+    imin = global_min(dd_.comm, imin);
+    imax = global_max(dd_.comm, imax);
+  }
+  cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
+  uniform_mass_kg_ = std::isfinite(mmin) && mmin == mmax ? mmin : 0.0;
+  const bool same_r = std::isfinite(rmin) && rmin == rmax && imin == imax;
+  uniform_radius_m_ = same_r ? rmin : 0.0;
+  uniform_inertia_kg_m2_ = same_r ? imin : 0.0;
 }
 
 void DemSystem::set_particle_properties(double r, double rho) {
@@ -112,10 +129,7 @@ void DemSystem::set_particle_properties(double r, double rho) {
     return;
   }
   if (!changed) return;
-  double rmax = 0.0;
-  for (double v : s_.radius) rmax = std::max(rmax, v);
-  cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
-  update_uniform_properties();
+  set_cutoff_and_uniform_properties();
   rebuild();
 }
 

@@ -168,6 +168,8 @@ class DemSystem {
   /// Keeps the particles keep[0] < keep[1] < ... (local ones), with their predicted velocities
   /// and wall histories, in that order.
   void select_particles(const std::vector<std::size_t>& keep);
+  /// The list cutoff (2 r_max + skin) and uniform_mass_kg_, uniform_radius_m_,
+  /// uniform_inertia_kg_m2_ from the particles (collective on several ranks).
   void set_cutoff_and_uniform_properties();
   void compute_forces();
   void kick(double h, bool predict);
@@ -190,8 +192,6 @@ class DemSystem {
   void collect_histories();
   /// Rebuilds prev_wall_contacts_ from the wall histories (after a reordering or a restart).
   void rescan_wall_contacts();
-  /// uniform_mass_kg_, uniform_radius_m_ and uniform_inertia_kg_m2_ from the stored particles.
-  void update_uniform_properties();
   /// r_i + r_j - |x_i - x_j| (minimum image), m; positive when the pair overlaps.
   double pair_overlap(std::size_t i, std::size_t j) const;
   void predict_velocities();

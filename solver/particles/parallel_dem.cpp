@@ -11,7 +11,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <utility>
 #include <vector>
 
@@ -83,31 +82,6 @@ void DemSystem::select_particles(const std::vector<std::size_t>& keep) {
   for (auto& a : pred_) compact_increasing(a, keep);
   for (auto* wh : {&whx_, &why_, &whz_})
     for (auto& a : *wh) compact_increasing(a, keep);
-}
-
-void DemSystem::set_cutoff_and_uniform_properties() {
-  const double inf = std::numeric_limits<double>::infinity();
-  double rmin = inf, rmax = 0.0, mmin = inf, mmax = -inf, imin = inf, imax = -inf;
-  for (std::size_t i = 0; i < s_.n_local; ++i) {
-    rmin = std::min(rmin, s_.radius[i]);
-    rmax = std::max(rmax, s_.radius[i]);
-    mmin = std::min(mmin, s_.mass[i]);
-    mmax = std::max(mmax, s_.mass[i]);
-    imin = std::min(imin, s_.inertia[i]);
-    imax = std::max(imax, s_.inertia[i]);
-  }
-  rmin = global_min(dd_.comm, rmin);
-  rmax = global_max(dd_.comm, rmax);
-  mmin = global_min(dd_.comm, mmin);
-  mmax = global_max(dd_.comm, mmax);
-  imin = global_min(dd_.comm, imin);
-  imax = global_max(dd_.comm, imax);
-  cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
-  uniform_mass_kg_ = std::isfinite(mmin) && mmin == mmax ? mmin : 0.0;
-  // the ghosts are copies of other ranks' particles, so the global extremes cover them too
-  const bool same_r = std::isfinite(rmin) && rmin == rmax && imin == imax;
-  uniform_radius_m_ = same_r ? rmin : 0.0;
-  uniform_inertia_kg_m2_ = same_r ? imin : 0.0;
 }
 
 bool DemSystem::needs_rebuild_parallel() {
