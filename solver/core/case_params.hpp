@@ -123,7 +123,7 @@ struct NumericsParams {
   /// sweep of the momentum equations at the corrected pressure and corrects again (the PISO
   /// corrector inside the iteration): the converged step meets the same simple_tolerance, in
   /// fewer iterations where convection is strong (docs/model.md).
-  std::int64_t simple_correctors = 1;
+  std::int64_t simple_correctors = 2;
   double cfl_max = 0.5;
   double neighbor_skin_m = 0.3e-3;
   std::string void_fraction_kernel = "trilinear_smoothed";

@@ -33,7 +33,7 @@ struct FluidSettings {
   bool piso = false;
   int piso_correctors = 2;
   /// Pressure corrections per SIMPLE iteration (numerics.simple_correctors).
-  int simple_correctors = 1;
+  int simple_correctors = 2;
   /// Builds the settings of a case: grid, fluid, numerics, `[flow]` forcing.
   static FluidSettings from_case(const CaseParams& p);
   /// Pressure-velocity coupling in words ("SIMPLEC", "SIMPLEC, 2 correctors" or "PISO, 2 correctors").

@@ -144,10 +144,16 @@ TEST(CaseParams, IdentityVersion2LeavesOutTheRunLengthAndOutputOnly) {
   validate(c);
   EXPECT_NE(case_id(c), case_id(a));
   // The default case's id under version 2 (a change of the scheme must bump kCaseIdVersion and
-  // migrate stored ids, see driver/store/case_id_migration.cpp). Mei's lift became the default after
-  // it: the default case of earlier builds, Saffman's lift, keeps its id.
-  EXPECT_EQ(case_id(a), "98d95b7d3ced7ffb");
-  CaseParams saffman;
+  // migrate stored ids, see driver/store/case_id_migration.cpp). Mei's lift and then two SIMPLE
+  // correctors became the default after it: a case with the defaults of earlier builds keeps its
+  // id (one corrector: the default case of the build before two; with Saffman's lift too: the
+  // default case of the builds before Mei's).
+  EXPECT_EQ(case_id(a), "53efe1afd84e4584");
+  CaseParams one_corrector;
+  apply_override(one_corrector, "numerics.simple_correctors=1");
+  validate(one_corrector);
+  EXPECT_EQ(case_id(one_corrector), "98d95b7d3ced7ffb");
+  CaseParams saffman = one_corrector;
   apply_override(saffman, "forces.lift=\"saffman\"");
   validate(saffman);
   EXPECT_EQ(case_id(saffman), "feaf57c856c9fbc2");
