@@ -22,9 +22,44 @@ std::vector<SweptValue> setting_of(Database& db, const std::string& case_id) {
   return v;
 }
 
-const SettlingResult& reference_at(const std::vector<SettlingResult>& refs, const std::string& ref_group,
-                                   Database& db, const SettlingResult& run) {
-  std::vector<const SettlingResult*> found;
+/// One (group, setting, angle) of the study with its finished replicas averaged: a curve point
+/// (driver/store/store.hpp), so that replicas count once, as their mean with the standard error
+/// of that mean, and the cost of one of its runs.
+struct Measured {
+  std::string group, case_id;  ///< case_id: the first replica's
+  double angle_deg = 0;
+  double w_m_s = 0, w_err_m_s = 0;  ///< NaN error when a single run gave none
+  int n_replicas = 1;
+  std::vector<std::string> case_ids;
+  std::optional<double> wall_time_s;           ///< mean over the replicas that recorded one
+  std::optional<std::int64_t> particle_steps;  ///< likewise
+};
+
+std::vector<Measured> measured_points(Database& db, const std::string& study) {
+  std::map<std::string, SettlingResult> by_id;
+  for (auto& r : settling_results(db, study)) by_id.try_emplace(r.case_id, std::move(r));
+  std::vector<Measured> out;
+  for (const auto& p : query_curve(db, study)) {
+    Measured m{p.group,      p.case_id,          p.angle_deg, p.w_m_s, p.w_err_m_s.value_or(std::nan("")),
+               p.n_replicas, p.replica_case_ids, {},          {}};
+    double wall = 0.0, steps = 0.0;
+    int n_wall = 0, n_steps = 0;
+    for (const auto& id : p.replica_case_ids) {
+      const auto it = by_id.find(id);
+      if (it == by_id.end()) continue;
+      if (it->second.wall_time_s) wall += *it->second.wall_time_s, ++n_wall;
+      if (it->second.particle_steps) steps += static_cast<double>(*it->second.particle_steps), ++n_steps;
+    }
+    if (n_wall) m.wall_time_s = wall / n_wall;
+    if (n_steps) m.particle_steps = std::llround(steps / n_steps);
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+const Measured& reference_at(const std::vector<Measured>& refs, const std::string& ref_group, Database& db,
+                             const Measured& run) {
+  std::vector<const Measured*> found;
   for (const auto& r : refs)
     if (r.angle_deg == run.angle_deg) found.push_back(&r);
   if (found.empty())
@@ -37,11 +72,10 @@ const SettlingResult& reference_at(const std::vector<SettlingResult>& refs, cons
     for (const auto* r : found)
       names += fmt::format("{}{} ({})", names.empty() ? "" : ", ", r->case_id,
                            report::join_values(setting_of(db, r->case_id)));
-    throw InputError(
-        fmt::format("reference group '{}' has {} finished cases at {} = {:g}: {}; a work-precision reference "
-                    "needs exactly "
-                    "one case per angle",
-                    ref_group, found.size(), kAngleKey, run.angle_deg, names));
+    throw InputError(fmt::format(
+        "reference group '{}' has {} finished cases at {} = {:g} that differ in more than their seed: {}; "
+        "a work-precision reference needs one setting per angle (its replicas are averaged)",
+        ref_group, found.size(), kAngleKey, run.angle_deg, names));
   }
   if (found[0]->w_m_s == 0.0)
     throw InputError(
@@ -80,9 +114,9 @@ WorkPrecision query_work_precision(Database& db, const std::string& study,
                     study, reference_group, names.empty() ? "none" : names));
   }
 
-  std::vector<SettlingResult> refs, runs;
-  for (auto& r : settling_results(db, study))
-    (r.group == reference_group ? refs : runs).push_back(std::move(r));
+  std::vector<Measured> refs, runs;
+  for (auto& m : measured_points(db, study))
+    (m.group == reference_group ? refs : runs).push_back(std::move(m));
 
   WorkPrecision wp{study, reference_group, {}, {}};
   for (const auto& run : runs) {
@@ -96,7 +130,9 @@ WorkPrecision query_work_precision(Database& db, const std::string& study,
     row.particle_steps = run.particle_steps;
     row.w_m_s = run.w_m_s;
     row.w_err_m_s = run.w_err_m_s;
+    row.n_replicas = run.n_replicas;
     row.ref_case_id = ref.case_id;
+    row.ref_n_replicas = ref.n_replicas;
     row.w_ref_m_s = ref.w_m_s;
     row.w_ref_err_m_s = ref.w_err_m_s;
     // e = w/w_ref - 1; de/dw = 1/w_ref, de/dw_ref = -w/w_ref^2 (independent standard errors).
@@ -106,7 +142,8 @@ WorkPrecision query_work_precision(Database& db, const std::string& study,
     wp.rows.push_back(std::move(row));
     if (std::none_of(wp.references.begin(), wp.references.end(),
                      [&](const ReferenceRun& r) { return r.case_id == ref.case_id; }))
-      wp.references.push_back({ref.case_id, ref.angle_deg, ref.w_m_s, ref.w_err_m_s, ref.wall_time_s});
+      wp.references.push_back(
+          {ref.case_id, ref.angle_deg, ref.w_m_s, ref.w_err_m_s, ref.wall_time_s, ref.n_replicas});
   }
 
   // r_acc against the reference's r_acc: the quantity the paper reports, whose error can be far
@@ -149,7 +186,8 @@ std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
                       {"angle_deg", r.angle_deg},
                       {"mean_settling_velocity_m_s", r.w_m_s},
                       {"stderr_m_s", r.w_err_m_s},
-                      {"wall_time_s", opt_json(r.wall_time_s)}});
+                      {"wall_time_s", opt_json(r.wall_time_s)},
+                      {"n_replicas", r.n_replicas}});
     for (const auto& r : wp.rows) {
       nlohmann::json setting = nlohmann::json::object();
       for (const auto& v : r.setting) setting[v.key] = report::value_json(v);
@@ -168,7 +206,9 @@ std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
            {"rel_error_r_acc", opt_json(r.rel_error_r_acc)},
            {"rel_error_r_acc_uncertainty", opt_json(r.rel_error_r_acc_unc)},
            {"case_id", r.case_id},
-           {"reference_case_id", r.ref_case_id}});
+           {"reference_case_id", r.ref_case_id},
+           {"n_replicas", r.n_replicas},
+           {"reference_n_replicas", r.ref_n_replicas}});
     }
     const nlohmann::json j = {
         {"study", wp.study}, {"reference_group", wp.reference_group}, {"references", refs}, {"rows", rows}};
@@ -180,33 +220,38 @@ std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
         "m_s,"
         "reference_stderr_m_s,rel_error_w,rel_error_w_uncertainty,rel_error_r_acc,rel_error_r_acc_"
         "uncertainty,"
-        "case_id,reference_case_id\n";
+        "case_id,reference_case_id,n_replicas,reference_n_replicas\n";
     for (const auto& r : wp.rows)
-      s += fmt::format(
-          "{},{},{:g},{},{},{:.9g},{},{:.9g},{},{:.9g},{},{},{},{},{}\n", report::csv_field(r.group),
-          report::csv_field(report::join_values(r.setting)), r.angle_deg, opt_csv(r.wall_time_s),
-          r.particle_steps ? std::to_string(*r.particle_steps) : "", r.w_m_s, opt_csv(r.w_err_m_s),
-          r.w_ref_m_s, opt_csv(r.w_ref_err_m_s), r.rel_error_w, opt_csv(r.rel_error_w_unc),
-          opt_csv(r.rel_error_r_acc), opt_csv(r.rel_error_r_acc_unc), r.case_id, r.ref_case_id);
+      s += fmt::format("{},{},{:g},{},{},{:.9g},{},{:.9g},{},{:.9g},{},{},{},{},{},{},{}\n",
+                       report::csv_field(r.group), report::csv_field(report::join_values(r.setting)),
+                       r.angle_deg, opt_csv(r.wall_time_s),
+                       r.particle_steps ? std::to_string(*r.particle_steps) : "", r.w_m_s,
+                       opt_csv(r.w_err_m_s), r.w_ref_m_s, opt_csv(r.w_ref_err_m_s), r.rel_error_w,
+                       opt_csv(r.rel_error_w_unc), opt_csv(r.rel_error_r_acc), opt_csv(r.rel_error_r_acc_unc),
+                       r.case_id, r.ref_case_id, r.n_replicas, r.ref_n_replicas);
     return s;
   }
   if (wp.rows.empty())
     return fmt::format("(no finished cases outside the reference group '{}')\n", wp.reference_group);
-  report::TextTable t({"group", "setting", "angle", "wall (s)", "particle steps", "<<w_p>> (mm/s)",
+  report::TextTable t({"group", "setting", "angle", "runs", "wall (s)", "particle steps", "<<w_p>> (mm/s)",
                        "ref (mm/s)", "error <<w_p>>", "error r_acc"},
-                      {false, false, true, true, true, true, true, true, true});
+                      {false, false, true, true, true, true, true, true, true, true});
   for (const auto& r : wp.rows)
     t.add({r.group, report::join_values(r.setting), fmt::format("{:g}", r.angle_deg),
-           r.wall_time_s ? report::seconds(*r.wall_time_s) : "-",
+           std::to_string(r.n_replicas), r.wall_time_s ? report::seconds(*r.wall_time_s) : "-",
            r.particle_steps ? std::to_string(*r.particle_steps) : "-", fmt::format("{:.4f}", r.w_m_s * 1e3),
            fmt::format("{:.4f}", r.w_ref_m_s * 1e3), percent_pm(r.rel_error_w, r.rel_error_w_unc),
            r.rel_error_r_acc ? percent_pm(*r.rel_error_r_acc, *r.rel_error_r_acc_unc) : "-"});
   std::string s = t.str();
   for (const auto& r : wp.references)
-    s += fmt::format("reference '{}' at {:g} deg: <<w_p>> {:.4f} +- {} mm/s, wall {} s, case {}\n",
+    s += fmt::format("reference '{}' at {:g} deg: <<w_p>> {:.4f} +- {} mm/s, wall {} s, case {}{}\n",
                      wp.reference_group, r.angle_deg, r.w_m_s * 1e3,
                      std::isnan(r.w_err_m_s) ? std::string("n/a") : fmt::format("{:.4f}", r.w_err_m_s * 1e3),
-                     r.wall_time_s ? report::seconds(*r.wall_time_s) : "-", r.case_id);
+                     r.wall_time_s ? report::seconds(*r.wall_time_s) : "-", r.case_id,
+                     r.n_replicas > 1
+                         ? fmt::format(" and {} more replicas (mean and its standard error; wall: one run's)",
+                                       r.n_replicas - 1)
+                         : "");
   return s;
 }
 

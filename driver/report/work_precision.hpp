@@ -1,8 +1,11 @@
 #pragma once
 // Error against run time: a work-precision study has one group of fine
 // reference runs (default name "reference") and groups that each change one setting (time.dt_dem,
-// domain.cells, ...), all over the same gravity.angle_deg values. Every finished case outside the
-// reference group is compared with the reference case of its angle.
+// domain.cells, ...), all over the same gravity.angle_deg values. Every finished point outside the
+// reference group is compared with the reference point of its angle. A point is a (group,
+// setting, angle) with its finished replicas (`replicas` in the study): their mean, the standard
+// error of that mean (their scatter; one run's own error without replicas) and the mean cost of
+// one of its runs, as the curve has them (driver/store/store.hpp, CurvePoint).
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -20,10 +23,12 @@ struct WorkPrecisionRow {
   std::vector<SweptValue> setting;  ///< the case's swept values without gravity.angle_deg
   double angle_deg = 0;
   std::optional<double> wall_time_s;
-  std::optional<std::int64_t> particle_steps;
-  double w_m_s = 0, w_err_m_s = 0;  ///< <<w_p>> and its standard error
+  std::optional<std::int64_t> particle_steps;  ///< with wall_time_s: one run's, the mean over replicas
+  double w_m_s = 0, w_err_m_s = 0;             ///< <<w_p>> and its standard error
+  int n_replicas = 1;                          ///< the runs averaged; case_id is the first one's
   std::string ref_case_id;
   double w_ref_m_s = 0, w_ref_err_m_s = 0;
+  int ref_n_replicas = 1;
   /// w / w_ref - 1: positive when the case settles faster than the reference (both velocities
   /// have the sign of gravity, so this is (|w| - |w_ref|)/|w_ref| whenever w and w_ref agree in sign).
   double rel_error_w = 0;
@@ -38,6 +43,7 @@ struct ReferenceRun {
   double angle_deg = 0;
   double w_m_s = 0, w_err_m_s = 0;
   std::optional<double> wall_time_s;
+  int n_replicas = 1;
 };
 
 struct WorkPrecision {
@@ -48,7 +54,8 @@ struct WorkPrecision {
 
 /// InputError when the study or the reference group does not exist, when a case has no finished
 /// reference case at its angle (naming the group and the angle), when the reference group has
-/// several finished cases at one angle (naming them), or when a reference <<w_p>> is zero.
+/// cases of several settings at one angle (naming them; replicas of one setting are averaged), or
+/// when a reference <<w_p>> is zero.
 WorkPrecision query_work_precision(Database& db, const std::string& study,
                                    const std::string& reference_group = "reference");
 

@@ -233,6 +233,67 @@ seed = [1, 2]
   for (const auto& id : ref_ids) EXPECT_NE(msg.find(id), std::string::npos) << msg;
 }
 
+TEST(WorkPrecision, ReplicasOfAPointCountOnceAsTheirMeanWithTheirStandardErrorAndOneRunsCost) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  // Two replicas (seeds 1 and 2) of every point, the reference's among them.
+  const auto study = bd::expand_study_string(R"(
+name = "wp3"
+replicas = 2
+[base.time]
+end = 2.0
+average_from = 1.0
+[[group]]
+name = "reference"
+set = { "time.dt_dem" = 1e-5 }
+[[group]]
+name = "dt_dem"
+set = { "time.dt_dem" = 4e-5 }
+[matrix]
+"gravity.angle_deg" = [65, 90]
+)");
+  bd::register_study(db, study);
+  ASSERT_EQ(study.cases.size(), 8u);
+  // Each point's replicas at its centre -+ a half-spread h: mean the centre, standard error of
+  // the mean sd / sqrt(2) = (h sqrt(2)) / sqrt(2) = h; wall times 10 and 30 s (one run: 20).
+  const std::map<std::pair<std::string, double>, std::pair<double, double>> centre_h = {
+      {{"reference", 65}, {-0.1, 0.001}},
+      {{"reference", 90}, {-0.08, 0.0008}},
+      {{"dt_dem", 65}, {-0.11, 0.002}},
+      {{"dt_dem", 90}, {-0.084, 0.0004}}};
+  for (const auto& c : study.cases) {
+    const auto [w, h] = centre_h.at({c.group, c.params.gravity.angle_deg});
+    const bool first = c.replica == 0;
+    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id,
+                      summary_of(c, {first ? w - h : w + h, 0.01, first ? 10.0 : 30.0}));
+  }
+  const auto wp = bd::query_work_precision(db, "wp3");
+  ASSERT_EQ(wp.rows.size(), 2u);
+  ASSERT_EQ(wp.references.size(), 2u);
+  const auto& r65 = row(wp, "dt_dem", 65);
+  EXPECT_EQ(r65.n_replicas, 2);
+  EXPECT_EQ(r65.ref_n_replicas, 2);
+  EXPECT_NEAR(r65.w_m_s, -0.11, 1e-15);
+  EXPECT_NEAR(r65.w_err_m_s, 0.002, 1e-15);  // the replicas' scatter, not their own 0.01
+  EXPECT_NEAR(r65.w_ref_m_s, -0.1, 1e-15);
+  EXPECT_NEAR(r65.w_ref_err_m_s, 0.001, 1e-15);
+  EXPECT_NEAR(r65.rel_error_w, 0.1, 1e-12);
+  EXPECT_NEAR(r65.rel_error_w_unc, std::hypot(0.002 / 0.1, 0.11 * 0.001 / 0.01), 1e-12);
+  ASSERT_TRUE(r65.wall_time_s.has_value());
+  EXPECT_DOUBLE_EQ(*r65.wall_time_s, 20.0);
+  // r_acc from the means: (0.11 / 0.084) / (0.1 / 0.08) - 1.
+  ASSERT_TRUE(r65.rel_error_r_acc.has_value());
+  EXPECT_NEAR(*r65.rel_error_r_acc, (0.11 / 0.084) / (0.1 / 0.08) - 1.0, 1e-12);
+  EXPECT_EQ(wp.references[0].n_replicas, 2);
+  EXPECT_DOUBLE_EQ(*wp.references[0].wall_time_s, 20.0);
+  const auto json = nlohmann::json::parse(bd::format_work_precision(wp, bd::ListingFormat::kJson));
+  EXPECT_EQ(json["rows"][0]["n_replicas"], 2);
+  EXPECT_EQ(json["rows"][0]["reference_n_replicas"], 2);
+  const auto csv = bd::format_work_precision(wp, bd::ListingFormat::kCsv);
+  EXPECT_NE(csv.find("case_id,reference_case_id,n_replicas,reference_n_replicas\n"), std::string::npos)
+      << csv;
+}
+
 // Occurrences of `needle` in `s`.
 std::size_t count_in(const std::string& s, const std::string& needle) {
   std::size_t n = 0;
