@@ -30,7 +30,6 @@ struct Measured {
   double angle_deg = 0;
   double w_m_s = 0, w_err_m_s = 0;  ///< NaN error when a single run gave none
   int n_replicas = 1;
-  std::vector<std::string> case_ids;
   std::optional<double> wall_time_s;           ///< mean over the replicas that recorded one
   std::optional<std::int64_t> particle_steps;  ///< likewise
 };
@@ -40,8 +39,8 @@ std::vector<Measured> measured_points(Database& db, const std::string& study) {
   for (auto& r : settling_results(db, study)) by_id.try_emplace(r.case_id, std::move(r));
   std::vector<Measured> out;
   for (const auto& p : query_curve(db, study)) {
-    Measured m{p.group,      p.case_id,          p.angle_deg, p.w_m_s, p.w_err_m_s.value_or(std::nan("")),
-               p.n_replicas, p.replica_case_ids, {},          {}};
+    Measured m{p.group,      p.case_id, p.angle_deg, p.w_m_s, p.w_err_m_s.value_or(std::nan("")),
+               p.n_replicas, {},        {}};
     double wall = 0.0, steps = 0.0;
     int n_wall = 0, n_steps = 0;
     for (const auto& id : p.replica_case_ids) {
