@@ -202,12 +202,11 @@ TEST(WorkPrecision, MissingReferenceIsAnInputErrorNamingTheGroupAndAngle) {
             std::string::npos);
 }
 
-TEST(WorkPrecision, TwoReferenceCasesAtOneAngleAreAnInputErrorNamingThem) {
-  TempDir d;
-  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
-  // Two seeds per angle make the reference group ambiguous.
-  const auto study = bd::expand_study_string(R"(
-name = "wp2"
+namespace {
+// A fine reference group and one with a coarser DEM step; `head`: the study's top-level keys,
+// `matrix`: its [matrix] lines.
+bd::Study dt_dem_study(const std::string& head, const std::string& matrix) {
+  return bd::expand_study_string(head + R"(
 [base.time]
 end = 2.0
 average_from = 1.0
@@ -218,9 +217,15 @@ set = { "time.dt_dem" = 1e-5 }
 name = "dt_dem"
 set = { "time.dt_dem" = 4e-5 }
 [matrix]
-"gravity.angle_deg" = [90]
-seed = [1, 2]
-)");
+)" + matrix);
+}
+}  // namespace
+
+TEST(WorkPrecision, TwoReferenceCasesAtOneAngleAreAnInputErrorNamingThem) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  // Two seeds per angle make the reference group ambiguous.
+  const auto study = dt_dem_study("name = \"wp2\"", "\"gravity.angle_deg\" = [90]\nseed = [1, 2]\n");
   bd::register_study(db, study);
   std::vector<std::string> ref_ids;
   for (const auto& c : study.cases) {
@@ -237,21 +242,7 @@ TEST(WorkPrecision, ReplicasOfAPointCountOnceAsTheirMeanWithTheirStandardErrorAn
   TempDir d;
   bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
   // Two replicas (seeds 1 and 2) of every point, the reference's among them.
-  const auto study = bd::expand_study_string(R"(
-name = "wp3"
-replicas = 2
-[base.time]
-end = 2.0
-average_from = 1.0
-[[group]]
-name = "reference"
-set = { "time.dt_dem" = 1e-5 }
-[[group]]
-name = "dt_dem"
-set = { "time.dt_dem" = 4e-5 }
-[matrix]
-"gravity.angle_deg" = [65, 90]
-)");
+  const auto study = dt_dem_study("name = \"wp3\"\nreplicas = 2", "\"gravity.angle_deg\" = [65, 90]\n");
   bd::register_study(db, study);
   ASSERT_EQ(study.cases.size(), 8u);
   // Each point's replicas at its centre -+ a half-spread h: mean the centre, standard error of
