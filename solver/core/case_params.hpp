@@ -1,8 +1,10 @@
 #pragma once
 // The case: one plain struct of parameters with Table III defaults (Zeng et al. 2021), units in
-// the names. Every key appears once, in the key table (case_key_table.hpp), which parsing and
-// overrides (case_parse.cpp), validation (case_rules.cpp), serialisation and the case id
-// (case_params.cpp) all read, so adding a key means editing that table only.
+// the names; a member's initializer is its key's default. Every key appears once in the key table
+// (case_key_table.hpp: name, member, limits, unit, meaning, and for a name its choices from
+// model_names.hpp), which parsing and overrides (case_parse.cpp), validation (case_rules.cpp),
+// serialisation and the case id (case_params.cpp) and `case keys` (key_docs.cpp) all read: adding
+// a key means a member here and a line in that table.
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -23,8 +25,8 @@ inline bool is_set(double v) {
 
 struct FluidParams {
   double density_kg_m3 = 1000.0;
-  double viscosity_pa_s = 1.0e-3;        ///< dynamic viscosity
-  std::string subgrid_model = "vreman";  ///< "vreman" | "none"
+  double viscosity_pa_s = 1.0e-3;  ///< dynamic viscosity
+  std::string subgrid_model = "vreman";
 };
 
 struct ParticleParams {
@@ -57,7 +59,7 @@ struct DomainParams {
   double height_z_m = 0.1;                            ///< periodic, settling direction
   std::array<std::int64_t, 3> cells = {200, 6, 100};  ///< x, y, z
   bool periodic_y = false;
-  std::string top_wall = "no_slip";  ///< fluid condition at y = W: "no_slip" | "slip"
+  std::string top_wall = "no_slip";  ///< fluid condition at y = W
 };
 
 struct GravityParams {
@@ -87,11 +89,10 @@ struct TimeParams {
 };
 
 struct ForceParams {
-  std::string drag = "difelice_paper";  ///< "difelice_paper" | "schiller_naumann" | "stokes" | "none"
+  std::string drag = "difelice_paper";
   bool saffman_lift = true;
-  /// The shear lift law while saffman_lift is on: "saffman" (Eq. 16), "saffman_mei" (Mei's
-  /// finite-Re factor) or "none" (coupling/lift_laws.hpp). saffman_lift = false means "none".
-  /// Mei's by default: at the Re_p of 20-50 of these suspensions Saffman's law is outside its
+  /// The shear lift law while saffman_lift is on (coupling/lift_laws.hpp); saffman_lift = false
+  /// means "none". Mei's by default: at the Re_p of 20-50 of these suspensions Saffman's law is outside its
   /// validity (Re_p << Re_w^1/2 << 1) and imprints the grid on the particles (docs/validation.md,
   /// "Across the gap"). Cases of earlier builds ran "saffman" and keep their ids.
   std::string lift = "saffman_mei";

@@ -1,6 +1,6 @@
 #pragma once
-// Unit and one line of meaning for every case key, for `boycott case keys` (and its JSON). A test
-// checks that every name of case_key_names() has an entry here, so a new key cannot go undocumented.
+// Unit and one line of meaning of every case key, for `boycott case keys` (and its JSON), read
+// from the key table (case_key_table.hpp), where each key is declared once.
 #include <optional>
 #include <string>
 #include <string_view>
@@ -8,9 +8,9 @@
 namespace boycott {
 
 struct KeyDoc {
-  std::string_view key;
-  std::string_view unit;  ///< SI unit, "-" for a pure number, "" for a name or a flag
-  std::string_view meaning;
+  std::string key;
+  std::string unit;  ///< SI unit, "-" for a pure number, "" for a name or a flag
+  std::string meaning;
 };
 
 /// The entry of a dotted key ("time.dt_dem"); empty when there is none.

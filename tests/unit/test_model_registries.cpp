@@ -93,6 +93,18 @@ TEST(KeyDocs, EveryCaseKeyHasAUnitAndAMeaning) {
   EXPECT_FALSE(key_doc("fluid.viscosty").has_value());
 }
 
+TEST(KeyDocs, UnitsAndChoicesComeFromTheKeyTable) {
+  // One table declares each key: its unit is the rule's, a name key lists its model list.
+  EXPECT_EQ(key_doc("fluid.viscosity")->unit, "Pa s");
+  EXPECT_EQ(key_doc("particles.count")->unit, "-");   // a pure number
+  EXPECT_EQ(key_doc("forces.added_mass")->unit, "");  // a flag
+  EXPECT_EQ(key_doc("forces.drag")->unit, "");        // a name
+  for (const auto& law : drag_law_names())
+    EXPECT_NE(key_doc("forces.drag")->meaning.find(law), std::string::npos) << law;
+  for (const auto& law : lift_law_names())
+    EXPECT_NE(key_doc("forces.lift")->meaning.find(law), std::string::npos) << law;
+}
+
 TEST(KeyDocs, MisspeltKeysSuggestTheNearestAndUnrelatedWordsNothing) {
   EXPECT_EQ(did_you_mean("fluid.viscosty"), " (did you mean 'fluid.viscosity'?)");
   EXPECT_EQ(did_you_mean("time.dt_dme"), " (did you mean 'time.dt_dem'?)");
