@@ -8,7 +8,7 @@
 #   solver/**/CMakeLists.txt and driver/**/CMakeLists.txt: add_library / add_executable /
 #   target_sources (which files a target compiles), target_link_libraries (what it links), and
 #   set() / list(APPEND) for source variables. Only targets defined there count (boycott_*);
-#   PkgConfig::, fmt::, ... are ignored.
+#   PkgConfig::, fmt::, ... are ignored. A link written $<LINK_LIBRARY:FEATURE,lib> links lib.
 #
 # Which target a file belongs to
 #   1. A file listed in a target's sources belongs to that target (to each, if several list it).
@@ -34,7 +34,7 @@
 #        solver/io/x.cpp:12 includes coupling/kernels.hpp: io does not link coupling
 #   2. A direct boycott_* link L of target T is unused when no file of T (its sources and its
 #      headers) includes a header of L or of a target that only L brings in (one that T's other
-#      direct links do not also bring in):
+#      direct links do not also bring in); a target that owns no file (a link wrapper) is exempt:
 #        solver/io/CMakeLists.txt:3 io links coupling but includes nothing of it ...
 #   Includes inside comments and `#if 0` blocks are ignored. Headers that resolve nowhere (system
 #   and third-party ones) are ignored; a missing project header (first path component a solver/
@@ -226,6 +226,10 @@ def parse_cmake(root, warnings):
                         continue
                     else:
                         for item in expand(a):
+                            # $<LINK_LIBRARY:WHOLE_ARCHIVE,lib> links lib (with a linker feature).
+                            m = re.fullmatch(r"\$<LINK_LIBRARY:[A-Za-z_]+,([A-Za-z0-9_]+)>", item)
+                            if m:
+                                item = m.group(1)
                             pending_links.append((args[0], item, public, rel_cmake, line))
     for name, args, add in pending_sources:
         if name in targets:
@@ -422,9 +426,11 @@ class Checker:
     def run(self):
         violations = []
         uses = {name: set() for name in self.targets}  # target -> targets whose headers it includes
+        owns_files = set()  # targets that own at least one file
         n_files = n_includes = 0
         for rel in self.code_files():
             mine = self.owners(rel)
+            owns_files.update(mine)
             if not mine:
                 what = "no target lists it" if rel.endswith(SOURCE_EXTS) else \
                     "no CMakeLists.txt in its folder or above defines a target"
@@ -452,6 +458,10 @@ class Checker:
                                                       f"{self.targets[t].short()} does not link "
                                                       f"{self.targets[owner].short()}"))
         for t in self.targets.values():
+            # A target of no files (an INTERFACE library that only passes links on, such as the
+            # scenes' whole-archive wrapper) uses its links by definition.
+            if t.name not in owns_files:
+                continue
             direct = [l[0] for l in t.links]
             for dep, _, cmake_file, line in t.links:
                 others = set()

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "checks/check_case.hpp"
 #include "core/case_params.hpp"
 #include "core/error.hpp"
 #include "core/key_docs.hpp"
@@ -26,7 +27,7 @@
 #include "driver/store/store.hpp"
 #include "fluid/petsc_session.hpp"
 #include "io/atomic_file.hpp"
-#include "scenes/preflight.hpp"
+#include "runs/run_case.hpp"
 #include "scenes/scene.hpp"
 #include "scenes/summarize.hpp"
 
@@ -151,7 +152,9 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv) {
     ctx.progress_note = [&](const std::string& s) { progress.note(s); };
   }
   try {
-    const int rc = scenes::run_case(p, ctx);
+    // The key rules were applied as the file was loaded; the pre-flight is on this run's ranks.
+    const checks::Preflight pre = checks::preflight_case(p, runs::run_ranks(), false);
+    const int rc = runs::run_case(p, pre, ctx);
     if (rank == 0 && !opt.quiet) {
       progress.finish();
       print_outcome(ctx.out_dir);
@@ -180,7 +183,7 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv) {
 
 int case_check(const std::string& file, const std::vector<std::string>& sets) {
   CaseParams p = load_case_file(file, sets);
-  const scenes::Preflight pre = scenes::check_case(p, 1, false);
+  const checks::Preflight pre = checks::preflight_case(p, 1, false);
   std::printf("case %s (scene %s): %s\n", case_id(p).c_str(), p.scene.c_str(),
               pre.errors.empty()
                   ? (pre.warnings.empty() && pre.machine_errors.empty() ? "valid" : "valid, with warnings")

@@ -10,13 +10,13 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "checks/check_case.hpp"
 #include "core/case_toml.hpp"
 #include "core/error.hpp"
 #include "core/input_file.hpp"
 #include "core/key_docs.hpp"
 #include "core/scene_specs.hpp"
 #include "core/toml_lookup.hpp"
-#include "scenes/preflight.hpp"
 
 namespace boycott::driver {
 namespace {
@@ -343,7 +343,7 @@ void expand_group(Study& s, const Group& g, const CaseParams& base, const std::v
     try {
       // Completely, pre-flight included: a case that cannot work is refused when the study is
       // read (by every command that reads it), not when its solver starts.
-      scenes::check_case(c.params);
+      checks::check_case(c.params);
     } catch (const InputError& e) {
       throw InputError(fmt::format("{}: {}", label, e.what()), e.key());
     }
@@ -442,7 +442,7 @@ StudyCase replica_of(const StudyCase& replica0, int k) {
   c.replica = k;
   c.point_id = replica0.id;
   apply_value(c.params, "seed", toml::value<std::int64_t>(replica0.params.seed + k));
-  scenes::check_case(c.params);
+  checks::check_case(c.params);
   c.id = case_id(c.params);
   return c;
 }

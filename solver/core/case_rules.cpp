@@ -84,8 +84,8 @@ void resolve_defaults(CaseParams& p, const SceneSpec& sc) {
     if (!is_set_key(p, key)) set_key(p, key, value);
   const bool reads_count = scene_reads(sc, "particles.count");
   if (!reads_count) {
-    // single_particle is one sphere by definition; scenes without particles have none.
-    p.particles.count = sc.name == "single_particle" ? 1 : 0;
+    // One sphere by definition (single_particle), or none.
+    p.particles.count = sc.fixed_particle_count;
     p.particles.volume_fraction = kUnset;
   } else if (!is_set_key(p, "particles.count") && !is_set(p.particles.volume_fraction)) {
     // Neither given: the scene's solid fraction (Table III's unless the scene has its own) in the
@@ -107,7 +107,9 @@ void resolve_defaults(CaseParams& p, const SceneSpec& sc) {
 }  // namespace
 
 namespace {
-void check_case(CaseParams& p) {
+
+/// Each key against its own limits (a NaN the user wrote is a value, and not a finite one).
+void check_each_key(CaseParams& p) {
   visit_keys(p, [&](const char* key, auto& ref, const Rule& r) {
     check_value(key, ref, r);
     // An optional key's NaN means "not set"; set by the user, it is a value, and not a finite one.
@@ -115,16 +117,20 @@ void check_case(CaseParams& p) {
       if (std::isnan(ref) && is_set_key(p, key) && !p.resolved)
         throw InputError(fmt::format("{} = nan is not a finite number", key));
   });
-  const SceneSpec& sc = scene_spec(p.scene);
+}
+
+void refuse_keys_the_scene_does_not_read(const CaseParams& p, const SceneSpec& sc) {
   for (const auto& key : p.set_keys)
     if (key != "scene" && !scene_reads(sc, key))
       throw InputError(
           fmt::format("{} is not used by scene {}: the scene would ignore or overwrite it (`boycott "
                       "case keys --scene {}` lists the keys it reads)",
                       key, sc.name, sc.name));
-  if (!p.resolved) resolve_defaults(p, sc);
-  const auto reads = [&](const char* key) { return scene_reads(sc, key); };
+}
 
+/// The particles fit the channel, the periodic lengths and the box.
+void check_particles_fit(const CaseParams& p, const SceneSpec& sc) {
+  const auto reads = [&](const char* key) { return scene_reads(sc, key); };
   const double d = p.particles.diameter_m;
   const bool particles = reads("particles.diameter");
   if (particles && !p.domain.periodic_y && d >= p.domain.width_y_m)
@@ -157,14 +163,18 @@ void check_case(CaseParams& p) {
         fmt::format("particles.count = {} (solid fraction {:.4f}) is too dense for random insertion: must be "
                     "<= 0.45; use particles.insertion = \"bed\" or \"packed\"",
                     p.particles.count, ap));
-
   // A scene that places particles measures them: none is nothing to measure (a settling
   // velocity of 0 would be stored as a result).
   if (sc.has_particles && reads("particles.count") && p.particles.count < 1)
     throw InputError(fmt::format("particles.count = {}: scene {} needs at least one particle",
                                  p.particles.count, sc.name));
+}
+
+/// The DEM step under the spring limit, whole sub-steps per fluid step, and a run that ends.
+void check_time_steps(const CaseParams& p, const SceneSpec& sc) {
+  const auto reads = [&](const char* key) { return scene_reads(sc, key); };
   const double limit = p.dem_spring_limit_s();
-  if (particles && p.particles.count > 0 && reads("time.dt_dem") && p.time.dt_dem_s > limit)
+  if (reads("particles.diameter") && p.particles.count > 0 && reads("time.dt_dem") && p.time.dt_dem_s > limit)
     throw InputError(fmt::format(
         "time.dt_dem = {:.4g} us exceeds the spring limit (pi/5) sqrt(m/k_n) = {:.4g} us for "
         "contact.stiffness = {} N/m "
@@ -188,6 +198,18 @@ void check_case(CaseParams& p) {
                       "most {:g} (a stop drops the unfinished fluid step; the paper's cases take 50)",
                       ratio, kMaxSubsteps));
   }
+  // A step so small that the run would not end in any time a machine has.
+  constexpr double kMaxSteps = 1e12;
+  for (auto [key, dt] : {std::pair{"time.dt_dem", p.time.dt_dem_s}, {"time.dt_cfd", p.time.dt_cfd_s}})
+    if (reads(key) && reads("time.end") && p.time.end_s / dt > kMaxSteps)
+      throw InputError(
+          fmt::format("{} = {} s would take {:.3g} steps to time.end = {} s: must be at most {:g}", key,
+                      fmt_num(dt), p.time.end_s / dt, fmt_num(p.time.end_s), kMaxSteps));
+}
+
+/// Model and numerics keys that contradict each other or that the solver cannot represent.
+void check_models_and_grid(const CaseParams& p, const SceneSpec& sc) {
+  const auto reads = [&](const char* key) { return scene_reads(sc, key); };
   // The SIMPLE iteration is SIMPLEC (fluid/pressure_correction.cpp), whose pressure correction
   // is consistent with its velocity correction and is applied whole: a relaxation factor would be
   // silently ignored, yet change the case id. The key stays for case files that spell out its
@@ -199,13 +221,6 @@ void check_case(CaseParams& p) {
         "SIMPLEC, which applies its pressure correction whole; to damp the iteration use "
         "numerics.velocity_relaxation",
         fmt_num(p.numerics.pressure_relaxation), fmt_num(NumericsParams{}.pressure_relaxation)));
-  // A step so small that the run would not end in any time a machine has.
-  constexpr double kMaxSteps = 1e12;
-  for (auto [key, dt] : {std::pair{"time.dt_dem", p.time.dt_dem_s}, {"time.dt_cfd", p.time.dt_cfd_s}})
-    if (reads(key) && reads("time.end") && p.time.end_s / dt > kMaxSteps)
-      throw InputError(
-          fmt::format("{} = {} s would take {:.3g} steps to time.end = {} s: must be at most {:g}", key,
-                      fmt_num(dt), p.time.end_s / dt, fmt_num(p.time.end_s), kMaxSteps));
   // A law other than the default named beside saffman_lift = false (a case written back with every
   // key holds the default law there, which the switch turns off).
   if (reads("forces.lift") && !p.forces.saffman_lift && p.forces.lift != ForceParams{}.lift &&
@@ -216,13 +231,21 @@ void check_case(CaseParams& p) {
                     p.forces.lift));
   // The fluid grid needs two cells per direction (its stencils and wall rules): refused here, before
   // a run folder is written, not when the solver is built.
-  if (reads("domain.cells") && p.scene != "dem_only")
+  if (reads("domain.cells") && sc.has_fluid)
     for (int d = 0; d < 3; ++d)
       if (p.domain.cells[d] < 2)
         throw InputError(fmt::format(
             "domain.cells = [{}, {}, {}]: the fluid grid needs at least 2 cells per "
             "direction ({} has {})",
             p.domain.cells[0], p.domain.cells[1], p.domain.cells[2], "xyz"[d], p.domain.cells[d]));
+  if (reads("numerics.neighbor_skin") && p.numerics.neighbor_skin_m > p.particles.diameter_m)
+    throw InputError(fmt::format("numerics.neighbor_skin = {} m must be <= particles.diameter = {} m",
+                                 fmt_num(p.numerics.neighbor_skin_m), fmt_num(p.particles.diameter_m)));
+}
+
+/// Output times (each writes a file) and the averaging window.
+void check_outputs_and_window(const CaseParams& p, const SceneSpec& sc) {
+  const auto reads = [&](const char* key) { return scene_reads(sc, key); };
   // Each time writes a file: a bounded number of them, none twice.
   for (auto [key, times] : {std::pair{"output.snapshot_times", &p.output.snapshot_times_s},
                             std::pair{"output.image_times", &p.output.image_times_s}}) {
@@ -248,19 +271,28 @@ void check_case(CaseParams& p) {
     throw InputError(fmt::format(
         "time.average_from = {} s{} must be < time.end = {} s", fmt_num(p.time.average_from.time_s),
         is_set_key(p, "time.average_from") ? "" : " (Table III's default)", fmt_num(p.time.end_s)));
-  if (reads("numerics.neighbor_skin") && p.numerics.neighbor_skin_m > d)
-    throw InputError(fmt::format("numerics.neighbor_skin = {} m must be <= particles.diameter = {} m",
-                                 fmt_num(p.numerics.neighbor_skin_m), fmt_num(d)));
+}
+
+/// The key rules, in order: each key alone, the scene's keys and defaults, the limits between keys.
+void check_key_rules(CaseParams& p) {
+  check_each_key(p);
+  const SceneSpec& sc = scene_spec(p.scene);
+  refuse_keys_the_scene_does_not_read(p, sc);
+  if (!p.resolved) resolve_defaults(p, sc);
+  check_particles_fit(p, sc);
+  check_time_steps(p, sc);
+  check_models_and_grid(p, sc);
+  check_outputs_and_window(p, sc);
 }
 
 }  // namespace
 
 void validate(CaseParams& p) {
   try {
-    check_case(p);
+    check_key_rules(p);
   } catch (const InputError& e) {
     if (!e.key().empty()) throw;
-    // Every message of check_case begins with the key at fault ("time.dt_dem = ..."): named as the
+    // Every message of check_key_rules begins with the key at fault ("time.dt_dem = ..."): named as the
     // error's key, a caller holding the file can say which line set it.
     std::string key;
     const std::string what = e.what();

@@ -14,7 +14,7 @@
 #include "core/timers.hpp"
 #include "fluid/fluid_solver.hpp"
 #include "scenes/run_common.hpp"
-#include "scenes/scenes_list.hpp"
+#include "scenes/scene.hpp"
 
 namespace boycott::scenes {
 
@@ -156,5 +156,16 @@ int run_channel_flow(const CaseParams& p, RunContext& ctx) {
         j["max_rel_error_vs_analytic"].dump().c_str());
   return interrupted ? kExitInterrupted : kExitOk;
 }
+
+const SceneRegistration kRegistered{
+    {.name = "channel_flow",
+     .measures = "fluid alone: mean and centreline velocity against plane Poiseuille",
+     .reads = {"fluid.", "domain.", "time.dt_cfd", "time.end", "flow.", "numerics.simple_max_iterations",
+               "numerics.simple_tolerance", "numerics.velocity_relaxation", "numerics.pressure_relaxation",
+               "numerics.pressure_velocity_coupling", "numerics.piso_correctors",
+               "numerics.simple_correctors", "numerics.cfl_max", "output.timeseries_every"},
+     .defaults = {{"fluid.subgrid_model", "\"none\""}},
+     .has_particles = false},
+    &run_channel_flow};
 
 }  // namespace boycott::scenes

@@ -15,17 +15,12 @@
 #include "particles/dem_system.hpp"
 #include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
-#include "scenes/scenes_list.hpp"
+#include "scenes/scene.hpp"
 
 namespace boycott::scenes {
 
 int run_dem_only(const CaseParams& p, RunContext& ctx) {
   WallClock clock;
-  if (p.forces.drag != "stokes" && p.forces.drag != "none")
-    throw InputError(
-        fmt::format("forces.drag = \"{}\": the dem_only scene has no fluid; use \"stokes\" (drag "
-                    "against still fluid) or \"none\"",
-                    p.forces.drag));
   ModelTimers timers;
   auto dc = particles::DemConfig::from_case(p);
   dc.dry = true;  // no fluid arrays in the kicks; Stokes drag is the beta toward rest
@@ -134,5 +129,30 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   return exit_code;
 }
+
+namespace {
+
+/// No fluid: a drag against still fluid (Stokes) or none.
+void dem_only_checks(const CaseParams& p, SceneFindings& f) {
+  if (p.forces.drag != "none" && p.forces.drag != "stokes")
+    f.errors.push_back(
+        fmt::format("forces.drag = \"{}\": the dem_only scene has no fluid; use \"stokes\" (drag "
+                    "against still fluid) or \"none\"",
+                    p.forces.drag));
+}
+
+}  // namespace
+
+const SceneRegistration kRegistered{
+    {.name = "dem_only",
+     .measures = "particles alone (optionally a Stokes drag against still fluid): <<w_p>>, contacts, speed",
+     .reads = {"seed", "particles.", "contact.", "domain.length_x", "domain.width_y", "domain.height_z",
+               "domain.periodic_y", "gravity.", "time.dt_dem", "time.dt_cfd", "time.end", "time.average_from",
+               "forces.drag", "fluid.viscosity", "numerics.neighbor_skin", "output.timeseries_every"},
+     .defaults = {{"forces.drag", "\"none\""}},
+     .default_solid_fraction = table3_solid_fraction(),
+     .has_fluid = false,
+     .own_checks = &dem_only_checks},
+    &run_dem_only};
 
 }  // namespace boycott::scenes

@@ -17,7 +17,7 @@
 #include "coupling/coupled_system.hpp"
 #include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
-#include "scenes/scenes_list.hpp"
+#include "scenes/scene.hpp"
 
 namespace boycott::scenes {
 
@@ -112,5 +112,20 @@ int run_ergun(const CaseParams& p, RunContext& ctx) {
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   return exit_code;
 }
+
+const SceneRegistration kRegistered{
+    {.name = "ergun",
+     .measures = "f* against Re*_p through a packed, frozen bed, beside the Ergun equation",
+     .reads = {"seed", "fluid.", "particles.", "contact.", "domain.", "time.dt_cfd", "time.dt_dem", "forces.",
+               "numerics.", "ergun."},
+     .defaults = {{"domain.periodic_y", "true"},
+                  {"particles.insertion", "\"packed\""},
+                  {"fluid.subgrid_model", "\"none\""},
+                  {"forces.saffman_lift", "false"},
+                  {"forces.added_mass", "false"}},
+     .default_solid_fraction = 0.64,
+     .particles_move = false,
+     .tolerances = {{"max_rel_error_f_star", 0.005, "the Ergun equation (the paper's 0.5 %)"}}},
+    &run_ergun};
 
 }  // namespace boycott::scenes

@@ -2,6 +2,15 @@
 // A scene is a function from a validated case to a finished run folder (summary.json,
 // timeseries.csv, ...). Scenes switch on only the physics they need and record it in
 // ModelTimers, which every summary lists.
+//
+// Each scene is one file of this folder that declares itself at namespace scope:
+//
+//   const SceneRegistration kRegistered{{.name = "my_scene", .measures = "...", .reads = {...},
+//                                        .own_checks = &my_checks},
+//                                       &run_my_scene};
+//
+// and one line in this folder's CMakeLists.txt. The declaration enters core's scene table (its
+// keys, defaults and checks: core/scene_specs.hpp) and this folder's run table before main.
 #include <atomic>
 #include <filesystem>
 #include <functional>
@@ -11,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/case_params.hpp"
+#include "core/scene_specs.hpp"
 
 namespace boycott::scenes {
 
@@ -38,15 +48,15 @@ struct RunContext {
 /// Runs (or resumes) a case. Returns the process exit code (error.hpp); writes summary.json.
 using SceneFn = int (*)(const CaseParams&, RunContext&);
 
-/// The scene table: name -> function. Throws InputError for a name not in core's scene list.
-SceneFn find_scene(const std::string& name);
-/// The names the scene table holds (a test checks them against core/scene_specs.hpp's list).
-std::vector<std::string> registered_scenes();
+/// A scene's declaration: its spec (into core's scene table) and its run function (into the run
+/// table). Defined once per scene file, at namespace scope.
+struct SceneRegistration {
+  SceneRegistration(SceneSpec spec, SceneFn run);
+};
 
-/// Validates, writes params.json beside the outputs (refusing a folder that holds another case)
-/// and runs the scene. A folder whose run already reached time.end says so and returns 0; a
-/// time.end below the time it reached is refused; with ctx.branch_from, the parent checkpoint
-/// is chosen and checked against the case (what cannot change mid-run is refused).
-int run_case(CaseParams params, RunContext& ctx);
+/// The run table: name -> function. Throws InputError for a name not in core's scene table.
+SceneFn find_scene(const std::string& name);
+/// The names the run table holds (a test checks them against core's scene table).
+std::vector<std::string> registered_scenes();
 
 }  // namespace boycott::scenes

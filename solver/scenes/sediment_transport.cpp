@@ -39,7 +39,7 @@
 #include "scenes/coupled_output.hpp"
 #include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
-#include "scenes/scenes_list.hpp"
+#include "scenes/scene.hpp"
 
 namespace boycott::scenes {
 
@@ -295,5 +295,47 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
         run.time_s(), q_star, tau_star, qwp, qn);
   return exit_code;
 }
+
+namespace {
+
+/// A bed on the wall y = 0 under gravity along -y, below a slip (mirror) top, as the paper's.
+void sediment_transport_checks(const CaseParams& p, SceneFindings& f) {
+  if (std::abs(std::cos(p.gravity.angle_deg * kPi / 180.0) - 1.0) > 1e-9)
+    f.errors.push_back(fmt::format(
+        "gravity.angle_deg = {} for sediment_transport: must be 0 (gravity along -y)", p.gravity.angle_deg));
+  if (p.domain.periodic_y)
+    f.errors.push_back(
+        "domain.periodic_y = true for sediment_transport: must be false (a bed on the wall y = 0)");
+  if (p.domain.top_wall != "slip")
+    f.warnings.push_back(
+        fmt::format("domain.top_wall = \"{}\" for sediment_transport: the paper's top is a slip "
+                    "(mirror) wall; the Shields stress assumes it",
+                    p.domain.top_wall));
+}
+
+/// The coupled run's keys, but of time and output only those it uses: time.target_rel_error is
+/// <<w_p>>'s (inclined_settling), not this scene's.
+std::vector<std::string> sediment_transport_keys() {
+  auto keys = coupled_scene_keys();
+  std::erase(keys, std::string("time."));
+  for (const char* k :
+       {"time.dt_cfd", "time.dt_dem", "time.end", "time.average_from", "time.checkpoint_every", "sediment.",
+        "output.timeseries_every", "output.keep_checkpoints", "output.snapshot_times", "output.image_times"})
+    keys.emplace_back(k);
+  return keys;
+}
+
+}  // namespace
+
+const SceneRegistration kRegistered{
+    {.name = "sediment_transport",
+     .measures = "q* against the Shields stress tau*, beside Wong-Parker and Nielsen; profiles over y",
+     .reads = sediment_transport_keys(),
+     .defaults = {{"gravity.angle_deg", "0.0"},
+                  {"domain.top_wall", "\"slip\""},
+                  {"particles.insertion", "\"bed\""}},
+     .default_solid_fraction = table3_solid_fraction(),
+     .own_checks = &sediment_transport_checks},
+    &run_sediment_transport};
 
 }  // namespace boycott::scenes

@@ -29,7 +29,7 @@
 #include "scenes/coupled_checkpoint.hpp"
 #include "scenes/coupled_output.hpp"
 #include "scenes/run_common.hpp"
-#include "scenes/scenes_list.hpp"
+#include "scenes/scene.hpp"
 
 namespace boycott::scenes {
 
@@ -135,5 +135,17 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   return exit_code;
 }
+
+const SceneRegistration kRegistered{
+    {.name = "single_particle",
+     .measures = "terminal velocity of one sphere against the drag law's",
+     .reads = {"fluid.", "particles.diameter", "particles.density", "contact.", "domain.", "gravity.",
+               "time.dt_cfd", "time.dt_dem", "time.end", "time.average_from", "time.checkpoint_every",
+               "forces.", "numerics.", "output.timeseries_every", "output.keep_checkpoints",
+               "output.snapshot_times", "output.image_times"},
+     .has_particles = false,
+     .fixed_particle_count = 1,
+     .tolerances = {{"rel_error", 0.02, "the drag law's isolated terminal velocity"}}},
+    &run_single_particle};
 
 }  // namespace boycott::scenes

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 # Tests of scripts/check_layers.py on small fake trees (ctest Style.LayerCheckerCatchesWrongWayIncludes):
 # a correct tree passes; wrong-way includes of header-only modules, a study file reaching past core,
-# a PRIVATE link taken as transitive, and an unused link are each reported, with file and line.
+# a PRIVATE link taken as transitive, and an unused link are each reported, with file and line; a
+# whole-archive INTERFACE wrapper passes its link on.
 import os
 import subprocess
 import sys
@@ -153,6 +154,32 @@ class CheckLayersTest(unittest.TestCase):
                                     "solver/io/state_io.cpp": io_cpp,
                                     "solver/io/state_io.hpp": '#include "fluid/vreman.hpp"\n'})
         self.assertEqual(rc, 0, lines)
+
+    def test_a_whole_archive_wrapper_passes_its_link_on(self):
+        # scenes: a static library linked whole through an INTERFACE wrapper of no files, as
+        # solver/scenes/CMakeLists.txt does; the wrapper's link counts for what links it.
+        scenes_cmake = ("add_library(boycott_scene_code STATIC scene.cpp)\n"
+                        "target_link_libraries(boycott_scene_code PUBLIC boycott_coupling)\n"
+                        "add_library(boycott_scenes INTERFACE)\n"
+                        "target_link_libraries(boycott_scenes INTERFACE "
+                        "\"$<LINK_LIBRARY:WHOLE_ARCHIVE,boycott_scene_code>\")\n")
+        runs_cmake = ("add_library(boycott_runs STATIC run_case.cpp)\n"
+                      "target_link_libraries(boycott_runs PUBLIC boycott_scenes)\n")
+        changes = {"solver/scenes/CMakeLists.txt": scenes_cmake,
+                   "solver/scenes/scene.cpp": '#include "scenes/scene.hpp"\n#include "coupling/kernels.hpp"\n',
+                   "solver/scenes/scene.hpp": "#pragma once\n",
+                   "solver/runs/CMakeLists.txt": runs_cmake,
+                   "solver/runs/run_case.cpp": '#include "scenes/scene.hpp"\n#include "fluid/vreman.hpp"\n'}
+        rc, lines, _ = self.run_on(changes)
+        self.assertEqual(rc, 0, lines)
+        # without the wrapper's link, runs does not see the scenes
+        changes["solver/scenes/CMakeLists.txt"] = scenes_cmake.replace(
+            "\"$<LINK_LIBRARY:WHOLE_ARCHIVE,boycott_scene_code>\"", "")
+        self.assertViolations(self.run_on(changes),
+                              ["solver/runs/CMakeLists.txt:2 runs links scenes but no file of runs includes "
+                               "a header of scenes (or of a target only scenes brings in): unused link",
+                               "solver/runs/run_case.cpp:1 includes scenes/scene.hpp: runs does not link scene_code",
+                               "solver/runs/run_case.cpp:2 includes fluid/vreman.hpp: runs does not link fluid"])
 
 
 if __name__ == "__main__":

@@ -8,10 +8,13 @@
 #include <nlohmann/json.hpp>
 
 #include "core/case_params.hpp"
+#include "runs/run_case.hpp"
 #include "scenes/scene.hpp"
 
 namespace boycott::scenes {
 namespace {
+
+using runs::run_case;
 
 nlohmann::json run_case_file(const std::string& file, const std::string& tag) {
   CaseParams p = parse_case_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/cases/" + file);

@@ -13,6 +13,7 @@
 #include "core/case_params.hpp"
 #include "core/error.hpp"
 #include "io/checkpoint_file.hpp"
+#include "runs/run_case.hpp"
 #include "scenes/scene.hpp"
 
 namespace boycott {
@@ -39,7 +40,7 @@ int run_in(const CaseParams& p, const fs::path& dir, double stop_at = -1.0) {
   ctx.progress = [&](double t) {
     if (stop_at > 0 && t >= stop_at) stop = true;
   };
-  return scenes::run_case(p, ctx);
+  return runs::run_case(p, ctx);
 }
 
 nlohmann::json summary(const fs::path& dir) {

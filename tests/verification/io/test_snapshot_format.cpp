@@ -20,6 +20,7 @@
 #include "core/error.hpp"
 #include "io/checkpoint_file.hpp"
 #include "io/snapshot.hpp"
+#include "runs/run_case.hpp"
 #include "scenes/scene.hpp"
 
 namespace boycott {
@@ -269,7 +270,7 @@ TEST(SnapshotFormat, CoupledRunSnapshotsReadBackOnEveryRankCount) {
   scenes::RunContext ctx;
   ctx.quiet = true;
   ctx.out_dir = d;
-  ASSERT_EQ(scenes::run_case(p, ctx), kExitOk);
+  ASSERT_EQ(runs::run_case(p, ctx), kExitOk);
   MPI_Barrier(MPI_COMM_WORLD);
   if (rank != 0) return;
   const auto facts = check_snapshots(d, p.domain.length_x_m, p.domain.height_z_m);

@@ -13,10 +13,13 @@
 #include <nlohmann/json.hpp>
 
 #include "core/case_params.hpp"
+#include "runs/run_case.hpp"
 #include "scenes/scene.hpp"
 
 namespace boycott::scenes {
 namespace {
+
+using runs::run_case;
 
 nlohmann::json run_file(const std::string& file, const std::string& tag,
                         const std::vector<std::string>& sets) {

@@ -17,10 +17,13 @@
 
 #include "core/case_params.hpp"
 #include "core/error.hpp"
+#include "runs/run_case.hpp"
 #include "scenes/scene.hpp"
 
 namespace boycott::scenes {
 namespace {
+
+using runs::run_case;
 
 TEST(SedimentTransport, BulkVelocityHeldBedPouredAndTransportDownstream) {
   CaseParams p = parse_case_file(std::string(BOYCOTT_SOURCE_DIR) + "/studies/cases/sediment_transport.toml");

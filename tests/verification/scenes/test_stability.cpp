@@ -18,16 +18,19 @@
 
 #include <nlohmann/json.hpp>
 
+#include "checks/preflight.hpp"
 #include "core/case_params.hpp"
 #include "core/constants.hpp"
 #include "core/error.hpp"
 #include "coupling/drag_laws.hpp"
 #include "io/checkpoint_file.hpp"
-#include "scenes/preflight.hpp"
+#include "runs/run_case.hpp"
 #include "scenes/scene.hpp"
 
 namespace boycott::scenes {
 namespace {
+
+using runs::run_case;
 
 namespace fs = std::filesystem;
 
@@ -209,7 +212,7 @@ TEST(StiffAndExtremeCases, ImpossibleCasesAreRefusedNamingTheLimit) {
 TEST(Preflight, ReportsTheDimensionlessGroupsOfTheBaseCase) {
   CaseParams p;  // Table III: Ga 1456, Sg 2.65, Sr 0.1 (Table III of the paper)
   validate(p);
-  const Preflight pre = preflight(p);
+  const checks::Preflight pre = checks::preflight(p);
   std::map<std::string, double> v;
   for (const auto& it : pre.items) v[it.name] = it.value;
   EXPECT_NEAR(v["Ga"], 1456.0, 1.0);

@@ -3,7 +3,8 @@
 // decide whether a run can work, computed before anything is allocated. `validate()` in
 // core/case_params refuses what cannot work at all (spring limit, overfilled box, d >= W, ...);
 // this report adds warnings for what is doubtful and errors for what the coupled solver cannot
-// represent, and is printed by `boycott case check` and before every `case run`.
+// represent, with the scene's own findings (its declaration's own_checks), and is printed by
+// `boycott case check` and before every `case run`.
 #include <string>
 #include <vector>
 
@@ -11,7 +12,7 @@
 
 #include "core/case_params.hpp"
 
-namespace boycott::scenes {
+namespace boycott::checks {
 
 struct PreflightItem {
   std::string name;  ///< e.g. "Re_p"
@@ -37,14 +38,6 @@ struct Preflight {
 /// memory estimate is per rank). Never throws for physics reasons: it collects.
 Preflight preflight(const CaseParams& p, int ranks = 1);
 
-/// The one complete check of a case, made when a study is expanded and by `case run` and
-/// `case check`: the key rules (validate(), which resolves the defaults into `p`), then the
-/// pre-flight. With `refuse`, the first error is thrown as InputError (a study names the case, a
-/// run leaves its folder as it was); without it the report carries the errors (case check prints
-/// them all). Machine errors are never thrown here: a study may be meant for larger machines, and
-/// `case run` refuses them on the machine it runs on.
-Preflight check_case(CaseParams& p, int ranks = 1, bool refuse = true);
-
 /// Memory of this machine available to the program, bytes (the cgroup limit where lower).
 double machine_memory_bytes();
 /// Estimated peak memory of one rank of a case on `ranks` ranks, bytes: particle and fluid
@@ -55,4 +48,4 @@ double memory_estimate_bytes(const CaseParams& p, int ranks);
 /// (s): pi / (omega_0 sqrt(1 - zeta^2)), omega_0 = sqrt(k / m_eff), m_eff = m / 2.
 double collision_time_s(double mass_kg, double stiffness_n_m, double restitution);
 
-}  // namespace boycott::scenes
+}  // namespace boycott::checks
