@@ -6,6 +6,8 @@
 #include <functional>
 #include <queue>
 
+#include "core/scene_specs.hpp"
+
 namespace boycott::driver {
 
 namespace {
@@ -45,7 +47,11 @@ CaseWork case_work(const nlohmann::json& p, double from_s, double to_s) {
   const double count = num(p, "particles", "count", 0.0);
   const double dt_dem = num(p, "time", "dt_dem", 0.0), dt_cfd = num(p, "time", "dt_cfd", 0.0);
   if (count > 0 && dt_dem > 0) w.particle_steps = count * span / dt_dem;
-  if (p.contains("domain") && p["domain"].contains("cells") && dt_cfd > 0 && w.scene != "dem_only") {
+  // A scene without fluid (or one this program does not know) has no fluid cells to pay for.
+  const auto& specs = scene_specs();
+  const bool fluid = std::any_of(specs.begin(), specs.end(),
+                                 [&](const SceneSpec& s) { return s.name == w.scene && s.has_fluid; });
+  if (p.contains("domain") && p["domain"].contains("cells") && dt_cfd > 0 && fluid) {
     double cells = 1.0;
     for (const auto& n : p["domain"]["cells"]) cells *= n.get<double>();
     w.fluid_cell_steps = cells * span / dt_cfd;

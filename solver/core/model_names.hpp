@@ -1,8 +1,9 @@
 #pragma once
 // One list of names per model kind. Parsing, `case check`, `case keys` and the registries that
 // turn a name into code (coupling/drag_laws.hpp, coupling/kernels.hpp, the contact model of
-// particles/, scenes/registry.cpp) all read these lists, and a test checks that each registry
-// knows exactly its list: a name is added here and in its registry, nowhere else.
+// particles/) all read these lists, and a test checks that each registry knows exactly its list:
+// a name is added here and in its registry, nowhere else. Scenes are not listed here: each
+// declares itself in its own file (core/scene_specs.hpp).
 #include <string>
 #include <vector>
 

@@ -1,12 +1,17 @@
 #include "scenes/summarize.hpp"
 
+#include <algorithm>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/case_params.hpp"
 #include "core/error.hpp"
 #include "core/run_status.hpp"
+#include "core/scene_specs.hpp"
 #include "core/version.hpp"
 #include "scenes/mean_error.hpp"
 
@@ -42,10 +47,16 @@ nlohmann::json resummarize_run(const std::filesystem::path& run_dir) {
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: summary.json is not JSON ({})", summary_path.string(), e.what()));
   }
+  // Only a scene that keeps <w_p>'s whole per-step series in its checkpoints can be recomputed.
   const std::string scene = j.value("scene", "");
-  if (scene != "inclined_settling")
-    throw InputError(fmt::format("{}: a {} run; case summarize recomputes <<w_p>> of inclined_settling runs",
-                                 run_dir.string(), scene.empty() ? "(no scene named)" : scene));
+  std::vector<std::string> keeping;
+  for (const auto& spec : scene_specs())
+    if (spec.detects_transient) keeping.push_back(spec.name);
+  if (std::find(keeping.begin(), keeping.end(), scene) == keeping.end())
+    throw InputError(fmt::format("{}: a {} run; case summarize recomputes <<w_p>> of {} runs, whose checkpoints "
+                                 "keep its per-step series",
+                                 run_dir.string(), scene.empty() ? "(no scene named)" : scene,
+                                 fmt::join(keeping, ", ")));
   const auto ckpt = io::latest_checkpoint(run_dir);
   if (!ckpt) throw InputError(fmt::format("{}: no checkpoint to recompute from", run_dir.string()));
   const io::CheckpointReader r(*ckpt);
