@@ -1,10 +1,10 @@
 #pragma once
 // The error bar of a curve point and of r_acc: a half-width that covers the true value about 68 %
-// of the time (core/distributions.hpp: kOneSigmaCoverage) however few numbers it rests on.
+// of the time (stats/distributions.hpp: kOneSigmaCoverage) however few numbers it rests on.
 //
 // - One run: its own covering error (summary.json settling_velocity_error_m_s: its standard error,
 //   from the autocorrelation or from the window's two halves, times Student's t at that estimate's
-//   degrees of freedom; core/statistics.hpp, MeanError).
+//   degrees of freedom; stats/window_error.hpp, MeanError).
 // - n >= 2 replicas: t_{n-1} s / sqrt(n) (s: the replicas' sample standard deviation); where every
 //   replica states its own error, an F test of the scatter against those errors (which are
 //   themselves estimates, with their own degrees of freedom): when the two disagree (two-sided,

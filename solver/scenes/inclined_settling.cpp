@@ -2,9 +2,9 @@
 // channel inclined at theta, periodic in x and z, walls at y = 0 and W, the slurry velocity held
 // at zero by the driving gradient G (Eq. 25). Measures <w_p>(t) and <w_f>(t) (Eq. 28), the
 // ensemble average <<w_p>> over [average_from, end] with its error from the autocorrelation of the
-// whole <w_p> series over the window (scenes/mean_error.hpp; Eq. 29), and the PDFs of particle y
-// and w_p over the same window (Fig. 12). With time.target_rel_error it stops once <<w_p>> is that
-// precise (status converged).
+// whole <w_p> series over the window (stats/window_error.hpp, scenes/summary_statistics.hpp;
+// Eq. 29), and the PDFs of particle y and w_p over the same window (Fig. 12). With
+// time.target_rel_error it stops once <<w_p>> is that precise (status converged).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,18 +14,21 @@
 
 #include "core/constants.hpp"
 #include "core/error.hpp"
-#include "core/statistics.hpp"
 #include "core/version.hpp"
 #include "coupling/drag_laws.hpp"
 #include "io/checkpoint_file.hpp"
 #include "io/state_io.hpp"
 #include "scenes/coupled_checkpoint.hpp"
 #include "scenes/coupled_output.hpp"
-#include "scenes/mean_error.hpp"
 #include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scenes_list.hpp"
 #include "scenes/summarize.hpp"
+#include "scenes/summary_statistics.hpp"
+#include "stats/precision_target.hpp"
+#include "stats/running.hpp"
+#include "stats/transient.hpp"
+#include "stats/window_error.hpp"
 
 namespace boycott::scenes {
 
@@ -49,14 +52,14 @@ double isolated_terminal_speed(const CaseParams& p) {
 }
 
 /// A histogram of the particles of every rank (each rank counts its own).
-Histogram over_ranks(const coupling::CoupledSystem& run, Histogram h) {
+stats::Histogram over_ranks(const coupling::CoupledSystem& run, stats::Histogram h) {
   for (double& c : h.counts_) c = run.global_sum(c);
   h.outside_ = run.global_sum(h.outside_);
   h.total_ = run.global_sum(h.total_);
   return h;
 }
 
-void write_pdf(const std::filesystem::path& path, const std::string& column, const Histogram& h) {
+void write_pdf(const std::filesystem::path& path, const std::string& column, const stats::Histogram& h) {
   std::string text = fmt::format("{},probability_density\n", column);
   const auto dens = h.density();
   for (int b = 0; b < h.bins(); ++b) text += fmt::format("{:.9g},{:.9g}\n", h.bin_center(b), dens[b]);
@@ -73,20 +76,20 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   const double vt = isolated_terminal_speed(p);
   const double W = p.domain.width_y_m;
   const int bins = static_cast<int>(p.output.pdf_bins);
-  Histogram pdf_y(0.0, W, bins);
+  stats::Histogram pdf_y(0.0, W, bins);
   // w_p range: a few isolated terminal speeds either way (values outside are counted apart).
   const double wrange = std::max(8.0 * vt, 0.05);
-  Histogram pdf_w(-wrange, 0.5 * wrange, bins);
+  stats::Histogram pdf_w(-wrange, 0.5 * wrange, bins);
   // The transverse force budget over the same window and bands as pdf_y (output.force_budget_y).
   std::optional<coupling::ForceBudget> budget;
   if (p.output.force_budget_y) budget.emplace(run.dem().config().box.lo[1], W, bins);
-  BatchMeans wp_avg, wf_avg, slurry_avg;
+  stats::BatchMeans wp_avg, wf_avg, slurry_avg;
   // Every <w_p> sample of the window, for its error (20 s of 1 ms steps: 15 000 doubles).
   std::vector<double> wp_series;
   bool wp_series_whole = true;  // false after resuming a checkpoint of a build that kept none
   // The samples before the window (the transient's detection) and the step lengths (s) of all.
-  StepSeries steps;
-  PrecisionTarget target(p.time.target_rel_error, p.time.average_from.automatic);
+  stats::StepSeries steps;
+  stats::PrecisionTarget target(p.time.target_rel_error, p.time.average_from.automatic);
   // With time.average_from = "auto" every step is collected and the window is cut at the end,
   // where the series shows its start-up transient over (the PDFs and fluid means keep all of it).
   const double collect_from_s = p.time.average_from.collect_from_s();
@@ -146,10 +149,10 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     ModelTimers::Scope sc(timers, "checkpoints");
     // Everything summed over ranks is summed here, on every rank: the writer below runs on rank 0
     // alone, and a collective inside it would wait for ranks that never enter it.
-    const Histogram all_y = over_ranks(run, pdf_y), all_w = over_ranks(run, pdf_w);
-    std::vector<Histogram> all_budget;
+    const stats::Histogram all_y = over_ranks(run, pdf_y), all_w = over_ranks(run, pdf_w);
+    std::vector<stats::Histogram> all_budget;
     if (budget)
-      for (const Histogram* h : budget->all()) all_budget.push_back(over_ranks(run, *h));
+      for (const stats::Histogram* h : budget->all()) all_budget.push_back(over_ranks(run, *h));
     checkpoint_coupled(run, ctx.out_dir, wall_before + clock.seconds(), [&](io::CheckpointWriter& w) {
       io::save(w, "stats.wp.", wp_avg);
       io::save(w, "stats.wf.", wf_avg);
@@ -225,7 +228,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   }
   if (budget) {
     run.set_force_budget(nullptr);
-    for (Histogram* h : budget->all()) *h = over_ranks(run, *h);
+    for (stats::Histogram* h : budget->all()) *h = over_ranks(run, *h);
     const double vp = p.particle_volume_m3();
     const double weight =
         std::abs(p.particles.density_kg_m3 - p.fluid.density_kg_m3) * vp * p.gravity.magnitude_m_s2;
@@ -239,9 +242,9 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   sb.particle_steps = static_cast<double>(particles) * static_cast<double>(run.dem().steps());
   sb.mean_settling_velocity_m_s = wp_avg.count() ? wp_avg.mean() : kUnset;
   const bool chose = p.time.average_from.automatic && wp_series_whole;
-  const ChosenWindow chosen = averaging_window(p.time.average_from, steps, wp_series, run.time_s());
-  const WindowError wp_err =
-      window_error(chosen.window, chosen.from_s, run.time_s(), sb.status == kStatusConverged);
+  const stats::ChosenWindow chosen = averaging_window(p.time.average_from, steps, wp_series, run.time_s());
+  const stats::WindowError wp_err =
+      stats::window_error(chosen.window, chosen.from_s, run.time_s(), sb.status == kStatusConverged);
   if (chose && !chosen.window.empty()) sb.mean_settling_velocity_m_s = wp_err.e.mean;
   sb.settling_velocity_stderr_m_s = wp_series_whole ? wp_err.err.stderr_of_mean : wp_avg.stderr_of_mean();
   auto j = make_summary(p, sb, timers);
@@ -270,7 +273,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     const double covering_rel = std::abs(wp_err.e.covering_error / sb.mean_settling_velocity_m_s);
     j["target_met"] = sb.status == kStatusConverged ||
                       (wp_series_whole && covering_rel < p.time.target_rel_error &&
-                       wp_err.e.correlation_times >= PrecisionTarget::kMinCorrelationTimes);
+                       wp_err.e.correlation_times >= stats::PrecisionTarget::kMinCorrelationTimes);
   }
   j["ranks"] = run.rank_report();
   j["mean_fluid_velocity_m_s"] = wf_avg.count() ? wf_avg.mean() : kUnset;

@@ -2,8 +2,8 @@
 // stated interval holds the true value about 68 % of the time (binomial standard error of the
 // coverage at 10 000 studies: 0.005). The series are AR(1) with a known integrated
 // autocorrelation time tau_int of 10 steps, started from the stationary distribution (no
-// transient), true mean 0; the product's own rules make the intervals (core/statistics.hpp,
-// core/distributions.hpp, driver/store/point_error.hpp).
+// transient), true mean 0; the product's own rules make the intervals (stats/window_error.hpp,
+// stats/distributions.hpp, driver/store/point_error.hpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,11 +13,13 @@
 #include <utility>
 #include <vector>
 
-#include "core/distributions.hpp"
-#include "core/statistics.hpp"
 #include "driver/store/point_error.hpp"
+#include "stats/autocorrelation.hpp"
+#include "stats/distributions.hpp"
+#include "stats/transient.hpp"
+#include "stats/window_error.hpp"
 
-using namespace boycott;
+using namespace boycott::stats;
 namespace bd = boycott::driver;
 
 namespace {
@@ -210,7 +212,7 @@ struct SingleRunCoverage {
   double batches = 0.0, width = 0.0;  ///< means of k and of the half-width over the true standard error
 };
 
-// One run's error as the product reports it (core/statistics.hpp, mean_error) over 10 000 AR(1)
+// One run's error as the product reports it (stats/window_error.hpp, mean_error) over 10 000 AR(1)
 // series of `window` correlation times, for each floor: reported only from that many correlation
 // times counted conservatively (AutocorrelationError::correlation_times; 0: always).
 std::vector<SingleRunCoverage> single_run_coverage(double tau, double window, std::uint64_t seed,
