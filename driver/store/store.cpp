@@ -414,7 +414,7 @@ std::vector<const CurveRun*> curve_order(const std::vector<CurveRun>& runs) {
 }
 
 /// One point from its replicas (one or more runs of the same group, setting and angle); the
-/// error as driver/store/point_error.hpp explains (stage_one: the replicas an adaptive group
+/// error as stats/point_error.hpp explains (stage_one: the replicas an adaptive group
 /// starts with, 0 for a fixed count).
 CurvePoint point_of_replicas(const std::vector<const CurveRun*>& replicas, int stage_one) {
   const CurvePoint& first = replicas.front()->point;
@@ -422,7 +422,7 @@ CurvePoint point_of_replicas(const std::vector<const CurveRun*>& replicas, int s
   p.n_replicas = static_cast<int>(replicas.size());
   double sum = 0.0, err_sum = 0.0;
   bool all_errors = true;
-  std::vector<RunEstimate> runs;
+  std::vector<stats::RunEstimate> runs;
   for (const CurveRun* run : replicas) {
     const CurvePoint& r = run->point;
     p.replica_case_ids.push_back(r.case_id);
@@ -437,7 +437,7 @@ CurvePoint point_of_replicas(const std::vector<const CurveRun*>& replicas, int s
   }
   const double n = static_cast<double>(p.n_replicas);
   p.w_m_s = p.n_replicas == 1 ? first.w_m_s : sum / n;
-  p.error = point_error(runs, stage_one);
+  p.error = stats::point_error(runs, stage_one);
   if (all_errors) p.mean_within_run_stderr_m_s = p.n_replicas == 1 ? *first.w_err_m_s : err_sum / n;
   if (p.n_replicas >= 2) {
     double ss = 0.0;
@@ -448,7 +448,7 @@ CurvePoint point_of_replicas(const std::vector<const CurveRun*>& replicas, int s
   return p;
 }
 
-/// r_acc = w / w90 with its covering error from the two points' (driver/store/point_error.hpp).
+/// r_acc = w / w90 with its covering error from the two points' (stats/point_error.hpp).
 void add_acceleration_ratios(std::vector<CurvePoint>& pts) {
   for (auto& p : pts) {
     const CurvePoint* ref = nullptr;
@@ -457,8 +457,9 @@ void add_acceleration_ratios(std::vector<CurvePoint>& pts) {
     if (!ref || ref->w_m_s == 0.0) continue;
     p.r_acc = p.w_m_s / ref->w_m_s;
     // At 90 deg itself the ratio is exactly 1 (the same number over itself).
-    p.r_acc_err =
-        &p == ref || p.case_id == ref->case_id ? 0.0 : ratio_error(p.w_m_s, p.error, ref->w_m_s, ref->error);
+    p.r_acc_err = &p == ref || p.case_id == ref->case_id
+                      ? 0.0
+                      : stats::ratio_error(p.w_m_s, p.error, ref->w_m_s, ref->error);
   }
 }
 

@@ -9,8 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "driver/store/database.hpp"
-#include "driver/store/point_error.hpp"
 #include "driver/study/study.hpp"
+#include "stats/point_error.hpp"
 
 namespace boycott::driver {
 
@@ -77,8 +77,8 @@ struct CurvePoint {
   /// "batch_means" for runs that predate it), "mixed" when the replicas differ.
   std::string error_method;
   /// The covering error of w_m_s (error_m_s, about 68 % for any number of replicas) and what it
-  /// rests on (error_basis); driver/store/point_error.hpp.
-  PointError error;
+  /// rests on (error_basis); stats/point_error.hpp.
+  stats::PointError error;
   /// A single run's degrees of freedom of its error (summary.json settling_velocity_error_dof).
   std::optional<double> run_dof;
   /// <<w_p>>/<<w_p>>(90 deg), unset without a 90 deg case; its covering error, from the two

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-namespace boycott::driver {
+namespace boycott::stats {
 
 /// One run's <<w_p>> and its error, as the database holds it.
 struct RunEstimate {
@@ -55,4 +55,4 @@ std::optional<double> ratio_error(double w, const PointError& e, double w90, con
 /// with t_{n0-1} s0 / sqrt(n) <= target |mean0|, at most `max` (from its first replicas).
 int stein_replicas_needed(const std::vector<double>& stage_one_w, double target_rel_error, int max);
 
-}  // namespace boycott::driver
+}  // namespace boycott::stats

@@ -1,4 +1,4 @@
-#include "driver/store/point_error.hpp"
+#include "stats/point_error.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "stats/distributions.hpp"
 
-namespace boycott::driver {
+namespace boycott::stats {
 namespace {
 
 struct Scatter {
@@ -32,7 +32,7 @@ Scatter scatter_of(const std::vector<double>& w) {
 // of freedom (a short run's two halves: 1): on runs of 10 correlation times it flagged "scatter
 // more" for 32-87 % of points of 2-10 replicas, and 9-28 % at 50.
 double agreement_cdf(const Scatter& s, double mean_sq_error, double error_dof, double n) {
-  return stats::f_cdf(s.sd * s.sd / mean_sq_error, n - 1.0, error_dof);
+  return f_cdf(s.sd * s.sd / mean_sq_error, n - 1.0, error_dof);
 }
 
 }  // namespace
@@ -46,7 +46,7 @@ PointError point_error(const std::vector<RunEstimate>& runs, int stage_one) {
     e.plain_m_s = r.stderr_m_s;
     if (r.dof && std::isfinite(*r.dof) && *r.dof > 0.0) {
       e.dof = *r.dof;
-      e.error_m_s = *r.stderr_m_s * stats::one_sigma_t_factor(e.dof);
+      e.error_m_s = *r.stderr_m_s * one_sigma_t_factor(e.dof);
       e.basis = "single_run";
     } else {
       e.dof = std::numeric_limits<double>::infinity();
@@ -65,11 +65,11 @@ PointError point_error(const std::vector<RunEstimate>& runs, int stage_one) {
     const Scatter first = scatter_of({w.begin(), w.begin() + stage_one});
     e.dof = stage_one - 1.0;
     e.plain_m_s = first.sd / std::sqrt(n);
-    e.error_m_s = stats::one_sigma_t_factor(e.dof) * *e.plain_m_s;
+    e.error_m_s = one_sigma_t_factor(e.dof) * *e.plain_m_s;
     e.basis = "two_stage_stein";
     return e;
   }
-  e.error_m_s = stats::one_sigma_t_factor(e.dof) * *e.plain_m_s;
+  e.error_m_s = one_sigma_t_factor(e.dof) * *e.plain_m_s;
   e.basis = "between_replicas_t";
   const bool all_within = std::all_of(runs.begin(), runs.end(), [](const RunEstimate& r) {
     return r.stderr_m_s && std::isfinite(*r.stderr_m_s) && *r.stderr_m_s > 0.0;
@@ -87,7 +87,7 @@ PointError point_error(const std::vector<RunEstimate>& runs, int stage_one) {
   const double within_plain = std::sqrt(var);
   const double within_nu =
       dofs && within_dof > 0.0 ? var * var / within_dof : std::numeric_limits<double>::infinity();
-  const double within = within_plain * stats::one_sigma_t_factor(within_nu);
+  const double within = within_plain * one_sigma_t_factor(within_nu);
   const double p = agreement_cdf(all, var * n, within_nu, n);
   if (p > 0.975) {
     e.basis += fmt::format("; the replicas scatter more than their own errors (F test p = {:.3f})", 1.0 - p);
@@ -115,16 +115,16 @@ std::optional<double> ratio_error(double w, const PointError& e, double w90, con
   const auto term = [](double x, double nu) { return std::isinf(nu) ? 0.0 : x * x * x * x / nu; };
   const double denom = term(a, e.dof) + term(b, e90.dof);
   const double nu = denom > 0.0 ? var * var / denom : std::numeric_limits<double>::infinity();
-  return std::sqrt(var) * stats::one_sigma_t_factor(nu);
+  return std::sqrt(var) * one_sigma_t_factor(nu);
 }
 
 int stein_replicas_needed(const std::vector<double>& stage_one_w, double target_rel_error, int max) {
   const int n0 = static_cast<int>(stage_one_w.size());
   const Scatter s = scatter_of(stage_one_w);
-  const double t = stats::one_sigma_t_factor(n0 - 1.0);
+  const double t = one_sigma_t_factor(n0 - 1.0);
   int n = n0;
   while (n < max && t * s.sd / std::sqrt(static_cast<double>(n)) > target_rel_error * std::abs(s.mean)) ++n;
   return n;
 }
 
-}  // namespace boycott::driver
+}  // namespace boycott::stats
