@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "driver/report/curve_query.hpp"
 #include "driver/report/report_util.hpp"
 
 namespace boycott::driver {
@@ -23,8 +24,8 @@ std::vector<SweptValue> setting_of(Database& db, const std::string& case_id) {
 }
 
 /// One (group, setting, angle) of the study with its finished replicas averaged: a curve point
-/// (driver/store/store.hpp), so that replicas count once, as their mean with the standard error
-/// of that mean, and the cost of one of its runs.
+/// (driver/report/curve_query.hpp), so that replicas count once, as their mean with the standard
+/// error of that mean, and the cost of one of its runs.
 struct Measured {
   std::string group, case_id;  ///< case_id: the first replica's
   double angle_deg = 0;

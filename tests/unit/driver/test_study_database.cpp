@@ -13,6 +13,7 @@
 #include "core/run_status.hpp"
 #include "stats/distributions.hpp"
 
+#include "driver/report/curve_query.hpp"
 #include "driver/store/database.hpp"
 #include "driver/store/schema_files.hpp"
 #include "driver/store/store.hpp"

@@ -12,6 +12,7 @@
 
 #include "core/error.hpp"
 #include "driver/report/curve.hpp"
+#include "driver/report/curve_query.hpp"
 #include "driver/report/plot_cairo.hpp"
 #include "driver/report/terminal_text.hpp"
 #include "driver/report/validation_query.hpp"
