@@ -1,7 +1,6 @@
 #include "driver/report/curve_query.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <cstdint>
 #include <exception>
 #include <map>
@@ -102,21 +101,20 @@ std::vector<const CurveRun*> curve_order(const std::vector<CurveRun>& runs) {
   return order;
 }
 
-/// One point from its replicas (one or more runs of the same group, setting and angle); the
-/// error as stats/point_error.hpp explains (stage_one: the replicas an adaptive group
-/// starts with, 0 for a fixed count).
+/// One point from its replicas (one or more runs of the same group, setting and angle): their
+/// mean, and the error as stats/point_error.hpp explains (stage_one: the replicas an adaptive
+/// group starts with, 0 for a fixed count).
 CurvePoint point_of_replicas(const std::vector<const CurveRun*>& replicas, int stage_one) {
   const CurvePoint& first = replicas.front()->point;
   CurvePoint p = first;
   p.n_replicas = static_cast<int>(replicas.size());
-  double sum = 0.0, err_sum = 0.0;
+  double err_sum = 0.0;
   bool all_errors = true;
   std::vector<stats::RunEstimate> runs;
   for (const CurveRun* run : replicas) {
     const CurvePoint& r = run->point;
     p.replica_case_ids.push_back(r.case_id);
     p.replica_w_m_s.push_back(r.w_m_s);
-    sum += r.w_m_s;
     if (r.w_err_m_s)
       err_sum += *r.w_err_m_s;
     else
@@ -124,14 +122,14 @@ CurvePoint point_of_replicas(const std::vector<const CurveRun*>& replicas, int s
     if (r.error_method != p.error_method) p.error_method = "mixed";
     runs.push_back({r.w_m_s, r.w_err_m_s, r.run_dof});
   }
-  const double n = static_cast<double>(p.n_replicas);
-  p.w_m_s = p.n_replicas == 1 ? first.w_m_s : sum / n;
+  const stats::ReplicaMean mean = stats::replica_mean(p.replica_w_m_s);
+  p.w_m_s = mean.mean;
   p.error = stats::point_error(runs, stage_one);
-  if (all_errors) p.mean_within_run_stderr_m_s = p.n_replicas == 1 ? *first.w_err_m_s : err_sum / n;
-  if (p.n_replicas >= 2) {
-    double ss = 0.0;
-    for (double w : p.replica_w_m_s) ss += (w - p.w_m_s) * (w - p.w_m_s);
-    p.between_replica_stderr_m_s = std::sqrt(ss / (n - 1.0)) / std::sqrt(n);
+  if (all_errors)
+    p.mean_within_run_stderr_m_s =
+        p.n_replicas == 1 ? *first.w_err_m_s : err_sum / static_cast<double>(p.n_replicas);
+  if (mean.between_stderr) {
+    p.between_replica_stderr_m_s = mean.between_stderr;
     p.w_err_m_s = p.between_replica_stderr_m_s;
   }
   return p;

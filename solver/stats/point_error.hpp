@@ -42,6 +42,15 @@ struct PointError {
   double dof = 0.0;
 };
 
+/// The replicas' mean and, from two replicas on, the standard error of that mean from their
+/// scatter, s / sqrt(n) (s: their sample standard deviation); one replica: its own value.
+struct ReplicaMean {
+  double mean = 0.0;
+  std::optional<double> between_stderr;  ///< unset below two replicas
+};
+/// `w`: each replica's value, in study order (at least one).
+ReplicaMean replica_mean(const std::vector<double>& w);
+
 /// The covering error of the mean of `runs` (replicas of one point, in study order).
 /// `stage_one`: the replicas an adaptive plan starts with (0: not adaptive). At least 2 is
 /// needed for Stein's rule; with fewer runs than that the plain between-replica rule applies.
