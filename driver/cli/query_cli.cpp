@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "driver/cli/command_line.hpp"
 #include "driver/report/curve.hpp"
+#include "driver/report/curve_query.hpp"
 #include "driver/report/listing_format.hpp"
 #include "driver/report/validation_query.hpp"
 #include "driver/report/work_precision.hpp"

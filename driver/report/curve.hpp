@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "driver/report/curve_query.hpp"
 #include "driver/report/listing_format.hpp"
 #include "driver/report/paper_reference.hpp"
 #include "driver/report/plot_cairo.hpp"

@@ -8,7 +8,9 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "driver/report/curve_query.hpp"
 #include "driver/report/report_util.hpp"
+#include "stats/relative_difference.hpp"
 
 namespace boycott::driver {
 
@@ -23,8 +25,8 @@ std::vector<SweptValue> setting_of(Database& db, const std::string& case_id) {
 }
 
 /// One (group, setting, angle) of the study with its finished replicas averaged: a curve point
-/// (driver/store/store.hpp), so that replicas count once, as their mean with the standard error
-/// of that mean, and the cost of one of its runs.
+/// (driver/report/curve_query.hpp), so that replicas count once, as their mean with the standard
+/// error of that mean, and the cost of one of its runs.
 struct Measured {
   std::string group, case_id;  ///< case_id: the first replica's
   double angle_deg = 0;
@@ -134,10 +136,10 @@ WorkPrecision query_work_precision(Database& db, const std::string& study,
     row.ref_n_replicas = ref.n_replicas;
     row.w_ref_m_s = ref.w_m_s;
     row.w_ref_err_m_s = ref.w_err_m_s;
-    // e = w/w_ref - 1; de/dw = 1/w_ref, de/dw_ref = -w/w_ref^2 (independent standard errors).
-    row.rel_error_w = run.w_m_s / ref.w_m_s - 1.0;
-    row.rel_error_w_unc =
-        std::hypot(run.w_err_m_s / ref.w_m_s, run.w_m_s * ref.w_err_m_s / (ref.w_m_s * ref.w_m_s));
+    const stats::RelativeDifference e =
+        stats::relative_difference(run.w_m_s, run.w_err_m_s, ref.w_m_s, ref.w_err_m_s);
+    row.rel_error_w = e.value;
+    row.rel_error_w_unc = e.stderr_of_value;
     wp.rows.push_back(std::move(row));
     if (std::none_of(wp.references.begin(), wp.references.end(),
                      [&](const ReferenceRun& r) { return r.case_id == ref.case_id; }))
@@ -154,13 +156,11 @@ WorkPrecision query_work_precision(Database& db, const std::string& study,
       if (q.group == row.group && q.angle_deg == 90.0 && q.setting == row.setting) v90 = &q;
     if (!v90 || v90->w_m_s == 0.0) continue;
     // R = (w / w90) / (wr / wr90); every reference w is non-zero (checked above).
-    const double w = row.w_m_s, w90 = v90->w_m_s, wr = row.w_ref_m_s, wr90 = v90->w_ref_m_s;
-    const double R = (w / w90) * (wr90 / wr);
-    row.rel_error_r_acc = R - 1.0;
-    const double dw = row.w_err_m_s * wr90 / (w90 * wr);
-    const double dw90 = R * v90->w_err_m_s / w90, dwr = R * row.w_ref_err_m_s / wr,
-                 dwr90 = R * v90->w_ref_err_m_s / wr90;
-    row.rel_error_r_acc_unc = std::sqrt(dw * dw + dw90 * dw90 + dwr * dwr + dwr90 * dwr90);
+    const stats::RelativeDifference e =
+        stats::ratio_of_ratios_difference(row.w_m_s, row.w_err_m_s, v90->w_m_s, v90->w_err_m_s, row.w_ref_m_s,
+                                          row.w_ref_err_m_s, v90->w_ref_m_s, v90->w_ref_err_m_s);
+    row.rel_error_r_acc = e.value;
+    row.rel_error_r_acc_unc = e.stderr_of_value;
   }
 
   std::map<std::string, std::size_t> order;

@@ -5,7 +5,8 @@
 // reference group is compared with the reference point of its angle. A point is a (group,
 // setting, angle) with its finished replicas (`replicas` in the study): their mean, the standard
 // error of that mean (their scatter; one run's own error without replicas) and the mean cost of
-// one of its runs, as the curve has them (driver/store/store.hpp, CurvePoint).
+// one of its runs, as the curve has them (driver/report/curve_query.hpp, CurvePoint); the errors of
+// the differences are the statistics room's (stats/relative_difference.hpp).
 #include <cstdint>
 #include <optional>
 #include <string>

@@ -6,8 +6,8 @@
 #include <map>
 #include <string>
 
-#include "driver/store/point_error.hpp"
 #include "driver/store/store.hpp"
+#include "stats/point_error.hpp"
 
 namespace boycott::driver {
 
@@ -29,7 +29,7 @@ ReplicaRound next_replica_round(Database& db, const Study& s) {
     const auto& reps = replicas[point];
     const auto plan = s.replica_plans.find(reps.front()->group);
     if (plan == s.replica_plans.end() || !plan->second.target_rel_error) continue;
-    // Stein's two-stage rule (driver/store/point_error.hpp): the first plan.replicas replicas decide how
+    // Stein's two-stage rule (stats/point_error.hpp): the first plan.replicas replicas decide how
     // many the point needs, all of them added in one round.
     std::vector<double> stage_one;
     bool all_done = true;
@@ -42,12 +42,14 @@ ReplicaRound next_replica_round(Database& db, const Study& s) {
       ++round.waiting;
       continue;
     }
-    const int needed = stein_replicas_needed(stage_one, *plan->second.target_rel_error, plan->second.max);
+    const int needed =
+        stats::stein_replicas_needed(stage_one, *plan->second.target_rel_error, plan->second.max);
     const int have = static_cast<int>(reps.size());
     if (have >= needed) {
       // Needed more than replicas_max allows: at the limit, above the target.
       if (needed == plan->second.max &&
-          stein_replicas_needed(stage_one, *plan->second.target_rel_error, plan->second.max + 1) > needed)
+          stats::stein_replicas_needed(stage_one, *plan->second.target_rel_error, plan->second.max + 1) >
+              needed)
         ++round.at_max;
       else
         ++round.precise;

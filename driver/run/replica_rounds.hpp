@@ -1,6 +1,6 @@
 #pragma once
 // `study run`'s rounds of replicas (study keys replicas_target_rel_error and replicas_max), by
-// Stein's two-stage rule (driver/store/point_error.hpp): every point of a group with a target starts
+// Stein's two-stage rule (stats/point_error.hpp): every point of a group with a target starts
 // with `replicas` (at least 3); once those have results, their scatter fixes how many replicas the
 // point needs to meet the target with an error that covers ~68 %, at most replicas_max, and the
 // next round adds them all. Seeds are deterministic, so a rerun of `study run` finds the replicas

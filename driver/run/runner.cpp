@@ -13,6 +13,7 @@
 
 #include "core/error.hpp"
 #include "driver/report/curve.hpp"
+#include "driver/report/curve_query.hpp"
 #include "driver/report/report_util.hpp"
 #include "driver/report/validation_query.hpp"
 #include "driver/run/collect.hpp"

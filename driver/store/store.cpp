@@ -2,13 +2,9 @@
 
 #include <unistd.h>
 
-#include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdlib>
 #include <limits>
-#include <map>
-#include <set>
 #include <thread>
 
 #include <fmt/format.h>
@@ -312,31 +308,14 @@ std::vector<SweptValue> case_swept_values(Database& db, const std::string& case_
   return out;
 }
 
-namespace {
-
-// Group -> the replicas its adaptive plan starts with, from the study file as last run (a study
-// file an older build stored and this one refuses: none, the plain between-replica rule).
-std::map<std::string, int> adaptive_stage_one(Database& db, const std::string& study) {
-  std::map<std::string, int> out;
+std::optional<std::string> study_source(Database& db, const std::string& study) {
   auto st = db.prepare("SELECT source_toml FROM studies WHERE name = ?1");
   st.bind(1, study);
-  if (!st.step()) return out;
-  try {
-    for (const auto& [grp, plan] : study_replica_plans(st.text(0), study))
-      if (plan.target_rel_error) out[grp] = plan.replicas;
-  } catch (const std::exception&) {
-  }
-  return out;
+  if (!st.step()) return std::nullopt;
+  return st.text(0);
 }
 
-/// One finished run of the study (or of one group) as a curve point of its own, with its first
-/// position in the study file.
-struct CurveRun {
-  CurvePoint point;
-  std::int64_t position = 0;
-};
-
-std::vector<CurveRun> curve_runs(Database& db, const std::string& study, const std::string& group) {
+std::vector<CurveResult> curve_results(Database& db, const std::string& study, const std::string& group) {
   // Runs whose summary names no error method predate the autocorrelation estimate: batch means.
   auto st = db.prepare(
       "SELECT sc.group_name, c.id, c.angle_deg, r.mean_settling_velocity_m_s, "
@@ -348,143 +327,20 @@ std::vector<CurveRun> curve_runs(Database& db, const std::string& study, const s
       "JOIN results r ON r.case_id = c.id WHERE sc.study = ?1 AND (?2 = '' OR sc.group_name = ?2) "
       "AND r.mean_settling_velocity_m_s IS NOT NULL GROUP BY sc.group_name, c.id");
   st.bind(1, study).bind(2, group);
-  std::vector<CurveRun> runs;
+  std::vector<CurveResult> out;
   while (st.step()) {
-    CurvePoint p;
-    p.group = st.text(0);
-    p.case_id = st.text(1);
-    p.angle_deg = st.real(2);
-    p.w_m_s = st.real(3);
-    if (!st.is_null(4)) p.w_err_m_s = st.real(4);
-    p.error_method = st.text(6);
-    if (!st.is_null(7)) p.run_dof = st.real(7);
-    runs.push_back({p, st.integer(5)});
+    CurveResult r;
+    r.group = st.text(0);
+    r.case_id = st.text(1);
+    r.angle_deg = st.real(2);
+    r.w_m_s = st.real(3);
+    if (!st.is_null(4)) r.w_err_m_s = st.real(4);
+    r.position = st.integer(5);
+    r.error_method = st.text(6);
+    if (!st.is_null(7)) r.error_dof = st.real(7);
+    out.push_back(std::move(r));
   }
-  return runs;
-}
-
-/// Each run's setting: what varies within its group at a given angle (a group's own `set` is its
-/// name's job). A key zipped with the angle (each angle its own time.end, say) takes one value
-/// per angle: it belongs to the angle's point, not to a second curve. Replicas differ in the seed
-/// alone, which a study with replicas does not sweep: they share their setting and angle.
-void name_settings(Database& db, std::vector<CurveRun>& runs) {
-  std::vector<std::vector<SweptValue>> swept(runs.size());
-  std::map<std::string, std::map<std::string, std::map<double, std::set<std::string>>>>
-      values_at_angle;  // group -> key -> angle -> values
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    const CurvePoint& p = runs[i].point;
-    swept[i] = case_swept_values(db, p.case_id);
-    for (const auto& v : swept[i]) values_at_angle[p.group][v.key][p.angle_deg].insert(v.value);
-  }
-  const auto splits_curve = [&](const std::string& grp, const std::string& key) {
-    for (const auto& [angle, values] : values_at_angle[grp][key])
-      if (values.size() >= 2) return true;
-    return false;
-  };
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    CurvePoint& p = runs[i].point;
-    for (const auto& v : swept[i]) {
-      if (v.key == "gravity.angle_deg" || !splits_curve(p.group, v.key)) continue;
-      p.setting += (p.setting.empty() ? "" : "; ") + v.key + "=" + v.display();
-    }
-  }
-}
-
-/// The runs in curve order: groups and settings in study order (the first position of any of
-/// their cases), then by angle, replicas of one point adjacent and in study order.
-std::vector<const CurveRun*> curve_order(const std::vector<CurveRun>& runs) {
-  std::map<std::string, std::int64_t> group_pos;
-  std::map<std::pair<std::string, std::string>, std::int64_t> first_pos;
-  for (const auto& r : runs) {
-    auto& gp = group_pos.try_emplace(r.point.group, r.position).first->second;
-    gp = std::min(gp, r.position);
-    auto& fp = first_pos.try_emplace({r.point.group, r.point.setting}, r.position).first->second;
-    fp = std::min(fp, r.position);
-  }
-  std::vector<const CurveRun*> order;
-  for (const auto& r : runs) order.push_back(&r);
-  std::stable_sort(order.begin(), order.end(), [&](const CurveRun* x, const CurveRun* y) {
-    const CurvePoint &a = x->point, &b = y->point;
-    if (a.group != b.group) return group_pos[a.group] < group_pos[b.group];
-    if (a.setting != b.setting) return first_pos[{a.group, a.setting}] < first_pos[{b.group, b.setting}];
-    if (a.angle_deg != b.angle_deg) return a.angle_deg < b.angle_deg;
-    return x->position < y->position;  // replicas in study order
-  });
-  return order;
-}
-
-/// One point from its replicas (one or more runs of the same group, setting and angle); the
-/// error as driver/store/point_error.hpp explains (stage_one: the replicas an adaptive group
-/// starts with, 0 for a fixed count).
-CurvePoint point_of_replicas(const std::vector<const CurveRun*>& replicas, int stage_one) {
-  const CurvePoint& first = replicas.front()->point;
-  CurvePoint p = first;
-  p.n_replicas = static_cast<int>(replicas.size());
-  double sum = 0.0, err_sum = 0.0;
-  bool all_errors = true;
-  std::vector<RunEstimate> runs;
-  for (const CurveRun* run : replicas) {
-    const CurvePoint& r = run->point;
-    p.replica_case_ids.push_back(r.case_id);
-    p.replica_w_m_s.push_back(r.w_m_s);
-    sum += r.w_m_s;
-    if (r.w_err_m_s)
-      err_sum += *r.w_err_m_s;
-    else
-      all_errors = false;
-    if (r.error_method != p.error_method) p.error_method = "mixed";
-    runs.push_back({r.w_m_s, r.w_err_m_s, r.run_dof});
-  }
-  const double n = static_cast<double>(p.n_replicas);
-  p.w_m_s = p.n_replicas == 1 ? first.w_m_s : sum / n;
-  p.error = point_error(runs, stage_one);
-  if (all_errors) p.mean_within_run_stderr_m_s = p.n_replicas == 1 ? *first.w_err_m_s : err_sum / n;
-  if (p.n_replicas >= 2) {
-    double ss = 0.0;
-    for (double w : p.replica_w_m_s) ss += (w - p.w_m_s) * (w - p.w_m_s);
-    p.between_replica_stderr_m_s = std::sqrt(ss / (n - 1.0)) / std::sqrt(n);
-    p.w_err_m_s = p.between_replica_stderr_m_s;
-  }
-  return p;
-}
-
-/// r_acc = w / w90 with its covering error from the two points' (driver/store/point_error.hpp).
-void add_acceleration_ratios(std::vector<CurvePoint>& pts) {
-  for (auto& p : pts) {
-    const CurvePoint* ref = nullptr;
-    for (const auto& q : pts)
-      if (q.group == p.group && q.setting == p.setting && q.angle_deg == 90.0) ref = &q;
-    if (!ref || ref->w_m_s == 0.0) continue;
-    p.r_acc = p.w_m_s / ref->w_m_s;
-    // At 90 deg itself the ratio is exactly 1 (the same number over itself).
-    p.r_acc_err =
-        &p == ref || p.case_id == ref->case_id ? 0.0 : ratio_error(p.w_m_s, p.error, ref->w_m_s, ref->error);
-  }
-}
-
-}  // namespace
-
-std::vector<CurvePoint> query_curve(Database& db, const std::string& study, const std::string& group) {
-  std::vector<CurveRun> runs = curve_runs(db, study, group);
-  name_settings(db, runs);
-  const std::vector<const CurveRun*> order = curve_order(runs);
-  const std::map<std::string, int> stage_one = adaptive_stage_one(db, study);
-  // Replicas of one point (adjacent now) become one point.
-  std::vector<CurvePoint> pts;
-  for (std::size_t k = 0; k < order.size();) {
-    const CurvePoint& first = order[k]->point;
-    std::size_t end = k;
-    while (end < order.size() && order[end]->point.group == first.group &&
-           order[end]->point.setting == first.setting && order[end]->point.angle_deg == first.angle_deg)
-      ++end;
-    const auto stage = stage_one.find(first.group);
-    pts.push_back(point_of_replicas(
-        {order.begin() + static_cast<std::ptrdiff_t>(k), order.begin() + static_cast<std::ptrdiff_t>(end)},
-        stage == stage_one.end() ? 0 : stage->second));
-    k = end;
-  }
-  add_acceleration_ratios(pts);
-  return pts;
+  return out;
 }
 
 void require_study(Database& db, const std::string& study) {

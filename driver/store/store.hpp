@@ -9,7 +9,6 @@
 #include <nlohmann/json.hpp>
 
 #include "driver/store/database.hpp"
-#include "driver/store/point_error.hpp"
 #include "driver/study/study.hpp"
 
 namespace boycott::driver {
@@ -53,39 +52,6 @@ struct CaseState {
 /// case counts as failed rather than pending.
 std::vector<CaseState> case_states(Database& db, const std::string& study, int retries);
 
-/// One point of a curve: a (group, setting, angle) and its finished replicas (the cases of the
-/// study that differ only in their seed; one without `replicas`).
-struct CurvePoint {
-  std::string group;
-  /// What else the study sets on the case besides the angle ("key=value; ..."), empty when the
-  /// group sweeps only the angle: one curve per (group, setting), r_acc within it.
-  std::string setting;
-  std::string case_id;  ///< the first replica's
-  double angle_deg = 0;
-  double w_m_s = 0;  ///< <<w_p>>, the mean over the replicas
-  /// The standard error of w_m_s: between_replica_stderr_m_s with two replicas or more, else the
-  /// run's own error; unset when the run recorded none.
-  std::optional<double> w_err_m_s;
-  int n_replicas = 1;
-  std::vector<std::string> replica_case_ids;
-  std::vector<double> replica_w_m_s;  ///< each replica's <<w_p>>, in study order
-  /// Sample standard deviation of the replicas' <<w_p>> over sqrt(N); unset below two replicas.
-  std::optional<double> between_replica_stderr_m_s;
-  /// The mean of the replicas' own (within-run) errors; unset when any replica recorded none.
-  std::optional<double> mean_within_run_stderr_m_s;
-  /// How the runs estimated their own errors (summary.json's settling_velocity_error_method;
-  /// "batch_means" for runs that predate it), "mixed" when the replicas differ.
-  std::string error_method;
-  /// The covering error of w_m_s (error_m_s, about 68 % for any number of replicas) and what it
-  /// rests on (error_basis); driver/store/point_error.hpp.
-  PointError error;
-  /// A single run's degrees of freedom of its error (summary.json settling_velocity_error_dof).
-  std::optional<double> run_dof;
-  /// <<w_p>>/<<w_p>>(90 deg), unset without a 90 deg case; its covering error, from the two
-  /// points' errors, unset when an error it depends on is.
-  std::optional<double> r_acc, r_acc_err;
-};
-
 /// A key a study sets on a case (group `set`, matrix, zip), as stored in case_values.
 struct SweptValue {
   std::string key;
@@ -98,11 +64,6 @@ struct SweptValue {
 
 /// The swept values of one case, by key.
 std::vector<SweptValue> case_swept_values(Database& db, const std::string& case_id);
-
-/// The correlation curve of finished cases, per group in study order, by angle; the replicas of
-/// a point (cases that differ only in their seed) are averaged, r_acc's error propagated from
-/// their scatter.
-std::vector<CurvePoint> query_curve(Database& db, const std::string& study, const std::string& group = "");
 
 /// InputError "no study 'S' in 'FILE'" when the database has no study of that name.
 void require_study(Database& db, const std::string& study);
@@ -121,6 +82,24 @@ struct StoredResult {
 /// Every result, once per study group its case belongs to (and once with no study for a case that
 /// none lists), of one study (or all, study empty); by study (none last), position, case id.
 std::vector<StoredResult> stored_results(Database& db, const std::string& study);
+
+/// A finished case with a <<w_p>>, as `query curve` reads it: once per study group it belongs to,
+/// with its first position in the study.
+struct CurveResult {
+  std::string group, case_id;
+  double angle_deg = 0;
+  double w_m_s = 0;                 ///< <<w_p>>
+  std::optional<double> w_err_m_s;  ///< its standard error; unset when the run recorded none
+  std::int64_t position = 0;        ///< its first position in the study within the group
+  std::string error_method;         ///< settling_velocity_error_method; "batch_means" when none
+  std::optional<double> error_dof;  ///< settling_velocity_error_dof
+};
+
+/// The study's cases with a recorded <<w_p>> (of one group, `group` non-empty), once per group.
+std::vector<CurveResult> curve_results(Database& db, const std::string& study, const std::string& group);
+
+/// The study file as last registered (its TOML text); unset when the database has no such study.
+std::optional<std::string> study_source(Database& db, const std::string& study);
 
 /// A finished case with a <<w_p>>, as `query work-precision` reads it.
 struct SettlingResult {

@@ -206,7 +206,7 @@ ReplicaPlan resolve_replicas(const ReplicaKeys& study, const ReplicaKeys& group,
     return plan;
   }
   // Stein's first stage: a scatter from fewer than 3 numbers leaves the t factor at 1.84 and
-  // its own size so uncertain that the stage would decide little (driver/store/point_error.hpp).
+  // its own size so uncertain that the stage would decide little (stats/point_error.hpp).
   plan.replicas = std::max(plan.replicas, ReplicaPlan::kStageOneMin);
   plan.max = static_cast<int>(max.value_or(std::max(ReplicaPlan::kDefaultReplicasMax, plan.replicas)));
   if (plan.max < plan.replicas)

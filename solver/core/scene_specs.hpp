@@ -24,13 +24,15 @@ struct SceneFindings {
   std::vector<std::string> warnings;  ///< doubtful: the run goes ahead
 };
 
+// Every member has an initializer, so that a declaration names only what differs (designated
+// initializers in the scene files).
 struct SceneSpec {
-  std::string name;
-  std::string measures;  ///< one line, for `case keys` and the README
+  std::string name = {};
+  std::string measures = {};  ///< one line, for `case keys` and the README
   /// The keys the scene reads: a whole section ("fluid.") or one key ("time.dt_dem", "seed").
-  std::vector<std::string> reads;
+  std::vector<std::string> reads = {};
   /// The scene's own defaults where they differ from Table III's, as TOML values.
-  std::vector<std::pair<std::string, std::string>> defaults;
+  std::vector<std::pair<std::string, std::string>> defaults = {};
   /// Places particles: particles.count follows the case's box when the case does not set it.
   bool has_particles = true;
   /// Particles of a scene that does not read particles.count (one sphere, or none).

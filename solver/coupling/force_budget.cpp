@@ -11,11 +11,11 @@ ForceBudget::ForceBudget(double y0_m, double width_m, int bands)
 
 void ForceBudget::commit(const particles::ParticleStore& s, double dt_s, double gravity_y_m_s2) {
   for (int t = 0; t < kTerms; ++t) {
-    Histogram& p = prepared_[t];
+    stats::Histogram& p = prepared_[t];
     for (std::size_t b = 0; b < p.counts_.size(); ++b) impulse_[t].counts_[b] += p.counts_[b] * dt_s;
     impulse_[t].outside_ += p.outside_ * dt_s;
     impulse_[t].total_ += p.total_ * dt_s;
-    p = Histogram(p.lo_, p.hi_, p.bins());
+    p = stats::Histogram(p.lo_, p.hi_, p.bins());
   }
   // The kick: (m + m_add) dv = dt (F_contacts + F_ext + m g) + J, F_ext holding the prepared
   // fluid forces, so the contact impulse (walls included) is what the rest leaves.
@@ -32,8 +32,8 @@ void ForceBudget::commit(const particles::ParticleStore& s, double dt_s, double 
   }
 }
 
-std::vector<Histogram*> ForceBudget::all() {
-  std::vector<Histogram*> h{&exposure_};
+std::vector<stats::Histogram*> ForceBudget::all() {
+  std::vector<stats::Histogram*> h{&exposure_};
   for (auto& i : impulse_) h.push_back(&i);
   return h;
 }

@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "core/statistics.hpp"
+#include "stats/running.hpp"
 
 namespace boycott::particles {
 struct ParticleStore;
@@ -67,20 +67,20 @@ class ForceBudget {
   void commit(const particles::ParticleStore& s, double dt_s, double gravity_y_m_s2);
 
   /// Impulse sums (N s) per band, the walls' as the DEM adds them.
-  Histogram& impulses(Term t) { return impulse_[t]; }
+  stats::Histogram& impulses(Term t) { return impulse_[t]; }
   /// Particle-seconds per band: the exposure each term's mean is over.
-  const Histogram& exposure() const { return exposure_; }
+  const stats::Histogram& exposure() const { return exposure_; }
 
   /// Every histogram (exposure first, then the terms), for checkpoints and sums over ranks.
-  std::vector<Histogram*> all();
+  std::vector<stats::Histogram*> all();
   /// The CSV: y_m, particle_density (1/m, the time-weighted pdf of y), then each force's mean
   /// per particle (N), the same divided by the buoyant weight w_b (N) in *_per_weight, and the
   /// band's mean Re_p and Re_w.
   std::string csv(double buoyant_weight_n) const;
 
  private:
-  Histogram exposure_;
-  std::vector<Histogram> impulse_, prepared_;
+  stats::Histogram exposure_;
+  std::vector<stats::Histogram> impulse_, prepared_;
 };
 
 }  // namespace boycott::coupling

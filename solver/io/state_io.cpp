@@ -82,14 +82,14 @@ void load(const CheckpointReader& r, const std::string& prefix, fluid::FluidStat
   s.fields = load_arrays(r, prefix + "field.");
 }
 
-void save(CheckpointWriter& w, const std::string& prefix, const BatchMeans& b) {
+void save(CheckpointWriter& w, const std::string& prefix, const stats::BatchMeans& b) {
   w.put(prefix + "ints", std::vector<std::int64_t>{b.min_batches_, b.count_, b.batch_len_, b.open_n_});
   w.put(prefix + "total", b.total_);
   w.put(prefix + "open_sum", b.open_sum_);
   w.put(prefix + "sums", b.sums_);
 }
 
-void load(const CheckpointReader& r, const std::string& prefix, BatchMeans& b) {
+void load(const CheckpointReader& r, const std::string& prefix, stats::BatchMeans& b) {
   const auto i = r.int64s(prefix + "ints");
   if (i.size() != 4) throw CheckpointError(fmt::format("{}: bad batch-means state", r.path().string()));
   b.min_batches_ = static_cast<int>(i[0]);
@@ -101,12 +101,12 @@ void load(const CheckpointReader& r, const std::string& prefix, BatchMeans& b) {
   b.sums_ = r.doubles(prefix + "sums");
 }
 
-void save(CheckpointWriter& w, const std::string& prefix, const Histogram& h) {
+void save(CheckpointWriter& w, const std::string& prefix, const stats::Histogram& h) {
   w.put(prefix + "range", std::vector<double>{h.lo_, h.hi_, h.outside_, h.total_});
   w.put(prefix + "counts", h.counts_);
 }
 
-void load(const CheckpointReader& r, const std::string& prefix, Histogram& h) {
+void load(const CheckpointReader& r, const std::string& prefix, stats::Histogram& h) {
   const auto range = r.doubles(prefix + "range");
   const auto counts = r.doubles(prefix + "counts");
   if (range.size() != 4 || range[0] != h.lo_ || range[1] != h.hi_ || counts.size() != h.counts_.size())

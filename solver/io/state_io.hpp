@@ -4,10 +4,10 @@
 #include <string>
 #include <vector>
 
-#include "core/statistics.hpp"
 #include "fluid/fluid_solver.hpp"
 #include "io/checkpoint_file.hpp"
 #include "particles/dem_system.hpp"
+#include "stats/running.hpp"
 
 namespace boycott::io {
 
@@ -18,11 +18,11 @@ void load(const CheckpointReader& r, const std::string& prefix, particles::DemSt
 void save(CheckpointWriter& w, const std::string& prefix, const fluid::FluidState& s);
 void load(const CheckpointReader& r, const std::string& prefix, fluid::FluidState& s);
 
-void save(CheckpointWriter& w, const std::string& prefix, const BatchMeans& b);
-void load(const CheckpointReader& r, const std::string& prefix, BatchMeans& b);
+void save(CheckpointWriter& w, const std::string& prefix, const stats::BatchMeans& b);
+void load(const CheckpointReader& r, const std::string& prefix, stats::BatchMeans& b);
 
-void save(CheckpointWriter& w, const std::string& prefix, const Histogram& h);
-void load(const CheckpointReader& r, const std::string& prefix, Histogram& h);
+void save(CheckpointWriter& w, const std::string& prefix, const stats::Histogram& h);
+void load(const CheckpointReader& r, const std::string& prefix, stats::Histogram& h);
 
 void save(CheckpointWriter& w, const std::string& prefix, const std::vector<std::vector<double>>& arrays);
 std::vector<std::vector<double>> load_arrays(const CheckpointReader& r, const std::string& prefix);

@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "core/case_params.hpp"
-#include "core/statistics.hpp"
 #include "particles/contact_models.hpp"
 #include "particles/displacement_bound.hpp"
 #include "particles/neighbor_list.hpp"
@@ -17,6 +16,7 @@
 #include "particles/particle_store.hpp"
 #include "particles/slab_decomposition.hpp"
 #include "particles/walls.hpp"
+#include "stats/running.hpp"
 
 namespace boycott::particles {
 
@@ -148,7 +148,7 @@ class DemSystem {
 
   /// When set (output.force_budget_y), every force evaluation adds the y-force (N) of each wall
   /// contact times dt_s into this histogram at the particle's y: the walls' share of the budget.
-  Histogram* wall_force_y_budget = nullptr;
+  stats::Histogram* wall_force_y_budget = nullptr;
 
  private:
   template <class Rolling>

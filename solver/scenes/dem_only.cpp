@@ -11,11 +11,11 @@
 #include "core/constants.hpp"
 #include "core/error.hpp"
 #include "core/run_status.hpp"
-#include "core/statistics.hpp"
 #include "particles/dem_system.hpp"
 #include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scene.hpp"
+#include "stats/running.hpp"
 
 namespace boycott::scenes {
 
@@ -56,7 +56,7 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
                 {"time_s", "mean_vx_m_s", "mean_vy_m_s", "mean_vz_m_s", "kinetic_energy_j", "contacts",
                  "neighbor_rebuilds"},
                 false);
-  BatchMeans wp_avg;
+  stats::BatchMeans wp_avg;
   const double N = static_cast<double>(s.n_local);
   auto mean_of_sum = [&](double sum) { return N > 0 ? sum / N : 0.0; };
   auto mean_of = [&](const std::vector<double>& a) {

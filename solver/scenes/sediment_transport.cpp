@@ -31,7 +31,6 @@
 
 #include "core/constants.hpp"
 #include "core/error.hpp"
-#include "core/statistics.hpp"
 #include "fluid/turbulent_start.hpp"
 #include "io/checkpoint_file.hpp"
 #include "io/state_io.hpp"
@@ -40,6 +39,7 @@
 #include "scenes/particle_setup.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scene.hpp"
+#include "stats/running.hpp"
 
 namespace boycott::scenes {
 
@@ -132,7 +132,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   opt.target_mean_flux_z_m_s = p.sediment.bulk_velocity_m_s;
   coupling::CoupledSystem run(p, opt);
   const auto& s = run.dem().particles();
-  BatchMeans q_avg, g_avg, wf_avg, vp_avg;
+  stats::BatchMeans q_avg, g_avg, wf_avg, vp_avg;
   const double h_y = p.domain.width_y_m / static_cast<double>(p.domain.cells[1]);
   Profiles profiles(static_cast<std::size_t>(p.domain.cells[1]));
   double alpha_min_seen = 1.0, ke_max_seen = 0.0, settle_s = 0.0, wall_before = 0.0;

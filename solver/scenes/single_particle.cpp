@@ -21,7 +21,6 @@
 #include "core/constants.hpp"
 #include "core/error.hpp"
 #include "core/run_status.hpp"
-#include "core/statistics.hpp"
 #include "coupling/coupled_system.hpp"
 #include "coupling/drag_laws.hpp"
 #include "io/checkpoint_file.hpp"
@@ -30,6 +29,7 @@
 #include "scenes/coupled_output.hpp"
 #include "scenes/run_common.hpp"
 #include "scenes/scene.hpp"
+#include "stats/running.hpp"
 
 namespace boycott::scenes {
 
@@ -38,7 +38,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   ModelTimers timers;
   coupling::CoupledSystem run(p, coupling::CoupledOptions{true, true});
   const auto& s = run.dem().particles();
-  BatchMeans wp_avg;
+  stats::BatchMeans wp_avg;
   double acc0 = kUnset, next_out = 0.0, wall_before = 0.0;  // next_out: the resumed output's, s
 
   const auto resumed = resume_coupled(

@@ -13,12 +13,12 @@
 #include "core/run_status.hpp"
 #include "core/scene_specs.hpp"
 #include "core/version.hpp"
-#include "scenes/mean_error.hpp"
+#include "scenes/summary_statistics.hpp"
 
 namespace boycott::scenes {
 
-StepSeries read_step_series(const io::CheckpointReader& r) {
-  StepSeries s;
+stats::StepSeries read_step_series(const io::CheckpointReader& r) {
+  stats::StepSeries s;
   if (r.has("stats.wp_before")) {
     s.before = r.doubles("stats.wp_before");
     s.before_dt = r.doubles("stats.wp_before_dt");
@@ -29,7 +29,7 @@ StepSeries read_step_series(const io::CheckpointReader& r) {
   return s;
 }
 
-void write_step_series(io::CheckpointWriter& w, const StepSeries& s) {
+void write_step_series(io::CheckpointWriter& w, const stats::StepSeries& s) {
   w.put("stats.wp_before", s.before);
   w.put("stats.wp_before_dt", s.before_dt);
   w.put("stats.wp_dt", s.window_dt);
@@ -66,7 +66,7 @@ nlohmann::json resummarize_run(const std::filesystem::path& run_dir) {
                     "recompute from",
                     run_dir.string(), ckpt->filename().string()));
   const CaseParams p = case_from_json(nlohmann::json::parse(r.string("case_json")));
-  const StepSeries steps = read_step_series(r);
+  const stats::StepSeries steps = read_step_series(r);
   const auto window = r.doubles("stats.wp_series");
   const double now_s = r.scalar("run.time_s");
   if (j.contains("warnings")) {
@@ -75,9 +75,9 @@ nlohmann::json resummarize_run(const std::filesystem::path& run_dir) {
       if (!w.is_string() || !is_settling_statistics_warning(w.get<std::string>())) kept.push_back(w);
     j["warnings"] = kept;
   }
-  const ChosenWindow chosen = averaging_window(p.time.average_from, steps, window, now_s);
-  const WindowError w =
-      window_error(chosen.window, chosen.from_s, now_s, j.value("status", "") == kStatusConverged);
+  const stats::ChosenWindow chosen = averaging_window(p.time.average_from, steps, window, now_s);
+  const stats::WindowError w =
+      stats::window_error(chosen.window, chosen.from_s, now_s, j.value("status", "") == kStatusConverged);
   report_settling_statistics(j, chosen.steps, chosen.window, w, true);
   if (p.time.average_from.automatic) {
     j["mean_settling_velocity_m_s"] = w.e.mean;

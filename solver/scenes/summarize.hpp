@@ -7,15 +7,15 @@
 #include <nlohmann/json.hpp>
 
 #include "io/checkpoint_file.hpp"
-#include "scenes/mean_error.hpp"
+#include "scenes/summary_statistics.hpp"
 
 namespace boycott::scenes {
 
 /// The step series an inclined_settling checkpoint keeps beside <w_p>'s window series (the samples
 /// before the window, the step lengths); marked incomplete for checkpoints of builds without them.
-StepSeries read_step_series(const io::CheckpointReader& r);
+stats::StepSeries read_step_series(const io::CheckpointReader& r);
 /// ... and written.
-void write_step_series(io::CheckpointWriter& w, const StepSeries& s);
+void write_step_series(io::CheckpointWriter& w, const stats::StepSeries& s);
 
 /// The run's summary.json with the statistics of <<w_p>> recomputed and their warnings replaced
 /// (not written). Throws InputError when the folder holds no finished inclined_settling run or

@@ -2,8 +2,8 @@
 // stated interval holds the true value about 68 % of the time (binomial standard error of the
 // coverage at 10 000 studies: 0.005). The series are AR(1) with a known integrated
 // autocorrelation time tau_int of 10 steps, started from the stationary distribution (no
-// transient), true mean 0; the product's own rules make the intervals (core/statistics.hpp,
-// core/distributions.hpp, driver/store/point_error.hpp).
+// transient), true mean 0; the product's own rules make the intervals (stats/window_error.hpp,
+// stats/distributions.hpp, stats/point_error.hpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,12 +13,13 @@
 #include <utility>
 #include <vector>
 
-#include "core/distributions.hpp"
-#include "core/statistics.hpp"
-#include "driver/store/point_error.hpp"
+#include "stats/autocorrelation.hpp"
+#include "stats/distributions.hpp"
+#include "stats/point_error.hpp"
+#include "stats/transient.hpp"
+#include "stats/window_error.hpp"
 
-using namespace boycott;
-namespace bd = boycott::driver;
+using namespace boycott::stats;
 
 namespace {
 
@@ -50,8 +51,8 @@ class Ar1 {
 
 // The replica means of one point: series of 50 correlation times each, scaled to spread `scale`
 // times 0.2 around `mean`.
-std::vector<bd::RunEstimate> replicas(Ar1& ar, int n, double mean = -1.0, double scale = 1.0) {
-  std::vector<bd::RunEstimate> r(n);
+std::vector<RunEstimate> replicas(Ar1& ar, int n, double mean = -1.0, double scale = 1.0) {
+  std::vector<RunEstimate> r(n);
   for (auto& x : r) x.w_m_s = mean + scale * ar.mean_of(static_cast<std::size_t>(50 * kTau));
   return r;
 }
@@ -91,7 +92,7 @@ TEST(ErrorCoverage, BetweenReplicaErrorCoversTwoThirdsAtTwoThreeFourAndTenReplic
     int covered = 0;
     for (int s = 0; s < studies; ++s) {
       const auto runs = replicas(ar, n);
-      const auto e = bd::point_error(runs);
+      const auto e = point_error(runs);
       double mean = 0.0;
       for (const auto& r : runs) mean += r.w_m_s / n;
       ASSERT_TRUE(e.error_m_s);
@@ -115,7 +116,7 @@ TEST(ErrorCoverage, ReplicasWithShortRunsOwnErrorsCoverAndFlagTheirScatterAtTheT
     const int studies = 10000;
     int covered = 0, more = 0, less = 0;
     for (int s = 0; s < studies; ++s) {
-      std::vector<bd::RunEstimate> runs(n);
+      std::vector<RunEstimate> runs(n);
       double mean = 0.0;
       for (auto& r : runs) {
         const auto x = ar.series(static_cast<std::size_t>(10 * kTau));
@@ -124,7 +125,7 @@ TEST(ErrorCoverage, ReplicasWithShortRunsOwnErrorsCoverAndFlagTheirScatterAtTheT
         r = {e.mean, m.stderr_of_mean, m.dof};
         mean += e.mean / n;
       }
-      const auto e = bd::point_error(runs);
+      const auto e = point_error(runs);
       ASSERT_TRUE(e.error_m_s);
       covered += std::abs(mean) <= *e.error_m_s;
       more += e.basis.find("scatter more") != std::string::npos;
@@ -157,10 +158,10 @@ TEST(ErrorCoverage, AdaptiveReplicasCoverTwoThirdsAtTargetsThatNeedThreeFourAndE
       auto runs = replicas(ar, 3);
       std::vector<double> stage_one;
       for (const auto& r : runs) stage_one.push_back(r.w_m_s);
-      const int n = bd::stein_replicas_needed(stage_one, target, 10);
+      const int n = stein_replicas_needed(stage_one, target, 10);
       const auto more = replicas(ar, n - 3);
       runs.insert(runs.end(), more.begin(), more.end());
-      const auto e = bd::point_error(runs, 3);
+      const auto e = point_error(runs, 3);
       ASSERT_TRUE(e.error_m_s);
       EXPECT_EQ(e.basis, "two_stage_stein");
       double mean = 0.0;
@@ -190,7 +191,7 @@ TEST(ErrorCoverage, AccelerationRatioOfTwoIndependentPointsCoversTwoThirds) {
       double wa = 0.0, wb = 0.0;
       for (const auto& r : a) wa += r.w_m_s / n;
       for (const auto& r : b) wb += r.w_m_s / n;
-      const auto err = bd::ratio_error(wa, bd::point_error(a), wb, bd::point_error(b));
+      const auto err = ratio_error(wa, point_error(a), wb, point_error(b));
       ASSERT_TRUE(err);
       covered += std::abs(wa / wb - w_true / w90_true) <= *err;
     }
@@ -210,7 +211,7 @@ struct SingleRunCoverage {
   double batches = 0.0, width = 0.0;  ///< means of k and of the half-width over the true standard error
 };
 
-// One run's error as the product reports it (core/statistics.hpp, mean_error) over 10 000 AR(1)
+// One run's error as the product reports it (stats/window_error.hpp, mean_error) over 10 000 AR(1)
 // series of `window` correlation times, for each floor: reported only from that many correlation
 // times counted conservatively (AutocorrelationError::correlation_times; 0: always).
 std::vector<SingleRunCoverage> single_run_coverage(double tau, double window, std::uint64_t seed,
@@ -289,31 +290,31 @@ TEST(ErrorCoverage, AFloorOnTheEstimatedCountLowersAShortRunsCoverage) {
 
 TEST(PointError, ReplicasThatScatterMoreThanTheirOwnErrorsShowTheLargerAndSaySo) {
   // Three replicas 10 apart with own errors of 1: the scatter wins, and the basis says why.
-  std::vector<bd::RunEstimate> wide{{-10.0, 1.0, 50.0}, {0.0, 1.0, 50.0}, {10.0, 1.0, 50.0}};
-  auto e = bd::point_error(wide);
+  std::vector<RunEstimate> wide{{-10.0, 1.0, 50.0}, {0.0, 1.0, 50.0}, {10.0, 1.0, 50.0}};
+  auto e = point_error(wide);
   ASSERT_TRUE(e.error_m_s);
   EXPECT_NEAR(*e.error_m_s, one_sigma_t_factor(2.0) * 10.0 / std::sqrt(3.0), 1e-12);
   EXPECT_NE(e.basis.find("between_replicas_t; the replicas scatter more"), std::string::npos) << e.basis;
   // Three replicas that agree to 0.01 with own errors of 1: the pooled within-run error.
-  std::vector<bd::RunEstimate> tight{{-1.0, 1.0, 50.0}, {-1.01, 1.0, 50.0}, {-0.99, 1.0, 50.0}};
-  e = bd::point_error(tight);
+  std::vector<RunEstimate> tight{{-1.0, 1.0, 50.0}, {-1.01, 1.0, 50.0}, {-0.99, 1.0, 50.0}};
+  e = point_error(tight);
   ASSERT_TRUE(e.error_m_s);
   EXPECT_NEAR(*e.error_m_s, std::sqrt(3.0) / 3.0 * one_sigma_t_factor(150.0), 1e-9);
   EXPECT_NE(e.basis.find("within_runs_pooled; the replicas agree more closely"), std::string::npos)
       << e.basis;
   // Consistent ones: the between-replica rule, plainly.
-  std::vector<bd::RunEstimate> fair{{-1.0, 1.0, 50.0}, {0.2, 1.0, 50.0}, {-2.1, 1.0, 50.0}};
-  EXPECT_EQ(bd::point_error(fair).basis, "between_replicas_t");
+  std::vector<RunEstimate> fair{{-1.0, 1.0, 50.0}, {0.2, 1.0, 50.0}, {-2.1, 1.0, 50.0}};
+  EXPECT_EQ(point_error(fair).basis, "between_replicas_t");
 }
 
 TEST(PointError, OneRunUsesItsOwnDegreesOfFreedomOrSaysItHasNone) {
-  auto e = bd::point_error({{-1.0, 0.1, 2.0}});
+  auto e = point_error({{-1.0, 0.1, 2.0}});
   EXPECT_NEAR(*e.error_m_s, 0.1 * one_sigma_t_factor(2.0), 1e-12);
   EXPECT_EQ(e.basis, "single_run");
-  e = bd::point_error({{-1.0, 0.1, std::nullopt}});  // a run of a build that stored no dof
+  e = point_error({{-1.0, 0.1, std::nullopt}});  // a run of a build that stored no dof
   EXPECT_DOUBLE_EQ(*e.error_m_s, 0.1);
   EXPECT_EQ(e.basis, "single_run_plain");
-  EXPECT_FALSE(bd::point_error({{-1.0, std::nullopt, std::nullopt}}).error_m_s);
+  EXPECT_FALSE(point_error({{-1.0, std::nullopt, std::nullopt}}).error_m_s);
 }
 
 namespace {

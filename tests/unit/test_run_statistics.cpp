@@ -1,5 +1,5 @@
-// What a run reports about its time average (scenes/mean_error.hpp): the early stop's error, the
-// time-weighted mean, the start-up transient.
+// What a run reports about its time average (stats/, scenes/summary_statistics.hpp): the early
+// stop's error, the time-weighted mean, the start-up transient.
 //
 // time.target_rel_error stops a run once its covering error is below the target (PrecisionTarget). A stop
 // that the estimate itself decides tends to come where tau was under-estimated; here the error reported at
@@ -12,8 +12,10 @@
 #include <random>
 #include <vector>
 
-#include "core/statistics.hpp"
-#include "scenes/mean_error.hpp"
+#include "scenes/summary_statistics.hpp"
+#include "stats/precision_target.hpp"
+#include "stats/transient.hpp"
+#include "stats/window_error.hpp"
 
 using namespace boycott;
 
@@ -30,7 +32,7 @@ TEST(ErrorCoverage, EarlyStopErrorCoverageAtThreeTargets) {
     int covered = 0, stopped = 0;
     double samples = 0.0;
     for (int s = 0; s < series; ++s) {
-      scenes::PrecisionTarget stop(target);
+      stats::PrecisionTarget stop(target);
       std::vector<double> x;
       double v = g(rng);
       // A run that never meets the target ends at 100 000 samples (time.end); not counted.
@@ -43,7 +45,7 @@ TEST(ErrorCoverage, EarlyStopErrorCoverageAtThreeTargets) {
       ++stopped;
       samples += static_cast<double>(x.size());
       // The error the run reports (summary.json's error_m_s of a run the target stopped).
-      const auto w = scenes::window_error(x, 0.0, static_cast<double>(x.size()), true);
+      const auto w = stats::window_error(x, 0.0, static_cast<double>(x.size()), true);
       covered += std::abs(w.e.mean + 1.0) <= w.err.covering_error;
     }
     const double c = static_cast<double>(covered) / stopped;
@@ -59,7 +61,7 @@ TEST(TimeWeightedMean, StepsOfTwoLengthsWeighTheirSamplesByLength) {
   // Samples 1, 2, 3, 4 over steps of 1 ms and 3 ms alternately: (1*1 + 2*3 + 3*1 + 4*3) / 8 = 2.75,
   // where the mean over steps is 2.5; the error 0.1 is exceeded, so it is said.
   nlohmann::json j;
-  scenes::StepSeries s;
+  stats::StepSeries s;
   s.window_dt = {1e-3, 3e-3, 1e-3, 3e-3};
   scenes::report_time_weighted(j, "settling_velocity_", "<<w_p>>", {1.0, 2.0, 3.0, 4.0}, s, 0.1, true);
   EXPECT_DOUBLE_EQ(j["settling_velocity_time_weighted_m_s"].get<double>(), 2.75);
@@ -80,7 +82,7 @@ TEST(TransientReport, AWindowThatStartsInsideTheTransientIsWarnedWithWhereItEnds
   // (50 steps) on white noise of unit spread, which lasts well into the window.
   std::mt19937_64 rng(11);
   std::normal_distribution<double> g(0.0, 1.0);
-  scenes::StepSeries s;
+  stats::StepSeries s;
   std::vector<double> window;
   for (int k = 0; k < 2000; ++k) {
     const double t = 0.01 * (k + 1), x = 5.0 * std::exp(-t / 0.5) + g(rng);
@@ -104,7 +106,7 @@ TEST(TransientReport, AWindowThatStartsInsideTheTransientIsWarnedWithWhereItEnds
   EXPECT_NE(j["warnings"][0].get<std::string>().find("after time.average_from = 0.5 s"), std::string::npos)
       << j["warnings"][0];
   // The same series averaged from 5 s: the transient is over, nothing to say.
-  scenes::StepSeries late;
+  stats::StepSeries late;
   std::vector<double> late_window;
   for (std::size_t k = 0; k < s.before.size() + window.size(); ++k) {
     const double x = k < s.before.size() ? s.before[k] : window[k - s.before.size()];
@@ -127,7 +129,7 @@ TEST(TransientReport, AnAutomaticWindowStartsWhereTheTransientEndsAndReportsNoTr
   // transient ends, its start is the sum of the steps before the cut, the head joins `before`.
   std::mt19937_64 rng(12);
   std::normal_distribution<double> g(0.0, 1.0);
-  scenes::StepSeries s;
+  stats::StepSeries s;
   std::vector<double> all;
   double t = 0.0;
   for (int k = 0; k < 2000; ++k) {
@@ -136,7 +138,7 @@ TEST(TransientReport, AnAutomaticWindowStartsWhereTheTransientEndsAndReportsNoTr
     all.push_back(5.0 * std::exp(-t / 0.5) + g(rng));
     s.window_dt.push_back(dt);
   }
-  const scenes::ChosenWindow c = scenes::cut_at_transient(s, all, 0.0, t);
+  const stats::ChosenWindow c = stats::cut_at_transient(s, all, 0.0, t);
   const std::size_t cut = c.steps.before.size();
   ASSERT_EQ(cut + c.window.size(), all.size());
   ASSERT_EQ(c.steps.before_dt.size(), cut);
@@ -157,12 +159,12 @@ TEST(TransientReport, AnAutomaticWindowStartsWhereTheTransientEndsAndReportsNoTr
   // A stationary series loses little; a series too short for an estimate is not cut.
   std::vector<double> flat(2000);
   for (auto& x : flat) x = g(rng);
-  scenes::StepSeries none;
+  stats::StepSeries none;
   none.dt_whole = false;
-  const auto f = scenes::cut_at_transient(none, flat, 1.0, 21.0);
+  const auto f = stats::cut_at_transient(none, flat, 1.0, 21.0);
   EXPECT_LE(f.steps.before.size(), 200u);
   EXPECT_NEAR(f.from_s, 1.0 + 20.0 * static_cast<double>(f.steps.before.size()) / 2000.0, 1e-12);
-  const auto tiny = scenes::cut_at_transient(none, {1.0, 2.0, 3.0}, 1.0, 2.0);
+  const auto tiny = stats::cut_at_transient(none, {1.0, 2.0, 3.0}, 1.0, 2.0);
   EXPECT_EQ(tiny.window.size(), 3u);
   EXPECT_EQ(tiny.from_s, 1.0);
 }
@@ -170,12 +172,12 @@ TEST(TransientReport, AnAutomaticWindowStartsWhereTheTransientEndsAndReportsNoTr
 TEST(WindowErrorReport, AWarningSaysWhatTheErrorRestsOnAndCallsNoLongWindowShort) {
   // A long window whose autocorrelation window did not close: the error comes from its batches,
   // and the warning names them without calling 80 correlation times "below 20".
-  scenes::WindowError w;
+  stats::WindowError w;
   w.e.samples = 8000;
   w.e.tau_int = w.e.tau_int_upper = 100.0;
   w.e.correlation_times = 80.0;
   w.e.window_closed = false;
-  w.err.basis = MeanError::Basis::batch_means;
+  w.err.basis = stats::MeanError::Basis::batch_means;
   w.err.batches = 4;
   w.err.dof = 3.0;
   w.window_s = 80.0;
@@ -193,7 +195,7 @@ TEST(WindowErrorReport, AWarningSaysWhatTheErrorRestsOnAndCallsNoLongWindowShort
   // A short window: "only", and the halves.
   w.e.correlation_times = 8.0;
   w.e.window_closed = true;
-  w.err.basis = MeanError::Basis::two_halves;
+  w.err.basis = stats::MeanError::Basis::two_halves;
   w.err.batches = 2;
   nlohmann::json short_window;
   scenes::report_window_error(short_window, "settling_velocity_", "<w_p>", w, true, std::nan(""));

@@ -5,9 +5,10 @@
 #include <random>
 #include <vector>
 
-#include "core/statistics.hpp"
+#include "stats/autocorrelation.hpp"
+#include "stats/running.hpp"
 
-using namespace boycott;
+using namespace boycott::stats;
 
 TEST(BatchMeans, StandardErrorOfCorrelatedSeriesMatchesAR1Theory) {
   // AR(1): x_n = phi x_{n-1} + eps, var(eps) = 1. Stationary variance 1/(1 - phi^2); the standard

@@ -24,7 +24,7 @@ import json, math, sys, pathlib
 
 def incomplete_beta(a, b, x):
     """Regularized I_x(a, b) by its continued fraction (modified Lentz), an oracle written apart
-    from the product's core/distributions.cpp."""
+    from the product's stats/distributions.cpp."""
     if x <= 0.0: return 0.0
     if x >= 1.0: return 1.0
     if x > (a + 1.0) / (a + b + 2.0): return 1.0 - incomplete_beta(b, a, 1.0 - x)

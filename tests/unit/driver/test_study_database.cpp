@@ -10,9 +10,10 @@
 #include <gtest/gtest.h>
 
 #include <sqlite3.h>
-#include "core/distributions.hpp"
 #include "core/run_status.hpp"
+#include "stats/distributions.hpp"
 
+#include "driver/report/curve_query.hpp"
 #include "driver/store/database.hpp"
 #include "driver/store/schema_files.hpp"
 #include "driver/store/store.hpp"
@@ -309,10 +310,10 @@ average_from = 1.0
   EXPECT_NEAR(*pts[0].r_acc, m45 / m90, 1e-12);
   // The covering errors: t at 2 degrees of freedom (the replicas' own errors of 1 % agree with
   // their scatter: no chi-square note), and r_acc's from Welch-Satterthwaite, written out.
-  EXPECT_NEAR(*pts[0].error.error_m_s, boycott::one_sigma_t_factor(2.0) * e45, 1e-15);
+  EXPECT_NEAR(*pts[0].error.error_m_s, boycott::stats::one_sigma_t_factor(2.0) * e45, 1e-15);
   const double a = e45 / m90, b = m45 / m90 * e90 / m90;
   const double nu = (a * a + b * b) * (a * a + b * b) / (a * a * a * a / 2.0 + b * b * b * b / 2.0);
-  EXPECT_NEAR(*pts[0].r_acc_err, std::hypot(a, b) * boycott::one_sigma_t_factor(nu), 1e-12);
+  EXPECT_NEAR(*pts[0].r_acc_err, std::hypot(a, b) * boycott::stats::one_sigma_t_factor(nu), 1e-12);
   EXPECT_EQ(*pts[1].r_acc_err, 0.0);
   // The error keys of <<w_p>> are not validation errors.
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results WHERE validation_errors_json LIKE '%settling_velocity%'"),

@@ -10,9 +10,9 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "core/distributions.hpp"
 #include "core/error.hpp"
 #include "driver/report/curve.hpp"
+#include "driver/report/curve_query.hpp"
 #include "driver/report/plot_cairo.hpp"
 #include "driver/report/terminal_text.hpp"
 #include "driver/report/validation_query.hpp"
@@ -21,6 +21,7 @@
 #include "driver/store/database.hpp"
 #include "driver/store/store.hpp"
 #include "driver/study/study.hpp"
+#include "stats/distributions.hpp"
 
 namespace bd = boycott::driver;
 namespace fs = std::filesystem;
@@ -637,7 +638,8 @@ average_from = 1.0
   ASSERT_EQ(pts.size(), 1u);
   EXPECT_EQ(pts[0].n_replicas, 7);
   EXPECT_EQ(pts[0].error.basis, "two_stage_stein");
-  EXPECT_NEAR(*pts[0].error.error_m_s, boycott::one_sigma_t_factor(2.0) * 0.002 / std::sqrt(7.0), 1e-12);
+  EXPECT_NEAR(*pts[0].error.error_m_s, boycott::stats::one_sigma_t_factor(2.0) * 0.002 / std::sqrt(7.0),
+              1e-12);
 }
 
 TEST(Listings, CasesAsTableCsvAndJsonHoldTheSameRows) {

@@ -6,7 +6,7 @@
 // 6.5.29, 6.5.31), evaluated with the modified Lentz method (Thompson & Barnett, J. Comput. Phys.
 // 64, 490 (1986)).
 
-namespace boycott {
+namespace boycott::stats {
 
 /// The probability inside +-1 standard deviation of a normal distribution, 0.6827: the coverage
 /// an error bar of one standard error promises.
@@ -29,4 +29,4 @@ double chi_square_cdf(double x, double k);
 /// with d1 over d1).
 double f_cdf(double x, double d1, double d2);
 
-}  // namespace boycott
+}  // namespace boycott::stats

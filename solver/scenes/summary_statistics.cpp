@@ -1,7 +1,8 @@
-#include "scenes/mean_error.hpp"
+#include "scenes/summary_statistics.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 
 #include <unistd.h>
@@ -11,17 +12,6 @@
 #include "scenes/run_common.hpp"
 
 namespace boycott::scenes {
-
-WindowError window_error(const std::vector<double>& series, double window_from_s, double now_s,
-                         bool stopped_by_target) {
-  WindowError w;
-  w.e = autocorrelation_error(series);
-  w.err = stopped_by_target ? sokal_mean_error(w.e) : mean_error(series, w.e);
-  w.from_s = window_from_s;
-  w.window_s = std::max(0.0, now_s - window_from_s);
-  w.sample_s = series.empty() ? 0.0 : w.window_s / static_cast<double>(series.size());
-  return w;
-}
 
 void add_warning(nlohmann::json& j, const std::string& text) {
   if (!j.contains("warnings")) j["warnings"] = nlohmann::json::array();
@@ -33,7 +23,7 @@ void add_warning(nlohmann::json& j, const std::string& text) {
 }
 
 void report_window_error(nlohmann::json& j, const std::string& prefix, const std::string& what,
-                         const WindowError& w, bool warn, double transient_end_s) {
+                         const stats::WindowError& w, bool warn, double transient_end_s) {
   const auto& e = w.e;
   auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   j[prefix + "stderr_m_s"] = num(w.err.stderr_of_mean);
@@ -43,18 +33,18 @@ void report_window_error(nlohmann::json& j, const std::string& prefix, const std
   j[prefix + "correlation_time_upper_s"] = num(w.correlation_time_upper_s());
   j[prefix + "effective_samples"] = num(e.effective_samples);
   j[prefix + "window_correlation_times"] = num(e.correlation_times);
-  j[prefix + "error_method"] = error_method_name(w.err.basis);
+  j[prefix + "error_method"] = stats::error_method_name(w.err.basis);
   j[prefix + "error_batches"] = w.err.batches > 0 ? nlohmann::json(w.err.batches) : nlohmann::json(nullptr);
   if (e.samples == 0 || !warn) return;
   std::string rests_on = "its error is not reported (fewer than 8 samples)";
-  if (w.err.basis == MeanError::Basis::two_halves)
+  if (w.err.basis == stats::MeanError::Basis::two_halves)
     rests_on =
         "its error comes from the difference of the window's two halves (1 degree of freedom; it "
         "covers ~2/3 of the time from ~10 correlation times on, less in shorter windows)";
-  else if (w.err.basis == MeanError::Basis::batch_means)
+  else if (w.err.basis == stats::MeanError::Basis::batch_means)
     rests_on = fmt::format("its error comes from {} batch means ({} degrees of freedom)", w.err.batches,
                            w.err.batches - 1);
-  else if (w.err.basis == MeanError::Basis::autocorrelation)
+  else if (w.err.basis == stats::MeanError::Basis::autocorrelation)
     rests_on = "its error is Sokal's, on which the run's target stopped it";
   if (!std::isfinite(e.tau_int)) {
     add_warning(
@@ -75,53 +65,31 @@ void report_window_error(nlohmann::json& j, const std::string& prefix, const std
                   "earlier would take it in)",
                   transient_end_s);
   // Doubtful with enough correlation times: only the autocorrelation window failed to close.
-  const bool few = !(e.correlation_times >= AutocorrelationError::kWarnCorrelationTimes);
+  const bool few = !(e.correlation_times >= stats::AutocorrelationError::kWarnCorrelationTimes);
   add_warning(
-      j, fmt::format("the averaging window ({:.4g} s) holds {}{:.1f} correlation times of {} (tau_int "
-                     "{:.3g} s, at most {:.3g} s{}); {}: {}",
-                     w.window_s, few ? "only " : "", e.correlation_times, what, w.correlation_time_s(),
-                     w.correlation_time_upper_s(),
-                     e.window_closed ? "" : ", the autocorrelation window did not close",
-                     few ? fmt::format("below {:g} {}", AutocorrelationError::kWarnCorrelationTimes, rests_on)
-                         : rests_on,
-                     advice));
+      j,
+      fmt::format(
+          "the averaging window ({:.4g} s) holds {}{:.1f} correlation times of {} (tau_int "
+          "{:.3g} s, at most {:.3g} s{}); {}: {}",
+          w.window_s, few ? "only " : "", e.correlation_times, what, w.correlation_time_s(),
+          w.correlation_time_upper_s(), e.window_closed ? "" : ", the autocorrelation window did not close",
+          few ? fmt::format("below {:g} {}", stats::AutocorrelationError::kWarnCorrelationTimes, rests_on)
+              : rests_on,
+          advice));
 }
 
-ChosenWindow cut_at_transient(const StepSeries& s, const std::vector<double>& window, double collected_from_s,
-                              double now_s) {
-  ChosenWindow c{s, window, collected_from_s};
-  const TransientEnd cut = transient_end(window);
-  if (!std::isfinite(cut.effective_samples) || cut.start <= 0) return c;
-  const auto k = static_cast<std::size_t>(cut.start);
-  c.steps.before.insert(c.steps.before.end(), window.begin(),
-                        window.begin() + static_cast<std::ptrdiff_t>(k));
-  c.window.erase(c.window.begin(), c.window.begin() + static_cast<std::ptrdiff_t>(k));
-  if (s.dt_whole && s.window_dt.size() == window.size()) {
-    for (std::size_t i = 0; i < k; ++i) c.from_s += s.window_dt[i];
-    c.steps.before_dt.insert(c.steps.before_dt.end(), s.window_dt.begin(),
-                             s.window_dt.begin() + static_cast<std::ptrdiff_t>(k));
-    c.steps.window_dt.erase(c.steps.window_dt.begin(),
-                            c.steps.window_dt.begin() + static_cast<std::ptrdiff_t>(k));
-  } else {  // no step lengths: the cut's time from the mean step
-    c.from_s += (now_s - collected_from_s) * static_cast<double>(k) / static_cast<double>(window.size());
-    c.steps.dt_whole = false;
-    c.steps.window_dt.clear();
-  }
-  return c;
+stats::ChosenWindow averaging_window(const WindowStart& start, const stats::StepSeries& s,
+                                     const std::vector<double>& collected, double now_s) {
+  return start.automatic ? stats::cut_at_transient(s, collected, start.collect_from_s(), now_s)
+                         : stats::ChosenWindow{s, collected, start.collect_from_s()};
 }
 
-ChosenWindow averaging_window(const WindowStart& start, const StepSeries& s,
-                              const std::vector<double>& collected, double now_s) {
-  return start.automatic ? cut_at_transient(s, collected, start.collect_from_s(), now_s)
-                         : ChosenWindow{s, collected, start.collect_from_s()};
-}
-
-double report_transient(nlohmann::json& j, const std::string& what, const StepSeries& s,
+double report_transient(nlohmann::json& j, const std::string& what, const stats::StepSeries& s,
                         const std::vector<double>& window, double window_from_s, bool warn) {
   j["average_from_s"] = window_from_s;
   std::vector<double> x(s.before);
   x.insert(x.end(), window.begin(), window.end());
-  const TransientEnd cut = transient_end(x);
+  const stats::TransientEnd cut = stats::transient_end(x);
   if (!std::isfinite(cut.effective_samples)) {
     j["transient_end_s"] = nullptr;
     return std::numeric_limits<double>::quiet_NaN();
@@ -149,7 +117,7 @@ double report_transient(nlohmann::json& j, const std::string& what, const StepSe
     for (double v : s.before_dt) d += v;
     return d;
   }();
-  if (warn && cut.start > n_before && transient_biases_mean(x, n_before, cut.start))
+  if (warn && cut.start > n_before && stats::transient_biases_mean(x, n_before, cut.start))
     add_warning(
         j, fmt::format("the start-up transient of {} ends at {:.3g} s, after time.average_from = {:g} s, "
                        "and the samples between shift the mean beyond their noise: average from {:.3g} s "
@@ -159,7 +127,8 @@ double report_transient(nlohmann::json& j, const std::string& what, const StepSe
 }
 
 void report_time_weighted(nlohmann::json& j, const std::string& prefix, const std::string& what,
-                          const std::vector<double>& window, const StepSeries& s, double error, bool warn) {
+                          const std::vector<double>& window, const stats::StepSeries& s, double error,
+                          bool warn) {
   const std::string key = prefix + "time_weighted_m_s";
   if (!s.dt_whole || s.window_dt.size() != window.size() || window.empty()) {
     j[key] = nullptr;
@@ -180,8 +149,8 @@ void report_time_weighted(nlohmann::json& j, const std::string& prefix, const st
                        what, weighted, plain, error));
 }
 
-void report_settling_statistics(nlohmann::json& j, const StepSeries& s, const std::vector<double>& window,
-                                const WindowError& w, bool warn) {
+void report_settling_statistics(nlohmann::json& j, const stats::StepSeries& s,
+                                const std::vector<double>& window, const stats::WindowError& w, bool warn) {
   const double window_from_s = w.from_s;
   auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   const double transient_s = report_transient(j, "<w_p>", s, window, window_from_s, warn);
@@ -195,34 +164,6 @@ bool is_settling_statistics_warning(const std::string& text) {
        {"the averaging window (", "the start-up transient of ", "the step length varied"})
     if (text.rfind(opening, 0) == 0) return true;
   return false;
-}
-
-bool PrecisionTarget::reached(const std::vector<double>& series, double window_from_s, double now_s) {
-  if (!active() || static_cast<std::int64_t>(series.size()) < next_check_) return false;
-  // Checks every 2 % of the samples (at least 25): their cost grows with the window.
-  const auto n = static_cast<std::int64_t>(series.size());
-  next_check_ = n + std::max<std::int64_t>(25, n / 50);
-  // The run's own window: judged from where the transient is detected to end (no step lengths
-  // here: the cut's time from the mean step).
-  ChosenWindow cut;
-  if (cut_transient_)
-    cut = cut_at_transient(StepSeries{{}, {}, {}, true, false}, series, window_from_s, now_s);
-  const std::vector<double>& x = cut_transient_ ? cut.window : series;
-  if (cut_transient_) window_from_s = cut.from_s;
-  const WindowError w = window_error(x, window_from_s, now_s, true);
-  const double rel = std::abs(w.err.covering_error / w.e.mean);
-  last_rel_error_ = rel;
-  const bool met = std::isfinite(rel) && rel < target_ && w.e.correlation_times >= kMinCorrelationTimes;
-  if (!met) {
-    met_since_s_ = -1.0;
-    return false;
-  }
-  if (met_since_s_ < 0.0) met_since_s_ = now_s;
-  // A stop the estimate itself decides comes where the estimate dipped (tau under-estimated): the
-  // target must hold while a good part of the data changes, not only over a few correlation times.
-  const double confirm_s = std::max(kConfirmCorrelationTimes * w.correlation_time_upper_s(),
-                                    kConfirmWindowFraction * (met_since_s_ - window_from_s));
-  return now_s - met_since_s_ >= confirm_s;
 }
 
 }  // namespace boycott::scenes

@@ -1,4 +1,4 @@
-#include "driver/store/point_error.hpp"
+#include "stats/point_error.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,9 +6,9 @@
 
 #include <fmt/format.h>
 
-#include "core/distributions.hpp"
+#include "stats/distributions.hpp"
 
-namespace boycott::driver {
+namespace boycott::stats {
 namespace {
 
 struct Scatter {
@@ -36,6 +36,20 @@ double agreement_cdf(const Scatter& s, double mean_sq_error, double error_dof, d
 }
 
 }  // namespace
+
+ReplicaMean replica_mean(const std::vector<double>& w) {
+  ReplicaMean m;
+  double sum = 0.0;
+  for (double x : w) sum += x;
+  const double n = static_cast<double>(w.size());
+  m.mean = w.size() == 1 ? w.front() : sum / n;
+  if (w.size() >= 2) {
+    double ss = 0.0;
+    for (double x : w) ss += (x - m.mean) * (x - m.mean);
+    m.between_stderr = std::sqrt(ss / (n - 1.0)) / std::sqrt(n);
+  }
+  return m;
+}
 
 PointError point_error(const std::vector<RunEstimate>& runs, int stage_one) {
   PointError e;
@@ -127,4 +141,4 @@ int stein_replicas_needed(const std::vector<double>& stage_one_w, double target_
   return n;
 }
 
-}  // namespace boycott::driver
+}  // namespace boycott::stats

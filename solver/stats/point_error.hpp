@@ -1,10 +1,10 @@
 #pragma once
 // The error bar of a curve point and of r_acc: a half-width that covers the true value about 68 %
-// of the time (core/distributions.hpp: kOneSigmaCoverage) however few numbers it rests on.
+// of the time (stats/distributions.hpp: kOneSigmaCoverage) however few numbers it rests on.
 //
 // - One run: its own covering error (summary.json settling_velocity_error_m_s: its standard error,
 //   from the autocorrelation or from the window's two halves, times Student's t at that estimate's
-//   degrees of freedom; core/statistics.hpp, MeanError).
+//   degrees of freedom; stats/window_error.hpp, MeanError).
 // - n >= 2 replicas: t_{n-1} s / sqrt(n) (s: the replicas' sample standard deviation); where every
 //   replica states its own error, an F test of the scatter against those errors (which are
 //   themselves estimates, with their own degrees of freedom): when the two disagree (two-sided,
@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-namespace boycott::driver {
+namespace boycott::stats {
 
 /// One run's <<w_p>> and its error, as the database holds it.
 struct RunEstimate {
@@ -42,6 +42,15 @@ struct PointError {
   double dof = 0.0;
 };
 
+/// The replicas' mean and, from two replicas on, the standard error of that mean from their
+/// scatter, s / sqrt(n) (s: their sample standard deviation); one replica: its own value.
+struct ReplicaMean {
+  double mean = 0.0;
+  std::optional<double> between_stderr;  ///< unset below two replicas
+};
+/// `w`: each replica's value, in study order (at least one).
+ReplicaMean replica_mean(const std::vector<double>& w);
+
 /// The covering error of the mean of `runs` (replicas of one point, in study order).
 /// `stage_one`: the replicas an adaptive plan starts with (0: not adaptive). At least 2 is
 /// needed for Stein's rule; with fewer runs than that the plain between-replica rule applies.
@@ -55,4 +64,4 @@ std::optional<double> ratio_error(double w, const PointError& e, double w90, con
 /// with t_{n0-1} s0 / sqrt(n) <= target |mean0|, at most `max` (from its first replicas).
 int stein_replicas_needed(const std::vector<double>& stage_one_w, double target_rel_error, int max);
 
-}  // namespace boycott::driver
+}  // namespace boycott::stats

@@ -1,9 +1,9 @@
-#include "core/distributions.hpp"
+#include "stats/distributions.hpp"
 
 #include <cmath>
 #include <limits>
 
-namespace boycott {
+namespace boycott::stats {
 namespace {
 
 constexpr double kTiny = 1e-300;
@@ -111,4 +111,4 @@ double f_cdf(double x, double d1, double d2) {
   return incomplete_beta(0.5 * d1, 0.5 * d2, d1 * x / (d1 * x + d2));
 }
 
-}  // namespace boycott
+}  // namespace boycott::stats
