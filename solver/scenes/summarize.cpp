@@ -53,10 +53,10 @@ nlohmann::json resummarize_run(const std::filesystem::path& run_dir) {
   for (const auto& spec : scene_specs())
     if (spec.detects_transient) keeping.push_back(spec.name);
   if (std::find(keeping.begin(), keeping.end(), scene) == keeping.end())
-    throw InputError(fmt::format("{}: a {} run; case summarize recomputes <<w_p>> of {} runs, whose checkpoints "
-                                 "keep its per-step series",
-                                 run_dir.string(), scene.empty() ? "(no scene named)" : scene,
-                                 fmt::join(keeping, ", ")));
+    throw InputError(
+        fmt::format("{}: a {} run; case summarize recomputes <<w_p>> of {} runs, whose checkpoints "
+                    "keep its per-step series",
+                    run_dir.string(), scene.empty() ? "(no scene named)" : scene, fmt::join(keeping, ", ")));
   const auto ckpt = io::latest_checkpoint(run_dir);
   if (!ckpt) throw InputError(fmt::format("{}: no checkpoint to recompute from", run_dir.string()));
   const io::CheckpointReader r(*ckpt);
