@@ -86,8 +86,8 @@ template <class Rolling>
 void DemSystem::compute_forces_impl(const Rolling& rolling) {
   // A fused kick has zeroed the local particles' forces and torques (kick_kick_drift); the ghost
   // copies' are zeroed here.
-  const std::size_t zero_from = local_forces_zeroed_ ? s_.n_local : 0;
-  local_forces_zeroed_ = false;
+  const std::size_t zero_from = fused_.local_forces_zeroed ? s_.n_local : 0;
+  fused_.local_forces_zeroed = false;
   for (auto* a : {&s_.fx, &s_.fy, &s_.fz, &s_.tx, &s_.ty, &s_.tz})
     std::fill(a->begin() + static_cast<std::ptrdiff_t>(zero_from), a->end(), 0.0);
   const LinearSpringDashpot& cm = cfg_.contact;
@@ -119,27 +119,27 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   const double* __restrict mass = s_.mass.data();
   const double* __restrict inertia = s_.inertia.data();
   std::int64_t contacts = 0;
-  const bool uniform = uniform_mass_kg_ > 0.0;
-  const double gn_pair = cm.gamma_n(0.5 * uniform_mass_kg_), gn_wall = cm.gamma_n(uniform_mass_kg_);
+  const bool uniform = uniform_.mass_kg > 0.0;
+  const double gn_pair = cm.gamma_n(0.5 * uniform_.mass_kg), gn_wall = cm.gamma_n(uniform_.mass_kg);
 
   // Pass 1: which list pairs overlap. In a suspension most list pairs (8 in 9 on the LIGGGHTS
   // bench) are apart, so this is a short branch-free loop that only appends the pair to the
   // contact list; the contact work below then runs without mispredicted branches.
-  const std::uint32_t* __restrict nb = nl_.neighbors.data();
-  const std::size_t np = nl_.pair_count();
-  contact_i_.resize(np);
-  contact_p_.resize(np);
-  std::uint32_t* __restrict ci = contact_i_.data();
-  std::uint32_t* __restrict cp = contact_p_.data();
+  const std::uint32_t* __restrict nb = verlet_.list.neighbors.data();
+  const std::size_t np = verlet_.list.pair_count();
+  pairs_.row.resize(np);
+  pairs_.slot.resize(np);
+  std::uint32_t* __restrict ci = pairs_.row.data();
+  std::uint32_t* __restrict cp = pairs_.slot.data();
   // Equal radii (and moments of inertia): the usual monodisperse case, where the loops below take
   // them as constants (the same values, so the same bits) instead of gathering them per pair.
-  const double Ru = uniform_radius_m_, Iu = uniform_inertia_kg_m2_;
+  const double Ru = uniform_.radius_m, Iu = uniform_.inertia_kg_m2;
   const bool same_r = Ru > 0.0;
   const int variant = (px ? 1 : 0) | (py ? 2 : 0) | (pz ? 4 : 0) | (same_r ? 8 : 0);
-  pair_flag_.resize(np);
-  const std::size_t nc = kFindContacts[variant](np, pair_i_.data(), nb, x, y, z, rad, Ru + Ru, cfg_.box.len,
-                                                pair_flag_.data(), ci, cp);
-  pair_hist_.carry_to_contacts(cp, nc);
+  pairs_.flag.resize(np);
+  const std::size_t nc = kFindContacts[variant](np, verlet_.row_of_slot.data(), nb, x, y, z, rad, Ru + Ru,
+                                                cfg_.box.len, pairs_.flag.data(), ci, cp);
+  pairs_.springs.carry_to_contacts(cp, nc);
   contacts = static_cast<std::int64_t>(nc);
 
   // Pass 2a: each contact's force and torques, written per contact. Each contact has its own
@@ -150,8 +150,8 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   // memory; the additions keep contact order, so the sums are the same bits as with one pass
   // over all contacts.
   constexpr std::size_t kBlock = 256;
-  contact_out_.resize(9 * kBlock);
-  double* __restrict oFx = contact_out_.data();
+  pairs_.block_out.resize(9 * kBlock);
+  double* __restrict oFx = pairs_.block_out.data();
   double* __restrict oFy = oFx + kBlock;
   double* __restrict oFz = oFy + kBlock;
   double* __restrict oTix = oFz + kBlock;
@@ -160,7 +160,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   double* __restrict oTjx = oTiz + kBlock;
   double* __restrict oTjy = oTjx + kBlock;
   double* __restrict oTjz = oTjy + kBlock;
-  double* __restrict hist = pair_hist_.data();  // per contact, in contact order
+  double* __restrict hist = pairs_.springs.data();  // per contact, in contact order
   const double iLx = 1.0 / Lx, iLy = 1.0 / Ly, iLz = 1.0 / Lz;
   // The period of each direction, 0 where it is not periodic (min_image then leaves d as it is):
   // a select on the loop-invariant flag would keep the loop from vectorising.
@@ -251,22 +251,22 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
   // vectorisable loop over the touching ones (each particle once per wall: no conflicts).
   // Local particles only: a ghost's wall contact is its own rank's.
   const std::size_t nloc = s_.n_local;
-  wall_contact_.resize(nloc);
-  if (pair_flag_.size() < nloc) pair_flag_.resize(nloc);
-  prev_wall_contacts_.resize(cfg_.walls.size());
-  std::uint32_t* __restrict wc = wall_contact_.data();
+  walls_.found.resize(nloc);
+  walls_.flag.resize(nloc);
+  walls_.touching.resize(cfg_.walls.size());
+  std::uint32_t* __restrict wc = walls_.found.data();
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
     const PlaneWall& W = cfg_.walls[w];
     const double nx = W.nx, ny = W.ny, nz = W.nz, wpx = W.px, wpy = W.py, wpz = W.pz;
-    double* __restrict whx = whx_[w].data();
-    double* __restrict why = why_[w].data();
-    double* __restrict whz = whz_[w].data();
-    const std::size_t nw = find_wall_contacts(nloc, W, x, y, z, rad, pair_flag_.data(), wc);
-    for (std::uint32_t i : prev_wall_contacts_[w]) {
+    double* __restrict whx = walls_.hx[w].data();
+    double* __restrict why = walls_.hy[w].data();
+    double* __restrict whz = walls_.hz[w].data();
+    const std::size_t nw = find_wall_contacts(nloc, W, x, y, z, rad, walls_.flag.data(), wc);
+    for (std::uint32_t i : walls_.touching[w]) {
       const double dist = (x[i] - wpx) * nx + (y[i] - wpy) * ny + (z[i] - wpz) * nz;
       if (dist >= rad[i]) whx[i] = why[i] = whz[i] = 0.0;
     }
-    prev_wall_contacts_[w].assign(wc, wc + nw);
+    walls_.touching[w].assign(wc, wc + nw);
     contacts += static_cast<std::int64_t>(nw);
     // The force budget (off in production runs): each contact's y-force, as what the loop adds.
     std::vector<double> fy_before;
@@ -310,7 +310,7 @@ void DemSystem::compute_forces_impl(const Rolling& rolling) {
       for (std::size_t k = 0; k < nw; ++k)
         wall_force_y_budget->add(y[wc[k]], (fy[wc[k]] - fy_before[k]) * cfg_.dt_s);
   }
-  contacts_ = contacts;
+  counters_.contacts = contacts;
 }
 
 void DemSystem::compute_forces() {
