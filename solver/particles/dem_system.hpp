@@ -152,8 +152,18 @@ class DemSystem {
   Histogram* wall_force_y_budget = nullptr;
 
  private:
+  // The force evaluation (contact_forces.cpp): pairs, then walls.
   template <class Rolling>
   void compute_forces_impl(const Rolling& rolling);
+  /// Zeroes the forces and torques that a fused kick has not already zeroed.
+  void zero_unspent_forces();
+  /// The overlapping list pairs into pairs_ (row, slot), their springs carried over; their number.
+  std::size_t find_pair_contacts();
+  template <class Rolling>
+  void add_pair_forces(const Rolling& rolling, std::size_t nc);
+  /// Returns the number of wall contacts.
+  template <class Rolling>
+  std::size_t add_wall_forces(const Rolling& rolling);
   // Several ranks (parallel_dem.cpp): the rebuild moves particles between ranks and renews the
   // ghost copies; between rebuilds the ghosts' positions and velocities are refreshed.
   bool needs_rebuild_parallel();
