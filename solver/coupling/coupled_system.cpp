@@ -251,14 +251,7 @@ void CoupledSystem::activate_models(ModelTimers& t) const {
     t.activate("added_mass", "Eq. 17, particle side in the mass matrix (timed with coupling_sample)");
   if (opt_.zero_slurry_flux) t.activate("slurry_flux_control", "Eq. 25 through the mean gradient G");
   if (opt_.move_particles) {
-    t.activate("dem_contacts",
-               fmt::format("{}, k_n = {} N/m, e = {}, mu = {}", p_.contact.model, p_.contact.stiffness_n_m,
-                           p_.contact.restitution, p_.contact.friction));
-    if (p_.contact.rolling_model != "none" && p_.contact.rolling_friction > 0.0)
-      t.activate("rolling_friction", fmt::format("{}, mu_r = {} (timed with dem_contacts)",
-                                                 p_.contact.rolling_model, p_.contact.rolling_friction));
-    t.activate("neighbor_search",
-               fmt::format("linked cells + Verlet skin {} m", p_.numerics.neighbor_skin_m));
+    particles::activate_dem_models(t, p_);
     t.activate("integration", "velocity Verlet, drag and added mass implicit");
   }
 }

@@ -20,39 +20,6 @@
 
 namespace boycott::particles {
 
-bool rolling_model_enabled(const std::string& name) {
-  if (name == "constant_directional") return true;
-  if (name == "none") return false;
-  throw InputError(fmt::format("contact.rolling_model = \"{}\" is not a rolling model of this engine", name));
-}
-
-void check_contact_model(const std::string& name) {
-  if (name != "linear_spring_dashpot")
-    throw InputError(fmt::format("contact.model = \"{}\" is not a contact model of this engine", name));
-}
-
-DemConfig DemConfig::from_case(const CaseParams& p) {
-  DemConfig c;
-  c.box.lo = {0.0, 0.0, 0.0};
-  c.box.len = {p.domain.length_x_m, p.domain.width_y_m, p.domain.height_z_m};
-  c.box.periodic = {true, p.domain.periodic_y, true};
-  if (!p.domain.periodic_y) {
-    c.walls.push_back(PlaneWall{0.0, 0.0, 0.0, 0.0, 1.0, 0.0});
-    c.walls.push_back(PlaneWall{0.0, p.domain.width_y_m, 0.0, 0.0, -1.0, 0.0});
-  }
-  c.gravity_m_s2 = p.gravity_vector();
-  c.dt_s = p.time.dt_dem_s;
-  c.skin_m = p.numerics.neighbor_skin_m;
-  c.slab_excursion_m = 0.5 * c.skin_m;
-  c.contact =
-      LinearSpringDashpot(p.contact.stiffness_n_m, p.contact.restitution, p.contact.tangential_damping_ratio,
-                          p.contact.friction, p.contact.clip_attractive_normal);
-  check_contact_model(p.contact.model);
-  c.rolling_model = p.contact.rolling_model;
-  c.rolling_friction = p.contact.rolling_friction;
-  return c;
-}
-
 DemSystem::DemSystem(const DemConfig& cfg)
     : cfg_(cfg), dd_(SlabDecomposition::serial(cfg.box.lo[2], cfg.box.lo[2] + cfg.box.len[2])) {
   walls_.set_wall_count(cfg_.walls.size());
@@ -190,6 +157,10 @@ void DemSystem::rebuild() {
   wrap_periodic();
   sort_by_cell();
   verlet_.list.build_binned(s_, cfg_.box, verlet_.cutoff_m);
+  finish_rebuild(t0);
+}
+
+void DemSystem::finish_rebuild(std::chrono::steady_clock::time_point t0) {
   restore_histories(carry_.springs.a, carry_.springs.b, carry_.springs.h);
   walls_.rescan();
   verlet_.set_reference(s_);

@@ -2,6 +2,7 @@
 // The DEM engine: particles, walls, neighbour list with Verlet skin, contact histories and the
 // velocity-Verlet integrator with the coupling hook (implicit linear drag, added mass).
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <random>
@@ -10,7 +11,7 @@
 
 #include "core/case_params.hpp"
 #include "core/statistics.hpp"
-#include "particles/contact_models.hpp"
+#include "particles/dem_config.hpp"
 #include "particles/dem_parts.hpp"
 #include "particles/displacement_bound.hpp"
 #include "particles/neighbor_list.hpp"
@@ -20,31 +21,6 @@
 #include "particles/walls.hpp"
 
 namespace boycott::particles {
-
-struct DemConfig {
-  BoxGeometry box;
-  std::vector<PlaneWall> walls;
-  std::array<double, 3> gravity_m_s2 = {0.0, 0.0, 0.0};
-  double dt_s = 2.0e-5;
-  double skin_m = 0.3e-3;
-  /// Several ranks: how far (m) a particle may move along z past its slab before the next
-  /// rebuild moves it to its new rank. The pairs need no limit (the list's bound covers the
-  /// pairs across slab faces); this one keeps the particles with the rank of their slab, half
-  /// the skin by default (from_case), and a coupled run sets the reach of the fluid window.
-  double slab_excursion_m = 0.15e-3;
-  LinearSpringDashpot contact;
-  std::string rolling_model = "constant_directional";  ///< or "none"
-  double rolling_friction = 0.1;
-  /// Accumulate the applied drag impulse per particle (ParticleStore::drag_j*), for coupling.
-  bool track_drag_impulse = false;
-  /// No fluid (the dem_only scene): the external forces, fluid velocities and added masses are
-  /// all zero, so the kicks need not read them (a DEM step is memory-bound: 21 streams instead
-  /// of 36). Only the implicit drag beta toward rest remains. initialize() checks the zeros.
-  bool dry = false;
-
-  /// Channel of the case: periodic x and z, walls at y = 0 and y = W unless periodic_y.
-  static DemConfig from_case(const CaseParams& p);
-};
 
 /// Everything the next step depends on, for checkpoints: all particles of the run, whatever
 /// the number of ranks that wrote it.
@@ -196,6 +172,9 @@ class DemSystem {
   /// The displacement box of the local particles: the fused kick's when fresh, else a pass.
   DisplacementSpread local_displacement_box() const;
   void rebuild();
+  /// The end of every rebuild, once the new list stands: the carried springs put back into it,
+  /// the wall contacts rescanned, the reference positions taken; counted and timed from t0.
+  void finish_rebuild(std::chrono::steady_clock::time_point t0);
   /// Periodic coordinates wrapped into the box (before a rebuild bins them).
   void wrap_periodic();
   /// The particles (and their predictions and wall histories) stored cell by cell.

@@ -129,11 +129,7 @@ void DemSystem::rebuild_parallel(bool collect) {
   sort_by_cell();
   exchange_ghosts();
   verlet_.list.build(s_, cfg_.box, verlet_.cutoff_m, s_.n_local);
-  restore_histories(carry_.springs.a, carry_.springs.b, carry_.springs.h);
-  walls_.rescan();
-  verlet_.set_reference(s_);
-  ++counters_.rebuilds;
-  seconds_neighbor += seconds_since(t0);
+  finish_rebuild(t0);
 }
 
 void DemSystem::migrate() {
