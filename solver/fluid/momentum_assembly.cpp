@@ -92,7 +92,9 @@ template <int c>
   double* __restrict a1v = r.a1;
   double* __restrict ts = r.ts;
   double* __restrict snb = r.snb;
-  const double* __restrict a0 = m.alpha[0] + P0, * __restrict an = m.alpha[1] + P0, * __restrict anm = m.alpha[2] + P0;
+  const double* __restrict a0 = m.alpha[0] + P0;
+  const double* __restrict an = m.alpha[1] + P0;
+  const double* __restrict anm = m.alpha[2] + P0;
   const double* __restrict pp = m.p + P0, * __restrict Ko = m.K + o0, * __restrict uno = m.un + o0;
   const double* __restrict unmo = m.unm1 + o0, * __restrict So = m.S + o0, * __restrict KUo = m.KU + o0;
 #pragma GCC ivdep
@@ -349,10 +351,10 @@ void FluidSolver::compute_face_fluxes() {
   const bool wall = !s_.grid.periodic[1];
   const GhostBox gb = ghost_box();
   PetscScalar ***u[3], ***al, ***F[3];
-  BC_PETSC(DMDAVecGetArray(da_, alphal_[0], &al));
+  BC_PETSC(DMDAVecGetArray(layout_.da, ghosts_.alpha[0], &al));
   for (int d = 0; d < 3; ++d) {
-    BC_PETSC(DMDAVecGetArray(da_, Ul_[d], &u[d]));
-    BC_PETSC(DMDAVecGetArray(da_, Fl_[d], &F[d]));
+    BC_PETSC(DMDAVecGetArray(layout_.da, ghosts_.U[d], &u[d]));
+    BC_PETSC(DMDAVecGetArray(layout_.da, ghosts_.F[d], &F[d]));
   }
   const int lo[3] = {(int)gb.lo[0], (int)gb.lo[1], (int)gb.lo[2]};
   const int hi[3] = {(int)(gb.lo[0] + gb.size[0]), (int)(gb.lo[1] + gb.size[1]),
@@ -367,16 +369,16 @@ void FluidSolver::compute_face_fluxes() {
           const bool wall_face = wall && d == 1 && (j <= 0 || j >= n1);
           F[d][k][j][i] = (outside || wall_face) ? 0.0 : 0.5 * (al[k][j][i] + al[km][jm][im]) * u[d][k][j][i];
         }
-  BC_PETSC(DMDAVecRestoreArray(da_, alphal_[0], &al));
+  BC_PETSC(DMDAVecRestoreArray(layout_.da, ghosts_.alpha[0], &al));
   for (int d = 0; d < 3; ++d) {
-    BC_PETSC(DMDAVecRestoreArray(da_, Ul_[d], &u[d]));
-    BC_PETSC(DMDAVecRestoreArray(da_, Fl_[d], &F[d]));
+    BC_PETSC(DMDAVecRestoreArray(layout_.da, ghosts_.U[d], &u[d]));
+    BC_PETSC(DMDAVecRestoreArray(layout_.da, ghosts_.F[d], &F[d]));
   }
 }
 
 void FluidSolver::compute_effective_viscosity() {
-  BC_PETSC(VecCopy(nutl_, nuel_));
-  BC_PETSC(VecShift(nuel_, s_.viscosity_pa_s / s_.density_kg_m3));
+  BC_PETSC(VecCopy(ghosts_.nut, ghosts_.nue));
+  BC_PETSC(VecShift(ghosts_.nue, s_.viscosity_pa_s / s_.density_kg_m3));
 }
 
 void FluidSolver::assemble_momentum(int c, double dt, double c0, double c1, double c2, bool first_iteration,
@@ -420,21 +422,21 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
   const MomentumConstants mc =
       momentum_constants<c>(s_, flow_.G_pa_m, dt, c0, c1, c2, first_iteration, b, gb);
   MomentumArrays m;
-  for (int d = 0; d < 3; ++d) BC_PETSC(VecGetArrayRead(Ul_[d], &m.u[d]));
-  for (int d = 0; d < 3; ++d) BC_PETSC(VecGetArrayRead(Fl_[d], &m.F[d]));
-  for (int l = 0; l < 3; ++l) BC_PETSC(VecGetArrayRead(alphal_[l], &m.alpha[l]));
-  BC_PETSC(VecGetArrayRead(Pl_, &m.p));
-  BC_PETSC(VecGetArrayRead(nuel_, &m.nue));
+  for (int d = 0; d < 3; ++d) BC_PETSC(VecGetArrayRead(ghosts_.U[d], &m.u[d]));
+  for (int d = 0; d < 3; ++d) BC_PETSC(VecGetArrayRead(ghosts_.F[d], &m.F[d]));
+  for (int l = 0; l < 3; ++l) BC_PETSC(VecGetArrayRead(ghosts_.alpha[l], &m.alpha[l]));
+  BC_PETSC(VecGetArrayRead(ghosts_.P, &m.p));
+  BC_PETSC(VecGetArrayRead(ghosts_.nue, &m.nue));
   BC_PETSC(VecGetArrayRead(flow_.Un[c], &m.un));
   BC_PETSC(VecGetArrayRead(flow_.Unm1[c], &m.unm1));
-  BC_PETSC(VecGetArrayRead(S_[c], &m.S));
-  BC_PETSC(VecGetArrayRead(K_[c], &m.K));
-  BC_PETSC(VecGetArrayRead(KU_[c], &m.KU));
-  BC_PETSC(VecGetArray(rhs_, &m.rhs));
-  BC_PETSC(VecGetArray(D_[c], &m.D));
-  BC_PETSC(VecGetArray(inv_diag_[c], &m.inv_diag));
+  BC_PETSC(VecGetArrayRead(coupling_.S[c], &m.S));
+  BC_PETSC(VecGetArrayRead(coupling_.K[c], &m.K));
+  BC_PETSC(VecGetArrayRead(coupling_.KU[c], &m.KU));
+  BC_PETSC(VecGetArray(work_.rhs, &m.rhs));
+  BC_PETSC(VecGetArray(work_.D[c], &m.D));
+  BC_PETSC(VecGetArray(work_.inv_diag[c], &m.inv_diag));
   for (int e = 0; e < 7; ++e) m.A[e] = A.coef(e);
-  const RowBuffers r(row_buffers_, mc.nx);
+  const RowBuffers r(work_.row_buffers, mc.nx);
 
   std::int64_t o0 = 0;
   for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
@@ -455,19 +457,19 @@ void FluidSolver::assemble_momentum_t(double dt, double c0, double c1, double c2
       store_row(m, r, o0, mc.nx, present);
     }
 
-  for (int d = 0; d < 3; ++d) BC_PETSC(VecRestoreArrayRead(Ul_[d], &m.u[d]));
-  for (int d = 0; d < 3; ++d) BC_PETSC(VecRestoreArrayRead(Fl_[d], &m.F[d]));
-  for (int l = 0; l < 3; ++l) BC_PETSC(VecRestoreArrayRead(alphal_[l], &m.alpha[l]));
-  BC_PETSC(VecRestoreArrayRead(Pl_, &m.p));
-  BC_PETSC(VecRestoreArrayRead(nuel_, &m.nue));
+  for (int d = 0; d < 3; ++d) BC_PETSC(VecRestoreArrayRead(ghosts_.U[d], &m.u[d]));
+  for (int d = 0; d < 3; ++d) BC_PETSC(VecRestoreArrayRead(ghosts_.F[d], &m.F[d]));
+  for (int l = 0; l < 3; ++l) BC_PETSC(VecRestoreArrayRead(ghosts_.alpha[l], &m.alpha[l]));
+  BC_PETSC(VecRestoreArrayRead(ghosts_.P, &m.p));
+  BC_PETSC(VecRestoreArrayRead(ghosts_.nue, &m.nue));
   BC_PETSC(VecRestoreArrayRead(flow_.Un[c], &m.un));
   BC_PETSC(VecRestoreArrayRead(flow_.Unm1[c], &m.unm1));
-  BC_PETSC(VecRestoreArrayRead(S_[c], &m.S));
-  BC_PETSC(VecRestoreArrayRead(K_[c], &m.K));
-  BC_PETSC(VecRestoreArrayRead(KU_[c], &m.KU));
-  BC_PETSC(VecRestoreArray(rhs_, &m.rhs));
-  BC_PETSC(VecRestoreArray(D_[c], &m.D));
-  BC_PETSC(VecRestoreArray(inv_diag_[c], &m.inv_diag));
+  BC_PETSC(VecRestoreArrayRead(coupling_.S[c], &m.S));
+  BC_PETSC(VecRestoreArrayRead(coupling_.K[c], &m.K));
+  BC_PETSC(VecRestoreArrayRead(coupling_.KU[c], &m.KU));
+  BC_PETSC(VecRestoreArray(work_.rhs, &m.rhs));
+  BC_PETSC(VecRestoreArray(work_.D[c], &m.D));
+  BC_PETSC(VecRestoreArray(work_.inv_diag[c], &m.inv_diag));
 }
 
 }  // namespace boycott::fluid

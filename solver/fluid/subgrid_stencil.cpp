@@ -102,7 +102,7 @@ void FluidSolver::compute_subgrid_viscosity() {
   const LogScope log_scope(fluid_events().subgrid);
   if (!s_.vreman) {
     BC_PETSC(VecZeroEntries(flow_.nut));
-    halo_->fill(flow_.nut, nutl_);
+    layout_.halo->fill(flow_.nut, ghosts_.nut);
     return;
   }
   const OwnedBox b = owned_box();
@@ -115,13 +115,13 @@ void FluidSolver::compute_subgrid_viscosity() {
   const std::array<double, 3> delta = {gg.h[0], gg.h[1], gg.h[2]};
   const double* u[3];
   double* nt;
-  for (int c = 0; c < 3; ++c) BC_PETSC(VecGetArrayRead(Ul_[c], &u[c]));
+  for (int c = 0; c < 3; ++c) BC_PETSC(VecGetArrayRead(ghosts_.U[c], &u[c]));
   BC_PETSC(VecGetArray(flow_.nut, &nt));
   const int nx = gg.nx;
-  row_buffers_.assign(static_cast<std::size_t>(9) * nx, 0.0);
+  work_.row_buffers.assign(static_cast<std::size_t>(9) * nx, 0.0);
   double* G[3][3];  // G[i][j] = d u_j / d x_i over the row
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) G[i][j] = row_buffers_.data() + (3 * i + j) * nx;
+    for (int j = 0; j < 3; ++j) G[i][j] = work_.row_buffers.data() + (3 * i + j) * nx;
   std::int64_t o0 = 0;
   for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
     for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j, o0 += nx) {
@@ -133,9 +133,9 @@ void FluidSolver::compute_subgrid_viscosity() {
       }
       vreman_row(G, delta, s_.vreman_constant, nx, nt + o0);
     }
-  for (int c = 0; c < 3; ++c) BC_PETSC(VecRestoreArrayRead(Ul_[c], &u[c]));
+  for (int c = 0; c < 3; ++c) BC_PETSC(VecRestoreArrayRead(ghosts_.U[c], &u[c]));
   BC_PETSC(VecRestoreArray(flow_.nut, &nt));
-  halo_->fill(flow_.nut, nutl_);
+  layout_.halo->fill(flow_.nut, ghosts_.nut);
 }
 
 }  // namespace boycott::fluid
