@@ -16,7 +16,7 @@
 // the particles see the fluid at level n while the fluid's implicit drag and its alpha-weighted
 // pressure and viscous terms act at level n+1. The next prepare() measures that difference
 // (totals().lag_impulse_ns, both levels sampled with the same weights), so a momentum budget
-// closes to round-off with it; it is not fed back (see coupler.cpp). It is bounded: for a
+// closes to round-off with it; it is not fed back (see coupler_sample.cpp). It is bounded: for a
 // steady state it vanishes, and over a run it sums to roughly the difference of its end values.
 #include <array>
 #include <cstdint>

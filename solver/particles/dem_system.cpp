@@ -1,6 +1,6 @@
-// The DEM engine's set-up and neighbour-list upkeep: configuration from a case, start-up,
-// when and how the list is rebuilt (wrapping, spatial reordering, histories carried over),
-// and the energies. The step itself is in integrator.cpp, the forces in contact_forces.cpp.
+// The DEM engine's set-up and neighbour-list upkeep: start-up, when and how the list is rebuilt
+// (wrapping, spatial reordering, histories carried over), and the energies. The configuration
+// from a case is in dem_config.cpp, the step in integrator.cpp, the forces in contact_forces.cpp.
 #include "particles/dem_system.hpp"
 
 #include <algorithm>
@@ -10,10 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include <fmt/format.h>
-
 #include "core/constants.hpp"
-#include "core/error.hpp"
 #include "core/timers.hpp"
 #include "particles/displacement_bound.hpp"
 #include "particles/min_image.hpp"
