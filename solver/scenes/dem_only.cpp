@@ -34,15 +34,7 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
   }
   dem.initialize();
 
-  timers.activate("dem_contacts",
-                  fmt::format("{}, k_n = {} N/m, e = {}, mu = {}{}", p.contact.model, p.contact.stiffness_n_m,
-                              p.contact.restitution, p.contact.friction,
-                              p.contact.clip_attractive_normal ? ", normal force clipped" : ""));
-  if (p.contact.rolling_model != "none" && p.contact.rolling_friction > 0.0)
-    timers.activate("rolling_friction", fmt::format("{}, mu_r = {} (timed with dem_contacts)",
-                                                    p.contact.rolling_model, p.contact.rolling_friction));
-  timers.activate("neighbor_search",
-                  fmt::format("linked cells + Verlet skin {} m", p.numerics.neighbor_skin_m));
+  particles::activate_dem_models(timers, p);
   timers.activate("integration", "velocity Verlet");
   if (stokes) timers.activate("stokes_drag", "implicit in the velocity update (timed with integration)");
 
