@@ -3,6 +3,7 @@
 // tests of test_study_runs.cpp and test_refine_runs.cpp): a scratch folder, the command run with
 // its environment, its exit status and output, and counts read from its database.
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -51,11 +52,17 @@ struct Run {
 };
 
 /// Starts `program args...` (the boycott binary unless given) with extra environment; stdout and
-/// stderr go to files in dir.
+/// stderr go to files in dir. A non-zero `address_space_bytes` limits the child's virtual memory
+/// (RLIMIT_AS): an allocation beyond it fails (std::bad_alloc) instead of swapping the machine.
 inline pid_t spawn(std::vector<std::string> args, const fs::path& dir,
-                   const std::map<std::string, std::string>& env, const std::string& program = BOYCOTT_BIN) {
+                   const std::map<std::string, std::string>& env, const std::string& program = BOYCOTT_BIN,
+                   rlim_t address_space_bytes = 0) {
   const pid_t pid = fork();
   if (pid == 0) {
+    if (address_space_bytes > 0) {
+      const rlimit limit{address_space_bytes, address_space_bytes};
+      if (setrlimit(RLIMIT_AS, &limit) != 0) _exit(125);
+    }
     setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
     setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
     for (const auto& [k, v] : env) setenv(k.c_str(), v.c_str(), 1);
