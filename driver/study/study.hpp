@@ -52,8 +52,9 @@ struct RefinePlan {
 };
 
 /// A study may list at most this many cases (groups x matrix x zip x replicas): every command
-/// holds each case's parameters and checks each one, about 2 kB and 0.1 ms a case
-/// (docs/performance.md, "Large studies"); a larger one is refused before anything is written.
+/// holds each case's parameters (1.1 kB) and checks each one, 3-4.5 kB and 0.1-0.15 ms of CPU a
+/// case all told (docs/performance.md, "Large studies"); a larger one is refused, from its axes'
+/// lengths, before a case is made or anything is written.
 inline constexpr long long kMaxStudyCases = 100000;
 
 struct Study {
