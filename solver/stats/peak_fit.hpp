@@ -16,7 +16,7 @@
 //   parabola's vertex to that of the weighted quadratic through five points and to that of a
 //   Gaussian (a parabola through the logarithms) through the three.
 // Coverage over noisy synthetic curves, one family at a time, after the refinement
-// (tests/unit/test_peak_fit.cpp, docs/validation.md): ~0.70 on skewed peaks, ~0.75 on symmetric
+// (tests/unit/test_peak_coverage.cpp, docs/validation.md "Peaks"): 0.70 on skewed peaks, 0.74 on symmetric
 // ones (the model term errs on the safe side there). Why not a Gaussian process or a spline: with
 // 5-15 points per curve they need a length scale the data cannot fix, and their intervals depend
 // on it; the parabola's assumption is local and the coverage tests check it.
