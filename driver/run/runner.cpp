@@ -54,6 +54,22 @@ std::vector<StudyCase> next_round(Database& db, const Study& s, int retries, std
   return round.added;
 }
 
+/// The settling curve where the study has one, with its peaks under [refine]; otherwise (ergun,
+/// single_particle, channel_flow, sediment_transport) each finished case's validation errors
+/// against their tolerances.
+void print_study_results(Database& db, const Study& study, int done) {
+  const auto curve = query_curve(db, study.name);
+  if (curve.empty() && done > 0) {
+    std::fputs(format_validation(query_validation(db, study.name), ListingFormat::kTable).c_str(), stdout);
+    return;
+  }
+  std::fputs(format_curve(curve, ListingFormat::kTable).c_str(), stdout);
+  if (study.refine && !curve.empty()) {
+    std::printf("peak (query peak):\n");
+    std::fputs(format_peak(query_peak(db, study.name), ListingFormat::kTable).c_str(), stdout);
+  }
+}
+
 }  // namespace
 
 int study_run(const StudyRunOptions& opt) {
@@ -129,17 +145,7 @@ int study_run(const StudyRunOptions& opt) {
   }
   std::printf("study %s: %d of %s done, %d failed\n", study.name.c_str(), done,
               count_of(n_total, "case").c_str(), failed);
-  // The settling curve where the study has one; otherwise (ergun, single_particle, channel_flow,
-  // sediment_transport) each finished case's validation errors against their tolerances.
-  const auto curve = query_curve(db, study.name);
-  if (!curve.empty() || done == 0) {
-    std::fputs(format_curve(curve, ListingFormat::kTable).c_str(), stdout);
-    if (study.refine && !curve.empty()) {
-      std::printf("peak (query peak):\n");
-      std::fputs(format_peak(query_peak(db, study.name), ListingFormat::kTable).c_str(), stdout);
-    }
-  } else
-    std::fputs(format_validation(query_validation(db, study.name), ListingFormat::kTable).c_str(), stdout);
+  print_study_results(db, study, done);
   return failed > 0 ? kExitFailure : kExitOk;
 }
 

@@ -30,7 +30,8 @@ std::string big_study() {
          "\"gravity.angle_deg\" = " +
          values(10, 1, 81) + "\n\"fluid.viscosity\" = " + values(1e-3, 1e-3, 10) +
          "\n\"particles.density\" = " + values(1500, 50, 13) +
-         "\n\"particles.diameter\" = " + values(4e-4, 2e-5, 10) + "\nseed = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n";
+         "\n\"particles.diameter\" = " + values(4e-4, 2e-5, 10) +
+         "\nseed = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n";
 }
 
 /// The command under the limit; its exit status and output.
