@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -30,6 +31,14 @@ std::string value_text(const toml::node& n) {
   if (auto v = n.value_exact<bool>()) return *v ? "true" : "false";
   if (auto v = n.value_exact<std::string>()) return nlohmann::json(*v).dump();
   throw InputError("[refine] set: values must be numbers, booleans or strings");
+}
+
+/// A value as the study file gives it, for a refusal: "(none)" where it is missing.
+std::string node_text(const toml::node* n) {
+  if (!n) return "(none)";
+  std::ostringstream out;
+  n->visit([&](const auto& v) { out << v; });
+  return out.str();
 }
 
 void read_set(const toml::table& set, const std::string& prefix, RefinePlan& plan) {
@@ -72,14 +81,16 @@ RefinePlan read_table(const toml::table& t) {
                                  plan.objective));
   const auto res = t["resolution"].value<double>();
   if (!res || !(*res > 0.0) || *res > 90.0)
-    throw InputError(
-        "[refine]: resolution (deg, the 68 % half-width to find the peak's angle to) must be in (0, 90]");
+    throw InputError(fmt::format(
+        "[refine]: resolution = {} must be a number of degrees in (0, 90] (the 68 % half-width to find "
+        "the peak's angle to)",
+        node_text(t.get("resolution"))));
   plan.resolution = *res;
   if (const auto* n = t.get("max_points")) {
     const auto v = n->value_exact<std::int64_t>();
     if (!v || *v < 1 || *v > RefinePlan::kMaxPointsLimit)
-      throw InputError(
-          fmt::format("[refine]: max_points must be a whole number in [1, {}]", RefinePlan::kMaxPointsLimit));
+      throw InputError(fmt::format("[refine]: max_points = {} must be a whole number in [1, {}]",
+                                   node_text(n), RefinePlan::kMaxPointsLimit));
     plan.max_points = static_cast<int>(*v);
   }
   if (const auto* set = t.get("set")) {

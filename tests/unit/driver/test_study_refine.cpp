@@ -111,9 +111,12 @@ TEST(StudyRefine, RefusesWhatItCannotRefineNamingWhy) {
       refusal(with(kRefined, "\"gravity.angle_deg\" = [30, 60, 90]", "\"gravity.angle_deg\" = [30, 60, 80]"))
           .find("needs a 90 deg point"),
       std::string::npos);
-  EXPECT_NE(refusal(with(kRefined, "resolution = 2.5", "resolution = 0")).find("resolution"),
+  EXPECT_NE(refusal(with(kRefined, "resolution = 2.5", "resolution = 0")).find("resolution = 0 must be"),
             std::string::npos);
-  EXPECT_NE(refusal(with(kRefined, "max_points = 3", "max_points = 0")).find("max_points"),
+  EXPECT_NE(refusal(with(kRefined, "resolution = 2.5", "")).find("resolution = (none) must be"),
+            std::string::npos);
+  EXPECT_NE(refusal(with(kRefined, "max_points = 3", "max_points = 0"))
+                .find("max_points = 0 must be a whole number in [1, 50]"),
             std::string::npos);
   EXPECT_NE(
       refusal(with(kRefined, "objective = \"max_r_acc\"", "objective = \"min\"")).find("max_abs_settling"),
