@@ -2,8 +2,8 @@
 // particle side of the coupling hook set from it: implicit drag, added mass, and the explicit
 // pressure-gradient, viscous, lift and added-mass forces; the time-level lag and the sampling
 // mismatch measured on the way (coupler.hpp).
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <vector>

@@ -139,9 +139,9 @@ TEST(StiffAndExtremeCases, DenseBedAtHalfSolidFraction) {
 // A bed against the lower wall in 10 cP fluid (the Ga 145.6 group's), 0.6 mm sand at 65 deg,
 // dt_cfd 1 ms: where it packs to alpha_f ~0.45 its particles relax past the fluid's lagged
 // counter-flow within a step (coupling/drag_stability.hpp). The step limit holds it.
-const std::vector<std::string> kViscousBed = {"fluid.viscosity=1.0e-2", "gravity.angle_deg=65.0",
+const std::vector<std::string> kViscousBed = {"fluid.viscosity=1.0e-2",        "gravity.angle_deg=65.0",
                                               "particles.volume_fraction=0.3", "time.end=1.5",
-                                              "time.average_from=0.5", "time.checkpoint_every=0.5"};
+                                              "time.average_from=0.5",         "time.checkpoint_every=0.5"};
 
 TEST(StiffAndExtremeCases, PackedBedInViscousFluidIsHeldByTheStepLimit) {
   auto sets = kViscousBed;
