@@ -28,10 +28,12 @@ void report_window_error(nlohmann::json& j, const std::string& prefix, const std
                          double transient_end_s = std::numeric_limits<double>::quiet_NaN());
 
 /// The window a run averages over, from what it collected since start.collect_from_s(): cut at the
-/// transient where `start` is automatic (stats::cut_at_transient), as collected otherwise. One
+/// transient where `start` is automatic (stats::cut_at_transient; where the first stage of the
+/// precision target's `plan` cut it, when the plan stopped the run), as collected otherwise. One
 /// rule for the scene and for `case summarize`.
 stats::ChosenWindow averaging_window(const WindowStart& start, const stats::StepSeries& s,
-                                     const std::vector<double>& collected, double now_s);
+                                     const std::vector<double>& collected, double now_s,
+                                     const stats::TwoStagePlan* plan = nullptr);
 
 /// transient_end_s (stats/transient.hpp: transient_end over the whole series) and average_from_s
 /// in `j`; with `warn`, a warning when the transient ends after the window's start and the

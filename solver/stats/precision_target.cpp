@@ -4,36 +4,65 @@
 #include <cmath>
 
 #include "stats/transient.hpp"
-#include "stats/window_error.hpp"
 
 namespace boycott::stats {
 
 bool PrecisionTarget::reached(const std::vector<double>& series, double window_from_s, double now_s) {
-  if (!active() || static_cast<std::int64_t>(series.size()) < next_check_) return false;
-  // Checks every 2 % of the samples (at least 25): their cost grows with the window.
+  if (!active()) return false;
   const auto n = static_cast<std::int64_t>(series.size());
-  next_check_ = n + std::max<std::int64_t>(25, n / 50);
-  // The run's own window: judged from where the transient is detected to end (no step lengths
-  // here: the cut's time from the mean step).
-  ChosenWindow cut;
-  if (cut_transient_)
-    cut = cut_at_transient(StepSeries{{}, {}, {}, true, false}, series, window_from_s, now_s);
-  const std::vector<double>& x = cut_transient_ ? cut.window : series;
-  if (cut_transient_) window_from_s = cut.from_s;
-  const WindowError w = window_error(x, window_from_s, now_s, true);
-  const double rel = std::abs(w.err.covering_error / w.e.mean);
-  last_rel_error_ = rel;
-  const bool met = std::isfinite(rel) && rel < target_ && w.e.correlation_times >= kMinCorrelationTimes;
-  if (!met) {
-    met_since_s_ = -1.0;
+  if (plan_.set()) return n >= plan_.planned;
+  // Before the first stage is fixed, checks every 2 % of the samples (at least 25): their cost
+  // grows with the window; after, nothing until the first stage.
+  if (first_stage_at_ > 0 ? n < first_stage_at_ : n < next_check_) return false;
+  if (first_stage_at_ == 0) next_check_ = n + std::max<std::int64_t>(25, n / 50);
+  // The run's own window: from where the transient is detected to end (no step lengths here).
+  std::int64_t cut = 0;
+  if (cut_transient_) {
+    const ChosenWindow c = cut_at_transient(StepSeries{{}, {}, {}, true, false}, series, window_from_s, now_s);
+    cut = static_cast<std::int64_t>(series.size() - c.window.size());
+  }
+  const std::vector<double> x(series.begin() + cut, series.end());
+  const auto nx = static_cast<std::int64_t>(x.size());
+  if (first_stage_at_ == 0) {
+    const AutocorrelationError e = autocorrelation_error(x);
+    last_rel_error_ = std::abs(e.covering_error / e.mean);
+    if (e.correlation_times >= kMinCorrelationTimes)
+      first_stage_at_ = cut + static_cast<std::int64_t>(std::ceil(kFirstStageFactor * static_cast<double>(nx)));
     return false;
   }
-  if (met_since_s_ < 0.0) met_since_s_ = now_s;
-  // A stop the estimate itself decides comes where the estimate dipped (tau under-estimated): the
-  // target must hold while a good part of the data changes, not only over a few correlation times.
-  const double confirm_s = std::max(kConfirmCorrelationTimes * w.correlation_time_upper_s(),
-                                    kConfirmWindowFraction * (met_since_s_ - window_from_s));
-  return now_s - met_since_s_ >= confirm_s;
+  // The first stage: the plan, fixed once.
+  const MeanError m = mean_error(x, autocorrelation_error(x));
+  double mean = 0.0;
+  for (double v : x) mean += v / static_cast<double>(nx);
+  plan_.n0 = nx;
+  plan_.se0 = m.stderr_of_mean;
+  plan_.dof0 = m.dof;
+  plan_.mean0 = mean;
+  plan_.cut = cut;
+  const double need = std::pow(m.covering_error / (target_ * std::abs(mean)), 2) * static_cast<double>(nx);
+  plan_.planned = cut + std::max<std::int64_t>(nx, std::isfinite(need) ? static_cast<std::int64_t>(std::ceil(need))
+                                                                       : std::numeric_limits<std::int64_t>::max() / 2);
+  last_rel_error_ = std::abs(m.covering_error / mean) *
+                    std::sqrt(static_cast<double>(nx) / static_cast<double>(plan_.planned - cut));
+  return n >= plan_.planned;
+}
+
+std::vector<double> PrecisionTarget::to_state() const {
+  return {static_cast<double>(next_check_), static_cast<double>(first_stage_at_), static_cast<double>(plan_.n0),
+          plan_.se0, plan_.dof0, plan_.mean0, static_cast<double>(plan_.planned), static_cast<double>(plan_.cut)};
+}
+
+void PrecisionTarget::from_state(const std::vector<double>& v) {
+  if (v.empty()) return;
+  next_check_ = static_cast<std::int64_t>(v[0]);
+  if (v.size() < 8) return;  // a build before the two-stage plan: the plan starts from here
+  first_stage_at_ = static_cast<std::int64_t>(v[1]);
+  plan_.n0 = static_cast<std::int64_t>(v[2]);
+  plan_.se0 = v[3];
+  plan_.dof0 = v[4];
+  plan_.mean0 = v[5];
+  plan_.planned = static_cast<std::int64_t>(v[6]);
+  plan_.cut = static_cast<std::int64_t>(v[7]);
 }
 
 }  // namespace boycott::stats

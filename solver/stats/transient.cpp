@@ -3,86 +3,49 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
 
 #include "stats/autocorrelation.hpp"
 
 namespace boycott::stats {
 
-namespace {
-
-// Batch means of x: `block` samples each, the incomplete last one left out.
-std::vector<double> batch_means(const std::vector<double>& x, std::int64_t block) {
-  std::vector<double> b(x.size() / static_cast<std::size_t>(block));
-  for (std::size_t i = 0; i < b.size(); ++i) {
-    double s = 0.0;
-    for (std::int64_t k = 0; k < block; ++k) s += x[i * block + k];
-    b[i] = s / static_cast<double>(block);
-  }
-  return b;
-}
-
-// The start in [0, b.size() / 2] with the most effective samples, (n - t0) / (2 tau_int), on a
-// grid of kCandidates starts, and that count; none where no start gives an estimate.
-struct EffectiveStart {
-  std::int64_t start = 0;
-  double effective_samples = 0.0;
-};
-std::optional<EffectiveStart> most_effective_samples_start(const std::vector<double>& b) {
-  const auto nb = static_cast<std::int64_t>(b.size());
-  std::optional<EffectiveStart> best;
-  for (int c = 0; c <= TransientEnd::kCandidates; ++c) {
-    const std::int64_t t0 = nb / 2 * c / TransientEnd::kCandidates;
-    const double neff = autocorrelation_error(std::vector<double>(b.begin() + t0, b.end())).effective_samples;
-    if (std::isfinite(neff) && !(best && neff <= best->effective_samples)) best = EffectiveStart{t0, neff};
-  }
-  return best;
-}
-
-// MSER: the start in [0, b.size() / 2] with the least marginal standard error,
-// sum over i >= t0 of (b_i - mean)^2 / (n - t0)^2, from suffix sums in O(n).
-std::int64_t mser_start(const std::vector<double>& b) {
-  const auto nb = static_cast<std::int64_t>(b.size());
-  std::vector<double> s1(b.size() + 1, 0.0), s2(b.size() + 1, 0.0);
-  for (std::int64_t i = nb - 1; i >= 0; --i) {
-    s1[i] = s1[i + 1] + b[i];
-    s2[i] = s2[i + 1] + b[i] * b[i];
-  }
-  double best = std::numeric_limits<double>::infinity();
-  std::int64_t start = 0;
-  for (std::int64_t t0 = 0; t0 <= nb / 2; ++t0) {
-    const double m = static_cast<double>(nb - t0), mean = s1[t0] / m;
-    const double mser = std::max(0.0, s2[t0] / m - mean * mean) / m;
-    if (mser < best) {
-      best = mser;
-      start = t0;
-    }
-  }
-  return start;
-}
-
-}  // namespace
-
 TransientEnd transient_end(const std::vector<double>& x) {
   TransientEnd cut;
-  cut.effective_samples = std::numeric_limits<double>::quiet_NaN();
   const auto n = static_cast<std::int64_t>(x.size());
   if (n < 16) return cut;
-  // The correlation time survives blocking to kMaxBlocks; MSER-5 batches at least 5 samples.
-  const std::int64_t block = (n + TransientEnd::kMaxBlocks - 1) / TransientEnd::kMaxBlocks;
-  const std::int64_t batch = std::max(TransientEnd::kBatch, block);
-  const std::vector<double> b = batch_means(x, block);
-  const auto effective_start = most_effective_samples_start(b);
-  if (!effective_start) return cut;
-  const std::int64_t mser =
-      batch == block ? mser_start(b) : mser_start(batch_means(x, batch)) * batch / block;
-  const std::int64_t start_block = std::max(effective_start->start, mser);
-  cut.start = start_block * block;
-  // Counted on the blocks (blocking keeps the count); MSER's later cut is counted anew.
-  cut.effective_samples =
-      start_block == effective_start->start
-          ? effective_start->effective_samples
-          : autocorrelation_error(std::vector<double>(b.begin() + start_block, b.end())).effective_samples;
+  const std::vector<double> ref(x.begin() + n / 2, x.end());
+  const auto e = autocorrelation_error(ref);
+  if (!std::isfinite(e.tau_int_upper)) return cut;
+  cut.estimated = true;
+  double var = 0.0;
+  for (double v : ref) var += (v - e.mean) * (v - e.mean);
+  var /= static_cast<double>(ref.size());
+  // The long-run variance of a sample mean, at the upper end of tau_int: a test that errs towards
+  // calling a segment stationary (its cuts then come from the data, not from an estimate that dipped).
+  const double long_run_var = 2.0 * var * e.tau_int_upper;
+  const std::int64_t len = std::max<std::int64_t>(1, n / (2 * TransientEnd::kSegments));
+  const std::int64_t segments = std::min<std::int64_t>(TransientEnd::kSegments, n / 2 / len);
+  const double diff_var = long_run_var * (1.0 / static_cast<double>(len) + 1.0 / static_cast<double>(ref.size()));
+  std::int64_t end = 0;
+  for (std::int64_t j = 0, clean = 0; j < segments && clean < 2; ++j) {
+    double mean = 0.0, spread = 0.0;
+    for (std::int64_t i = j * len; i < (j + 1) * len; ++i) {
+      mean += x[static_cast<std::size_t>(i)];
+      spread += (x[static_cast<std::size_t>(i)] - e.mean) * (x[static_cast<std::size_t>(i)] - e.mean);
+    }
+    mean /= static_cast<double>(len);
+    spread /= static_cast<double>(len);
+    const double d = std::abs(mean - e.mean);
+    const bool differs = (d > 0.0 && d * d > TransientEnd::kMeanZ * TransientEnd::kMeanZ * diff_var) ||
+                         spread > TransientEnd::kSpreadFactor * var;
+    if (differs) {
+      end = j + 1;
+      clean = 0;
+    } else {
+      ++clean;
+    }
+  }
+  cut.detected = end * len;
+  cut.start = std::min<std::int64_t>(n / 2, std::llround(TransientEnd::kGuard * static_cast<double>(cut.detected)));
   return cut;
 }
 
@@ -104,10 +67,15 @@ bool transient_biases_mean(const std::vector<double>& x, std::int64_t from, std:
 
 ChosenWindow cut_at_transient(const StepSeries& s, const std::vector<double>& window, double collected_from_s,
                               double now_s) {
-  ChosenWindow c{s, window, collected_from_s};
   const TransientEnd cut = transient_end(window);
-  if (!std::isfinite(cut.effective_samples) || cut.start <= 0) return c;
-  const auto k = static_cast<std::size_t>(cut.start);
+  return cut_window_at(s, window, collected_from_s, now_s, cut.estimated ? cut.start : 0);
+}
+
+ChosenWindow cut_window_at(const StepSeries& s, const std::vector<double>& window, double collected_from_s,
+                           double now_s, std::int64_t cut) {
+  ChosenWindow c{s, window, collected_from_s};
+  if (cut <= 0) return c;
+  const auto k = std::min(static_cast<std::size_t>(cut), window.size());
   c.steps.before.insert(c.steps.before.end(), window.begin(),
                         window.begin() + static_cast<std::ptrdiff_t>(k));
   c.window.erase(c.window.begin(), c.window.begin() + static_cast<std::ptrdiff_t>(k));
