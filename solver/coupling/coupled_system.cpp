@@ -114,13 +114,7 @@ void CoupledSystem::start() {
 
 CoupledStep CoupledSystem::step() {
   CoupledStep st;
-  const double dt_dem = p_.time.dt_dem_s;
-  double dt = std::min(p_.time.dt_cfd_s, fluid_->stable_dt());
-  if (opt_.move_particles) {
-    st.dem_substeps = std::max(1, static_cast<int>(std::floor(dt / dt_dem + 1e-9)));
-    dt = st.dem_substeps * dt_dem;
-  }
-  st.dt_s = dt;
+  st.dt_s = step_size(st.dem_substeps);
   if (interrupted_) throw std::logic_error("CoupledSystem::step after an interrupted step");
   // One count over ranks per step (a collective), for the test below and the stop checks.
   const double per_substep = interrupt_ ? work_per_substep() : 0.0;
@@ -128,73 +122,100 @@ CoupledStep CoupledSystem::step() {
                          static_cast<double>(st.dem_substeps) * per_substep >= kLongStepParticleSteps;
   if (long_step) start_of_step_ = {dem_->export_state(), coupler_->export_state()};
   coupler_->prepare(*dem_, *fluid_, dt_prev_);
+  if (!advance_particles(st, long_step, per_substep)) return st;
+  check_particles_finite(st.dt_s);
+  coupler_->deposit(*dem_, *fluid_, st.dt_s);
+  if (opt_.zero_slurry_flux) hold_zero_slurry_flux();
+  wait_for_slowest_rank();
+  advance_fluid(st);
+  return st;
+}
+
+double CoupledSystem::step_size(int& dem_substeps) const {
+  const double dt_dem = p_.time.dt_dem_s;
+  double dt = std::min(p_.time.dt_cfd_s, fluid_->stable_dt());
   if (opt_.move_particles) {
-    if (long_step) {
-      st.substeps_done =
-          dem_->advance_interruptible(st.dem_substeps, substeps_per_check(per_substep), interrupt_);
-      if (st.substeps_done < st.dem_substeps) {
-        // The particles are part-way through the step and the coupler has sampled for it: only
-        // the state kept above may be checkpointed.
-        interrupted_ = true;
-        st.interrupted = true;
-        return st;
-      }
-    } else {
-      dem_->advance(st.dem_substeps);
-    }
-    if (budget_) budget_->commit(dem_->particles(), dt, p_.gravity_vector()[1]);
-  } else {
+    dem_substeps = std::max(1, static_cast<int>(std::floor(dt / dt_dem + 1e-9)));
+    dt = dem_substeps * dt_dem;
+  }
+  return dt;
+}
+
+bool CoupledSystem::advance_particles(CoupledStep& st, bool long_step, double per_substep) {
+  if (!opt_.move_particles) {
     // A frozen bed takes the whole drag impulse beta (u_f - v) dt (it is held in place).
     auto& s = dem_->particles();
+    const double dt = st.dt_s;
     for (std::size_t i = 0; i < s.n_local; ++i) {
       s.drag_jx[i] = dt * s.beta[i] * (s.ufx[i] - s.vx[i]);
       s.drag_jy[i] = dt * s.beta[i] * (s.ufy[i] - s.vy[i]);
       s.drag_jz[i] = dt * s.beta[i] * (s.ufz[i] - s.vz[i]);
     }
+    return true;
   }
+  if (long_step) {
+    st.substeps_done =
+        dem_->advance_interruptible(st.dem_substeps, substeps_per_check(per_substep), interrupt_);
+    if (st.substeps_done < st.dem_substeps) {
+      // The particles are part-way through the step and the coupler has sampled for it: only
+      // the state kept at the step's start may be checkpointed.
+      interrupted_ = true;
+      st.interrupted = true;
+      return false;
+    }
+  } else {
+    dem_->advance(st.dem_substeps);
+  }
+  if (budget_) budget_->commit(dem_->particles(), st.dt_s, p_.gravity_vector()[1]);
+  return true;
+}
+
+void CoupledSystem::check_particles_finite(double dt) const {
   // NaN or Inf stops the run here, before the kernels turn a position into a cell index and
   // before anything is checkpointed (the scene's last good checkpoint stays the newest).
-  {
-    const auto& s = dem_->particles();
-    double sum = 0.0;
-    for (std::size_t i = 0; i < s.n_local; ++i)
-      sum += s.x[i] + s.y[i] + s.z[i] + s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i];
-    // Every rank stops together (a NaN on one rank would otherwise leave the others waiting).
-    if (!std::isfinite(global_sum(sum)))
-      throw PhysicsError(
-          fmt::format("particle state became NaN or Inf at t = {:.6g} s (CFD step {}); nothing was "
-                      "checkpointed after the last good state",
-                      time_ + dt, steps_ + 1));
-  }
-  coupler_->deposit(*dem_, *fluid_, dt);
-  if (opt_.zero_slurry_flux) {
-    // Eq. 25: the fluid's flux controller finds the G that makes alpha_f <w_f> cancel the
-    // particles' volume flux at the new level.
-    const auto& s = dem_->particles();
-    double q = 0.0;
-    for (std::size_t i = 0; i < s.n_local; ++i)
-      q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
-    fluid_->set_target_mean_flux_z(-global_sum(q) / p_.box_volume_m3());
-  }
-  if (ranks_ > 1) {
-    // The particle phases end here on every rank; the time a rank waits for the slowest one is
-    // its share of the load imbalance (the fluid's own collectives would hide it otherwise).
-    const auto tw = std::chrono::steady_clock::now();
-    MPI_Barrier(fluid_->comm());
-    seconds_wait_ += seconds_since(tw);
-  }
+  const auto& s = dem_->particles();
+  double sum = 0.0;
+  for (std::size_t i = 0; i < s.n_local; ++i)
+    sum += s.x[i] + s.y[i] + s.z[i] + s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i];
+  // Every rank stops together (a NaN on one rank would otherwise leave the others waiting).
+  if (!std::isfinite(global_sum(sum)))
+    throw PhysicsError(
+        fmt::format("particle state became NaN or Inf at t = {:.6g} s (CFD step {}); nothing was "
+                    "checkpointed after the last good state",
+                    time_ + dt, steps_ + 1));
+}
+
+void CoupledSystem::hold_zero_slurry_flux() {
+  // Eq. 25: the fluid's flux controller finds the G that makes alpha_f <w_f> cancel the
+  // particles' volume flux at the new level.
+  const auto& s = dem_->particles();
+  double q = 0.0;
+  for (std::size_t i = 0; i < s.n_local; ++i)
+    q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
+  fluid_->set_target_mean_flux_z(-global_sum(q) / p_.box_volume_m3());
+}
+
+void CoupledSystem::wait_for_slowest_rank() {
+  if (ranks_ == 1) return;
+  // The particle phases end here on every rank; the time a rank waits for the slowest one is
+  // its share of the load imbalance (the fluid's own collectives would hide it otherwise).
+  const auto tw = std::chrono::steady_clock::now();
+  MPI_Barrier(fluid_->comm());
+  seconds_wait_ += seconds_since(tw);
+}
+
+void CoupledSystem::advance_fluid(CoupledStep& st) {
   const auto t0 = std::chrono::steady_clock::now();
-  st.fluid = fluid_->step(dt);
+  st.fluid = fluid_->step(st.dt_s);
   if (!st.fluid.converged) ++unconverged_;
   seconds_fluid_ += seconds_since(t0);
-  dt_prev_ = dt;
-  time_ += dt;
+  dt_prev_ = st.dt_s;
+  time_ += st.dt_s;
   ++steps_;
   const double ke = dem_->kinetic_energy_j();
   if (!std::isfinite(ke))
     throw PhysicsError(
         fmt::format("particle velocities became NaN at t = {:.6g} s (CFD step {})", time_, steps_));
-  return st;
 }
 
 double CoupledSystem::work_per_substep() const {
@@ -251,14 +272,7 @@ void CoupledSystem::activate_models(ModelTimers& t) const {
     t.activate("added_mass", "Eq. 17, particle side in the mass matrix (timed with coupling_sample)");
   if (opt_.zero_slurry_flux) t.activate("slurry_flux_control", "Eq. 25 through the mean gradient G");
   if (opt_.move_particles) {
-    t.activate("dem_contacts",
-               fmt::format("{}, k_n = {} N/m, e = {}, mu = {}", p_.contact.model, p_.contact.stiffness_n_m,
-                           p_.contact.restitution, p_.contact.friction));
-    if (p_.contact.rolling_model != "none" && p_.contact.rolling_friction > 0.0)
-      t.activate("rolling_friction", fmt::format("{}, mu_r = {} (timed with dem_contacts)",
-                                                 p_.contact.rolling_model, p_.contact.rolling_friction));
-    t.activate("neighbor_search",
-               fmt::format("linked cells + Verlet skin {} m", p_.numerics.neighbor_skin_m));
+    particles::activate_dem_models(t, p_);
     t.activate("integration", "velocity Verlet, drag and added mass implicit");
   }
 }

@@ -126,6 +126,20 @@ class CoupledSystem {
   void activate_models(ModelTimers& t) const;
 
  private:
+  // The parts of step(), in order.
+  /// The step (s): at most time.dt_cfd and CFL-limited, a whole number (set) of DEM sub-steps.
+  double step_size(int& dem_substeps) const;
+  /// The sub-steps (or, frozen bed, the drag impulse they would take); false when a stop request
+  /// interrupted a long step.
+  bool advance_particles(CoupledStep& st, bool long_step, double per_substep);
+  /// Throws PhysicsError, on every rank, when a particle's state is not finite.
+  void check_particles_finite(double dt) const;
+  /// Eq. 25's target for the fluid's flux controller.
+  void hold_zero_slurry_flux();
+  /// Several ranks: the barrier that ends the particle phases, timed as waiting.
+  void wait_for_slowest_rank();
+  /// The fluid step, then the run's clock.
+  void advance_fluid(CoupledStep& st);
   /// max(particles over all ranks, kSubstepOverhead): a sub-step's work in particle-steps (collective).
   double work_per_substep() const;
   static int substeps_per_check(double per_substep);

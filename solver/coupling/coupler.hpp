@@ -16,7 +16,7 @@
 // the particles see the fluid at level n while the fluid's implicit drag and its alpha-weighted
 // pressure and viscous terms act at level n+1. The next prepare() measures that difference
 // (totals().lag_impulse_ns, both levels sampled with the same weights), so a momentum budget
-// closes to round-off with it; it is not fed back (see coupler.cpp). It is bounded: for a
+// closes to round-off with it; it is not fed back (see coupler_sample.cpp). It is bounded: for a
 // steady state it vanishes, and over a run it sums to roughly the difference of its end values.
 #include <array>
 #include <cstdint>
@@ -35,7 +35,8 @@
 
 namespace boycott::particles {
 class DemSystem;
-}
+struct ParticleStore;
+}  // namespace boycott::particles
 namespace boycott::fluid {
 class FluidSolver;
 }
@@ -121,8 +122,35 @@ class Coupler {
   };
   Stencil stencil(double x, double y, double z) const;
   LinearStencil linear_stencil(double x, double y, double z, int z_image) const;
+  // prepare (coupler_sample.cpp): per particle, the face fields, the cell-centred ones, the
+  // explicit forces from them and the force budget's share.
   template <class Law>
   void prepare_impl(const Law& law, particles::DemSystem& dem, double dt_prev_s);
+  struct FaceSample;
+  /// The face fields with the kernel's weights (vp: the particle's volume, m^3).
+  void sample_faces_kernel(const Stencil& st, double vp, FaceSample& f) const;
+  /// The face fields with the trilinear weights, and with the kernel's for the mismatch.
+  void sample_faces_trilinear(const Stencil& st, const LinearStencil& ls, double vp, FaceSample& f) const;
+  /// The solid fraction (returned) and, where the lift needs it, the vorticity w (1/s).
+  double sample_solid_and_vorticity(const Stencil& st, const LinearStencil& ls, bool linear,
+                                    double (&w)[3]) const;
+  /// Lift and added mass added to the sampled force fe (N), their reactions to react, the lift to
+  /// fl; sets the particle's added mass and explicit force.
+  void add_explicit_forces(particles::ParticleStore& p, std::size_t i, const double (&slip)[3],
+                           const double (&w)[3], double d, double vp, const FaceSample& f, double (&fe)[3],
+                           double (&react)[3], double (&fl)[3]) const;
+  void add_to_budget(double y, const double (&fl)[3], const FaceSample& f, double madd, double slip,
+                     const double (&w)[3], double d) const;
+  // deposit (coupler_deposit.cpp).
+  /// Every local particle's volume and (dt_s > 0) drag and reactions onto this rank's arrays;
+  /// returns the sum of the reactions (N).
+  std::vector<double> deposit_particles(particles::DemSystem& dem, double dt_s);
+  void deposit_drag(const Stencil& st, const particles::ParticleStore& p, std::size_t i,
+                    const double (&rf)[3], double dt_s);
+  /// This rank's planes into the fluid's deposition arrays.
+  void add_solid_fraction(fluid::FluidSolver& fs, const std::vector<double>& solid) const;
+  void add_drag_and_sources(fluid::FluidSolver& fs, int c) const;
+  void record_alpha_range(const std::vector<double>& solid);
   /// The owned planes of a windowed field, summed over every rank's window (several ranks).
   std::vector<double> sum_owned(const GridField& f) const;
   /// A field's own planes gathered over all ranks to rank 0 (the whole grid on one rank).

@@ -133,6 +133,23 @@ class FluidFields {
   template <class Rule>
   static void fill_padded(Padded& dst, int nx, int ny, int nz, Rule&& value);
 
+  // The steps of update(): the solver's fields copied in, their padded copies, the face fields
+  // of each component (the rows' stencil reads gathered first), the wall rows of v, the vorticity.
+  struct ViscousTerm;
+  struct ConvectionTerm;
+  void read_solver_fields(fluid::FluidSolver& fs);
+  void fill_padded_copies();
+  /// Row (j, k) of a padded copy, at i = 0.
+  const double* padded_row(const Padded& P, int j, int k) const;
+  void update_face_fields(int c, double G, double dt_s, bool first, bool need_viscous, bool need_material);
+  /// The reads of the six neighbour terms of component c's viscous operator in row (j, k).
+  void viscous_terms(int c, int j, int k, ViscousTerm (&terms)[6]) const;
+  /// The reads of the three terms of component c's convective derivative in row (j, k).
+  void convection_terms(int c, int j, int k, ConvectionTerm (&cv)[3]) const;
+  void copy_wall_rows_of_v();
+  void update_centre_vorticity();
+  void update_edge_vorticity();
+
   GridSpec g_;
   bool walls_, top_slip_, edge_vorticity_;
   const SlabExchange* window_ = nullptr;
@@ -143,7 +160,32 @@ class FluidFields {
   GridField u_[3], uprev_[3], gradp_[3], visc_[3], dudt_[3], vort_[3], p_, nut_;
   Padded upad_[3], ppad_, nupad_;  // uval, p and nu + nu_t, padded
   bool have_prev_ = false;
-  void update_edge_vorticity();
 };
+
+// The per-node reads of the field derivations, inline for both files that derive them.
+inline double FluidFields::uval(int c, int i, int j, int k) const {
+  if (walls_) {
+    const int ny = (int)g_.n[1];
+    if (c == 1) {
+      if (j < 0) return -u_[1].at(i, -j, k);
+      if (j > ny) return -u_[1].at(i, 2 * ny - j, k);
+    } else {
+      if (j < 0) return -u_[c].at(i, -1 - j, k);
+      if (j >= ny) return (top_slip_ ? 1.0 : -1.0) * u_[c].at(i, 2 * ny - 1 - j, k);
+    }
+  }
+  return u_[c].at(i, j, k);
+}
+
+inline const double* FluidFields::padded_row(const Padded& P, int j, int k) const {
+  // The value at (i + di, j, k) of a padded copy is padded_row(P, j, k)[i + di]: each stencil
+  // read is one row pointer, set once per (j, k) row, plus the cell index; the sums are the same
+  // as reading node by node, in the same order.
+  return P.a.data() +
+         (static_cast<std::size_t>(k - kofs_ + Padded::kPad) * P.ny +
+          static_cast<std::size_t>(j + Padded::kPad)) *
+             P.nx +
+         Padded::kPad;
+}
 
 }  // namespace boycott::coupling

@@ -26,31 +26,32 @@ FluidSolver::~FluidSolver() {
   auto vd = [](Vec& v) {
     if (v) VecDestroy(&v);
   };
-  for (int c = 0; c < 3; ++c) {
+  for (int c = 0; c < 3; ++c)
     for (Vec* v :
-         {&flow_.U[c], &flow_.Un[c], &flow_.Unm1[c], &flow_.alpha[c], &D_[c], &S_[c], &K_[c], &KU_[c],
-          &inv_diag_[c], &Ul_[c], &alphal_[c], &Dl_[c], &dep_S_[c], &dep_K_[c], &dep_KU_[c], &Fl_[c]})
+         {&flow_.U[c], &flow_.Un[c], &flow_.Unm1[c], &flow_.alpha[c], &work_.D[c], &work_.inv_diag[c],
+          &ghosts_.U[c], &ghosts_.alpha[c], &ghosts_.D[c], &ghosts_.F[c], &coupling_.S[c], &coupling_.K[c],
+          &coupling_.KU[c], &coupling_.dep_S[c], &coupling_.dep_K[c], &coupling_.dep_KU[c]})
       vd(*v);
-  }
-  for (Vec* v : {&flow_.P, &flow_.nut, &rhs_, &sol_, &R_, &pc_, &Pl_, &nutl_, &pcl_, &dep_solid_, &nuel_})
+  for (Vec* v : {&flow_.P, &flow_.nut, &work_.rhs, &work_.sol, &work_.R, &work_.pc, &ghosts_.P, &ghosts_.nut,
+                 &ghosts_.pc, &ghosts_.nue, &coupling_.dep_solid})
     vd(*v);
   if (solvers_.null_space) MatNullSpaceDestroy(&solvers_.null_space);
   if (solvers_.momentum) KSPDestroy(&solvers_.momentum);
   if (solvers_.pressure) KSPDestroy(&solvers_.pressure);
   solvers_.spectral_pc.reset();  // its vectors and scatter before the DM
   if (solvers_.pressure_fallback) KSPDestroy(&solvers_.pressure_fallback);
-  if (A_) MatDestroy(&A_);
+  if (ops_.momentum_aij) MatDestroy(&ops_.momentum_aij);
+  if (ops_.pressure_aij) MatDestroy(&ops_.pressure_aij);
   for (int c = 0; c < 3; ++c) {
-    opm_[c].reset();
-    vd(bm_[c]);
+    ops_.frozen[c].reset();
+    vd(ops_.frozen_rhs[c]);
   }
-  vd(P_asm_);
-  if (Ap_) MatDestroy(&Ap_);
-  opA_.reset();
-  opP_.reset();
-  halo_.reset();
-  if (dam_) DMDestroy(&dam_);
-  if (da_) DMDestroy(&da_);
+  vd(ops_.frozen_pressure);
+  ops_.momentum.reset();
+  ops_.pressure.reset();
+  layout_.halo.reset();
+  if (layout_.dam) DMDestroy(&layout_.dam);
+  if (layout_.da) DMDestroy(&layout_.da);
 }
 
 void FluidSolver::create_layout() {
@@ -77,44 +78,46 @@ void FluidSolver::create_layout() {
   const PetscInt pz = z_slabs.empty() ? PETSC_DECIDE : nranks, pxy = z_slabs.empty() ? PETSC_DECIDE : 1;
   BC_PETSC(DMDACreate3d(comm_, DM_BOUNDARY_PERIODIC, by, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_BOX,
                         (PetscInt)g.n[0], (PetscInt)g.n[1], (PetscInt)g.n[2], pxy, pxy, pz, 1, 2, nullptr,
-                        nullptr, z_slabs.empty() ? nullptr : z_slabs.data(), &da_));
-  BC_PETSC(DMSetUp(da_));
-  halo_ = std::make_unique<HaloExchange>(da_);
+                        nullptr, z_slabs.empty() ? nullptr : z_slabs.data(), &layout_.da));
+  BC_PETSC(DMSetUp(layout_.da));
+  layout_.halo = std::make_unique<HaloExchange>(layout_.da);
   const PetscInt *lx, *ly, *lz;
   PetscInt mx, my, mz;
-  BC_PETSC(DMDAGetInfo(da_, nullptr, nullptr, nullptr, nullptr, &mx, &my, &mz, nullptr, nullptr, nullptr,
-                       nullptr, nullptr, nullptr));
-  BC_PETSC(DMDAGetOwnershipRanges(da_, &lx, &ly, &lz));
+  BC_PETSC(DMDAGetInfo(layout_.da, nullptr, nullptr, nullptr, nullptr, &mx, &my, &mz, nullptr, nullptr,
+                       nullptr, nullptr, nullptr, nullptr));
+  BC_PETSC(DMDAGetOwnershipRanges(layout_.da, &lx, &ly, &lz));
   // Same ownership, 7-point star of width 1: the matrices need no more than that.
   BC_PETSC(DMDACreate3d(comm_, DM_BOUNDARY_PERIODIC, by, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR,
                         (PetscInt)g.n[0], (PetscInt)g.n[1], (PetscInt)g.n[2], mx, my, mz, 1, 1, lx, ly, lz,
-                        &dam_));
-  BC_PETSC(DMSetUp(dam_));
+                        &layout_.dam));
+  BC_PETSC(DMSetUp(layout_.dam));
   // Both systems are applied matrix-free (stencil_operator.hpp); an AIJ copy is made only for a
   // preconditioner that needs the entries.
-  opA_ = std::make_unique<StencilOperator>(dam_);
-  opP_ = std::make_unique<StencilOperator>(dam_);
+  ops_.momentum = std::make_unique<StencilOperator>(layout_.dam);
+  ops_.pressure = std::make_unique<StencilOperator>(layout_.dam);
   PetscBool user_momentum_pc = PETSC_FALSE;
   BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-momentum_pc_type", &user_momentum_pc));
-  momentum_aij_ = user_momentum_pc;
-  pressure_aij_ = user_pc;
+  ops_.momentum_needs_aij = user_momentum_pc;
+  ops_.pressure_needs_aij = user_pc;
 
-  auto gv = [&](Vec* v) { BC_PETSC(DMCreateGlobalVector(da_, v)); };
-  auto lv = [&](Vec* v) { BC_PETSC(DMCreateLocalVector(da_, v)); };
+  auto gv = [&](Vec* v) { BC_PETSC(DMCreateGlobalVector(layout_.da, v)); };
+  auto lv = [&](Vec* v) { BC_PETSC(DMCreateLocalVector(layout_.da, v)); };
   for (int c = 0; c < 3; ++c) {
-    for (Vec* v : {&flow_.U[c], &flow_.Un[c], &flow_.Unm1[c], &flow_.alpha[c], &D_[c], &S_[c], &K_[c],
-                   &KU_[c], &inv_diag_[c]})
+    for (Vec* v : {&flow_.U[c], &flow_.Un[c], &flow_.Unm1[c], &flow_.alpha[c], &work_.D[c], &coupling_.S[c],
+                   &coupling_.K[c], &coupling_.KU[c], &work_.inv_diag[c]})
       gv(v);
-    for (Vec* v : {&Ul_[c], &alphal_[c], &Dl_[c], &dep_S_[c], &dep_K_[c], &dep_KU_[c], &Fl_[c]}) lv(v);
+    for (Vec* v : {&ghosts_.U[c], &ghosts_.alpha[c], &ghosts_.D[c], &coupling_.dep_S[c], &coupling_.dep_K[c],
+                   &coupling_.dep_KU[c], &ghosts_.F[c]})
+      lv(v);
     BC_PETSC(VecSet(flow_.alpha[c], 1.0));
   }
-  for (Vec* v : {&flow_.P, &flow_.nut, &rhs_, &sol_, &R_, &pc_}) gv(v);
-  for (Vec* v : {&Pl_, &nutl_, &pcl_, &dep_solid_, &nuel_}) lv(v);
+  for (Vec* v : {&flow_.P, &flow_.nut, &work_.rhs, &work_.sol, &work_.R, &work_.pc}) gv(v);
+  for (Vec* v : {&ghosts_.P, &ghosts_.nut, &ghosts_.pc, &coupling_.dep_solid, &ghosts_.nue}) lv(v);
 
-  solvers_.momentum = create_momentum_ksp(comm_, &jacobi_inv_diag_, inexact_inner_solves());
+  solvers_.momentum = create_momentum_ksp(comm_, &work_.jacobi_inv_diag, inexact_inner_solves());
   BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-momentum_ksp_atol", &solvers_.user_momentum_atol));
   // The spectral preconditioner unless the user names another (-pressure_pc_type).
-  if (!user_pc) solvers_.spectral_pc = std::make_unique<SpectralPcShell>(dam_, g);
+  if (!user_pc) solvers_.spectral_pc = std::make_unique<SpectralPcShell>(layout_.dam, g);
   // With the spectral preconditioner a tighter solve than the multigrid's is cheap (about one
   // Krylov iteration per decade). With one correction per SIMPLE iteration it saves iterations
   // (5.8 -> 5.0 per step on the fluid bench at 1e-3 against 1e-2; 1e-4: 5.0); with two it does
@@ -125,47 +128,47 @@ void FluidSolver::create_layout() {
   BC_PETSC(PetscOptionsHasName(nullptr, nullptr, "-pressure_ksp_atol", &solvers_.user_pressure_atol));
   // Periodic x, z and walls (or periodicity) in y: pure Neumann, the constant is the null space.
   BC_PETSC(MatNullSpaceCreate(comm_, PETSC_TRUE, 0, nullptr, &solvers_.null_space));
-  BC_PETSC(MatSetNullSpace(opP_->mat(), solvers_.null_space));
+  BC_PETSC(MatSetNullSpace(ops_.pressure->mat(), solvers_.null_space));
   update_ghosts();
 }
 
 Mat FluidSolver::aij_copy(const StencilOperator& op, Mat* M) {
   if (!*M) {
-    BC_PETSC(DMCreateMatrix(dam_, M));
+    BC_PETSC(DMCreateMatrix(layout_.dam, M));
     // Every rank writes only its own rows (StencilMatrixWriter): without this, each assembly of
     // an MPIAIJ matrix still set up the communication of off-process entries.
     BC_PETSC(MatSetOption(*M, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
     BC_PETSC(MatSetOption(*M, MAT_NO_OFF_PROC_ENTRIES, PETSC_TRUE));
-    if (M == &Ap_) BC_PETSC(MatSetNullSpace(*M, solvers_.null_space));
-    if (!writer_) writer_ = std::make_unique<StencilMatrixWriter>(dam_, *M);
+    if (M == &ops_.pressure_aij) BC_PETSC(MatSetNullSpace(*M, solvers_.null_space));
+    if (!ops_.writer) ops_.writer = std::make_unique<StencilMatrixWriter>(layout_.dam, *M);
   }
-  op.copy_to(*M, *writer_);
+  op.copy_to(*M, *ops_.writer);
   return *M;
 }
 
 OwnedBox FluidSolver::owned_box() const {
   PetscInt xs, ys, zs, xm, ym, zm;
-  DMDAGetCorners(da_, &xs, &ys, &zs, &xm, &ym, &zm);
+  DMDAGetCorners(layout_.da, &xs, &ys, &zs, &xm, &ym, &zm);
   return OwnedBox{{xs, ys, zs}, {xm, ym, zm}};
 }
 
 GhostBox FluidSolver::ghost_box() const {
   PetscInt xs, ys, zs, xm, ym, zm;
-  DMDAGetGhostCorners(da_, &xs, &ys, &zs, &xm, &ym, &zm);
+  DMDAGetGhostCorners(layout_.da, &xs, &ys, &zs, &xm, &ym, &zm);
   return GhostBox{{xs, ys, zs}, {xm, ym, zm}};
 }
 
 void FluidSolver::update_ghosts() {
-  for (int c = 0; c < 3; ++c) halo_->fill(flow_.alpha[c], alphal_[c]);
-  halo_->fill(flow_.nut, nutl_);
+  for (int c = 0; c < 3; ++c) layout_.halo->fill(flow_.alpha[c], ghosts_.alpha[c]);
+  layout_.halo->fill(flow_.nut, ghosts_.nut);
   update_flow_ghosts();
 }
 
 // Within a step alpha_f and nu_t are fixed; only u and p change (a ghost fill of the bench mesh
 // cost ~0.3 ms with DMGlobalToLocal then, and a SIMPLE step did ~90 of them).
 void FluidSolver::update_flow_ghosts() {
-  for (int c = 0; c < 3; ++c) halo_->fill(flow_.U[c], Ul_[c]);
-  halo_->fill(flow_.P, Pl_);
+  for (int c = 0; c < 3; ++c) layout_.halo->fill(flow_.U[c], ghosts_.U[c]);
+  layout_.halo->fill(flow_.P, ghosts_.P);
 }
 
 }  // namespace boycott::fluid

@@ -25,7 +25,9 @@
 // The class's members are defined by concern: fluid_solver.cpp (layout, solvers, ghosts),
 // simple_piso.cpp (the step), momentum_assembly.cpp, pressure_correction.cpp,
 // flux_controller.cpp, subgrid_stencil.cpp, deposition_interface.cpp and fluid_state.cpp
-// (given fields, diagnostics, checkpoint state).
+// (given fields, diagnostics, checkpoint state). Its data fall into one struct per concern: the
+// layout, the operators, the solvers, the flow, the counters, the work vectors, the ghosted
+// copies and the coupling exchange.
 #include <mpi.h>
 #include <petscdmda.h>
 #include <petscksp.h>
@@ -164,7 +166,7 @@ class FluidSolver {
   void compute_subgrid_viscosity();
   void compute_face_fluxes();
   void compute_effective_viscosity();
-  /// Assembles component c's momentum equations into A and rhs_; D_[c] on the first iteration of
+  /// Assembles component c's momentum equations into A and work_.rhs; work_.D[c] on the first iteration of
   /// a step.
   void assemble_momentum(int c, double dt, double c0, double c1, double c2, bool first_iteration,
                          StencilOperator& A);
@@ -178,11 +180,11 @@ class FluidSolver {
   /// (simple_piso.cpp); one corrector and PISO keep the tolerances they always had.
   bool inexact_inner_solves() const { return !s_.piso && s_.simple_correctors > 1; }
   void step_piso(double dt, const double c[3], StepReport& rep);
-  /// Solves component cc's momentum equations from the guess flow_.U[cc]; the solution is left in sol_.
+  /// Solves component cc's momentum equations from the guess flow_.U[cc]; the solution is left in work_.sol.
   void solve_momentum(int cc, const StencilOperator& A, StepReport& rep);
   /// The AIJ copy of op in *M (created on first use), for preconditioners that need entries.
   Mat aij_copy(const StencilOperator& op, Mat* M);
-  /// Pressure correction from the continuity residual in R_, then the velocity and pressure
+  /// Pressure correction from the continuity residual in work_.R, then the velocity and pressure
   /// update (and their ghosts unless told otherwise).
   void solve_pressure_correction(StepReport& rep, bool refresh_ghosts = true);
   /// max |d a/dt + div(a u)| h_min / U of flow_.U (also refreshes the ghosted velocities).
@@ -197,20 +199,31 @@ class FluidSolver {
 
   FluidSettings s_;
   MPI_Comm comm_;
-  DM da_ = nullptr;                       // box stencil, width 2: ghosted fields
-  DM dam_ = nullptr;                      // star stencil, width 1, same ownership: matrices
-  std::unique_ptr<HaloExchange> halo_;    // ghost fills of da_'s local vectors
-  std::unique_ptr<StencilOperator> opA_;  // momentum operator (one component at a time)
-  std::unique_ptr<StencilOperator> opP_;  // pressure-correction operator
-  // PISO and SIMPLE with several correctors: each component's operator and right-hand side, kept
-  // for the corrector sweeps, and the pressure they were assembled with
-  std::unique_ptr<StencilOperator> opm_[3];
-  Vec bm_[3]{}, P_asm_ = nullptr;
-  // AIJ copies of the operators, made only for preconditioners that need the entries
-  // (-momentum_pc_type, -pressure_pc_type, the pressure fallback); the writer knows their slots
-  bool momentum_aij_ = false, pressure_aij_ = false;
-  Mat A_ = nullptr, Ap_ = nullptr;
-  std::unique_ptr<StencilMatrixWriter> writer_;
+
+  /// The grid's layout on the ranks: its DMDAs and the ghost fills.
+  struct Layout {
+    DM da = nullptr;                     // box stencil, width 2: ghosted fields
+    DM dam = nullptr;                    // star stencil, width 1, same ownership: matrices
+    std::unique_ptr<HaloExchange> halo;  // ghost fills of da's local vectors
+  };
+  Layout layout_;
+
+  /// The linear operators, applied matrix-free (stencil_operator.hpp), and their AIJ copies.
+  struct Operators {
+    std::unique_ptr<StencilOperator> momentum;  // one component at a time
+    std::unique_ptr<StencilOperator> pressure;  // the pressure correction's
+    // PISO and SIMPLE with several correctors: each component's operator and right-hand side,
+    // kept for the corrector sweeps, and the pressure they were assembled with
+    std::unique_ptr<StencilOperator> frozen[3];
+    Vec frozen_rhs[3]{}, frozen_pressure = nullptr;
+    // AIJ copies of the operators, made only for preconditioners that need the entries
+    // (-momentum_pc_type, -pressure_pc_type, the pressure fallback); the writer knows their slots
+    bool momentum_needs_aij = false, pressure_needs_aij = false;
+    Mat momentum_aij = nullptr, pressure_aij = nullptr;
+    std::unique_ptr<StencilMatrixWriter> writer;
+  };
+  Operators ops_;
+
   /// The linear solvers of a step (linear_solvers.hpp) and how they are steered.
   struct Solvers {
     KSP momentum = nullptr, pressure = nullptr;
@@ -236,7 +249,8 @@ class FluidSolver {
     double time_s = 0.0;
     double dt_prev_s = 0.0;  // the last step's, for the second-order time derivative
     int steps = 0;
-    double G_pa_m = 0.0;  // the mean pressure gradient driving the flow
+    double G_pa_m = 0.0;             // the mean pressure gradient driving the flow
+    bool alpha_initialised = false;  // alpha_f was set (levels n and n-1 too, before the first step)
   };
   Flow flow_;
 
@@ -249,25 +263,36 @@ class FluidSolver {
   };
   Counters counters_;
 
-  // global vectors
-  Vec D_[3]{};                     // a_face / (rho a_P') per face (SIMPLE correction coefficient)
-  Vec inv_diag_[3]{};              // 1 / diagonal of each component's momentum matrix (Jacobi)
-  Vec jacobi_inv_diag_ = nullptr;  // the one the momentum solve in progress uses
-  Vec S_[3]{}, K_[3]{}, KU_[3]{};  // coupling fields on faces
-  Vec rhs_ = nullptr, sol_ = nullptr, R_ = nullptr, pc_ = nullptr;
-  // ghosted local vectors
-  Vec Ul_[3]{}, Pl_ = nullptr, alphal_[3]{}, nutl_ = nullptr, pcl_ = nullptr, Dl_[3]{};
-  Vec dep_solid_ = nullptr, dep_S_[3]{}, dep_K_[3]{}, dep_KU_[3]{};
-  // per SIMPLE iteration: a_f u_d on each lower d-face (0 on walls), m/s; per step: nu + nu_t, m^2/s
-  Vec Fl_[3]{}, nuel_ = nullptr;
-  bool deposition_open_ = false;
-  bool coupling_armed_ = false;
-  bool alpha_initialised_ = false;
-  PetscScalar*** dep_arrays_[10]{};
-  PetscScalar*** read_arrays_[5]{};
+  /// The global work vectors of the pressure-velocity iteration.
+  struct Work {
+    Vec D[3]{};                        // a_face / (rho a_P') per face (SIMPLE correction coefficient)
+    Vec inv_diag[3]{};                 // 1 / diagonal of each component's momentum matrix (Jacobi)
+    Vec jacobi_inv_diag = nullptr;     // the one the momentum solve in progress uses
+    Vec rhs = nullptr, sol = nullptr;  // a momentum system's right-hand side and solution
+    Vec R = nullptr, pc = nullptr;     // continuity residual, pressure correction
+    std::vector<double> row_buffers;   // momentum assembly and subgrid stencil, one (k, j) row of cells
+  };
+  Work work_;
 
-  double last_c_[3] = {1.0, 1.0, 0.0};
-  std::vector<double> row_buffers_;  // momentum assembly, one (k, j) row of cells at a time
+  /// Ghosted local vectors of da, read by the stencils.
+  struct Ghosts {
+    Vec U[3]{}, P = nullptr, alpha[3]{}, nut = nullptr, pc = nullptr, D[3]{};
+    // per SIMPLE iteration: a_f u_d on each lower d-face (0 on walls), m/s; per step: nu + nu_t, m^2/s
+    Vec F[3]{}, nue = nullptr;
+  };
+  Ghosts ghosts_;
+
+  /// The coupling interface: the local deposition arrays, the sources they arm on the faces, and
+  /// the read views of the ghosted fields.
+  struct CouplingExchange {
+    Vec dep_solid = nullptr, dep_S[3]{}, dep_K[3]{}, dep_KU[3]{};  // ghosted local, summed into S, K, KU
+    PetscScalar*** dep_arrays[10]{};
+    bool open = false;            // between begin_deposition and end_deposition
+    Vec S[3]{}, K[3]{}, KU[3]{};  // explicit source, drag coefficient and K u_p on faces
+    bool armed = false;           // S, K, KU hold a deposition
+    PetscScalar*** read_arrays[5]{};
+  };
+  CouplingExchange coupling_;
 };
 
 }  // namespace boycott::fluid

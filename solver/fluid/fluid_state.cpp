@@ -20,7 +20,7 @@ void FluidSolver::set_velocity(int c, const std::function<double(double, double,
   const auto& g = s_.grid;
   const OwnedBox b = owned_box();
   PetscScalar*** u;
-  BC_PETSC(DMDAVecGetArray(da_, flow_.U[c], &u));
+  BC_PETSC(DMDAVecGetArray(layout_.da, flow_.U[c], &u));
   for (auto k = b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
     for (auto j = b.lo[1]; j < b.lo[1] + b.size[1]; ++j)
       for (auto i = b.lo[0]; i < b.lo[0] + b.size[0]; ++i) {
@@ -30,10 +30,10 @@ void FluidSolver::set_velocity(int c, const std::function<double(double, double,
         const bool wall = c == 1 && !g.periodic[1] && j == 0;
         u[k][j][i] = wall ? 0.0 : f(x[0], x[1], x[2]);
       }
-  BC_PETSC(DMDAVecRestoreArray(da_, flow_.U[c], &u));
+  BC_PETSC(DMDAVecRestoreArray(layout_.da, flow_.U[c], &u));
   BC_PETSC(VecCopy(flow_.U[c], flow_.Un[c]));
   BC_PETSC(VecCopy(flow_.U[c], flow_.Unm1[c]));
-  halo_->fill(flow_.U[c], Ul_[c]);
+  layout_.halo->fill(flow_.U[c], ghosts_.U[c]);
 }
 
 void FluidSolver::set_fluid_fraction(const std::function<double(double, double, double)>& f) {
@@ -41,7 +41,7 @@ void FluidSolver::set_fluid_fraction(const std::function<double(double, double, 
   const OwnedBox b = owned_box();
   PetscScalar*** a;
   double amin = 1.0, amax = 0.0;
-  BC_PETSC(DMDAVecGetArray(da_, flow_.alpha[0], &a));
+  BC_PETSC(DMDAVecGetArray(layout_.da, flow_.alpha[0], &a));
   for (auto k = b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
     for (auto j = b.lo[1]; j < b.lo[1] + b.size[1]; ++j)
       for (auto i = b.lo[0]; i < b.lo[0] + b.size[0]; ++i) {
@@ -49,15 +49,15 @@ void FluidSolver::set_fluid_fraction(const std::function<double(double, double, 
         a[k][j][i] = v;
         amin = std::min(amin, v), amax = std::max(amax, v);
       }
-  BC_PETSC(DMDAVecRestoreArray(da_, flow_.alpha[0], &a));
+  BC_PETSC(DMDAVecRestoreArray(layout_.da, flow_.alpha[0], &a));
   if (!(amin > 0.0) || !(amax <= 1.0))
     throw PhysicsError(fmt::format("fluid fraction outside (0, 1]: min {:.4g}, max {:.4g}", amin, amax));
-  if (!alpha_initialised_ && flow_.steps == 0) {
+  if (!flow_.alpha_initialised && flow_.steps == 0) {
     BC_PETSC(VecCopy(flow_.alpha[0], flow_.alpha[1]));
     BC_PETSC(VecCopy(flow_.alpha[0], flow_.alpha[2]));
   }
-  alpha_initialised_ = true;
-  for (int l = 0; l < 3; ++l) halo_->fill(flow_.alpha[l], alphal_[l]);
+  flow_.alpha_initialised = true;
+  for (int l = 0; l < 3; ++l) layout_.halo->fill(flow_.alpha[l], ghosts_.alpha[l]);
 }
 
 // ---------------------------------------------------------------- diagnostics
@@ -83,11 +83,11 @@ std::vector<double> FluidSolver::profile_y(int c) const {
   const int ny = (int)s_.grid.n[1];
   std::vector<double> loc(ny, 0.0), glob(ny, 0.0);
   PetscScalar*** u;
-  DMDAVecGetArray(da_, flow_.U[c], &u);
+  DMDAVecGetArray(layout_.da, flow_.U[c], &u);
   for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
     for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j)
       for (int i = (int)b.lo[0]; i < b.lo[0] + b.size[0]; ++i) loc[j] += u[k][j][i];
-  DMDAVecRestoreArray(da_, flow_.U[c], &u);
+  DMDAVecRestoreArray(layout_.da, flow_.U[c], &u);
   MPI_Allreduce(loc.data(), glob.data(), ny, MPI_DOUBLE, MPI_SUM, comm_);
   const double nxz = static_cast<double>(s_.grid.n[0] * s_.grid.n[2]);
   for (auto& v : glob) v /= nxz;
@@ -98,9 +98,9 @@ std::vector<double> FluidSolver::gather(int c) const {
   Vec src = c < 3 ? flow_.U[c] : (c == 3 ? flow_.P : (c == 4 ? flow_.nut : flow_.alpha[1]));
   Vec nat, all;
   VecScatter sc;
-  BC_PETSC(DMDACreateNaturalVector(da_, &nat));
-  BC_PETSC(DMDAGlobalToNaturalBegin(da_, src, INSERT_VALUES, nat));
-  BC_PETSC(DMDAGlobalToNaturalEnd(da_, src, INSERT_VALUES, nat));
+  BC_PETSC(DMDACreateNaturalVector(layout_.da, &nat));
+  BC_PETSC(DMDAGlobalToNaturalBegin(layout_.da, src, INSERT_VALUES, nat));
+  BC_PETSC(DMDAGlobalToNaturalEnd(layout_.da, src, INSERT_VALUES, nat));
   BC_PETSC(VecScatterCreateToAll(nat, &sc, &all));
   BC_PETSC(VecScatterBegin(sc, nat, all, INSERT_VALUES, SCATTER_FORWARD));
   BC_PETSC(VecScatterEnd(sc, nat, all, INSERT_VALUES, SCATTER_FORWARD));
@@ -158,9 +158,9 @@ void FluidSolver::import_state(const FluidState& st) {
   flow_.dt_prev_s = st.dt_prev_s;
   flow_.steps = st.steps;
   flow_.G_pa_m = st.mean_pressure_gradient_pa_m;
-  alpha_initialised_ = true;
-  for (int l = 0; l < 3; ++l) halo_->fill(flow_.alpha[l], alphal_[l]);
-  halo_->fill(flow_.nut, nutl_);
+  flow_.alpha_initialised = true;
+  for (int l = 0; l < 3; ++l) layout_.halo->fill(flow_.alpha[l], ghosts_.alpha[l]);
+  layout_.halo->fill(flow_.nut, ghosts_.nut);
   update_ghosts();
 }
 

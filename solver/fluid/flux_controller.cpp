@@ -12,9 +12,9 @@ void FluidSolver::apply_flux_controller() {
   if (!std::isfinite(s_.target_mean_flux_z_m_s)) return;
   const OwnedBox b = owned_box();
   PetscScalar ***w, ***al, ***Dz;
-  BC_PETSC(DMDAVecGetArray(da_, flow_.U[2], &w));
-  BC_PETSC(DMDAVecGetArray(da_, alphal_[0], &al));
-  BC_PETSC(DMDAVecGetArray(da_, D_[2], &Dz));
+  BC_PETSC(DMDAVecGetArray(layout_.da, flow_.U[2], &w));
+  BC_PETSC(DMDAVecGetArray(layout_.da, ghosts_.alpha[0], &al));
+  BC_PETSC(DMDAVecGetArray(layout_.da, work_.D[2], &Dz));
   double loc[2] = {0.0, 0.0};  // sum a_f w, sum a_f D
   for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
     for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j)
@@ -33,23 +33,23 @@ void FluidSolver::apply_flux_controller() {
   for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
     for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j)
       for (int i = (int)b.lo[0]; i < b.lo[0] + b.size[0]; ++i) w[k][j][i] -= Dz[k][j][i] * dG;
-  BC_PETSC(DMDAVecRestoreArray(da_, flow_.U[2], &w));
-  BC_PETSC(DMDAVecRestoreArray(da_, alphal_[0], &al));
-  BC_PETSC(DMDAVecRestoreArray(da_, D_[2], &Dz));
+  BC_PETSC(DMDAVecRestoreArray(layout_.da, flow_.U[2], &w));
+  BC_PETSC(DMDAVecRestoreArray(layout_.da, ghosts_.alpha[0], &al));
+  BC_PETSC(DMDAVecRestoreArray(layout_.da, work_.D[2], &Dz));
 }
 
 double FluidSolver::mean_flux_z() const {
   const OwnedBox b = owned_box();
   PetscScalar ***w, ***al;
-  DMDAVecGetArray(da_, flow_.U[2], &w);
-  DMDAVecGetArray(da_, alphal_[0], &al);
+  DMDAVecGetArray(layout_.da, flow_.U[2], &w);
+  DMDAVecGetArray(layout_.da, ghosts_.alpha[0], &al);
   double loc = 0.0;
   for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
     for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j)
       for (int i = (int)b.lo[0]; i < b.lo[0] + b.size[0]; ++i)
         loc += 0.5 * (al[k][j][i] + al[k - 1][j][i]) * w[k][j][i];
-  DMDAVecRestoreArray(da_, flow_.U[2], &w);
-  DMDAVecRestoreArray(da_, alphal_[0], &al);
+  DMDAVecRestoreArray(layout_.da, flow_.U[2], &w);
+  DMDAVecRestoreArray(layout_.da, ghosts_.alpha[0], &al);
   double glob;
   MPI_Allreduce(&loc, &glob, 1, MPI_DOUBLE, MPI_SUM, comm_);
   return glob / static_cast<double>(s_.grid.cell_count());

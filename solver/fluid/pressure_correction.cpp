@@ -28,9 +28,9 @@ double FluidSolver::continuity_residual(double dt, double c0, double c1, double 
   const bool wall = !g.periodic[1];
   const OwnedBox b = owned_box();
   PetscScalar ***u[3], ***al[3], ***R;
-  for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecGetArray(da_, Ul_[d], &u[d]));
-  for (int l = 0; l < 3; ++l) BC_PETSC(DMDAVecGetArray(da_, alphal_[l], &al[l]));
-  BC_PETSC(DMDAVecGetArray(da_, Rv, &R));
+  for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecGetArray(layout_.da, ghosts_.U[d], &u[d]));
+  for (int l = 0; l < 3; ++l) BC_PETSC(DMDAVecGetArray(layout_.da, ghosts_.alpha[l], &al[l]));
+  BC_PETSC(DMDAVecGetArray(layout_.da, Rv, &R));
   auto flux = [&](int d, int qi, int qj, int qk) -> double {
     if (wall && d == 1 && (qj <= 0 || qj >= n1)) return 0.0;
     const double af = 0.5 * (al[0][qk][qj][qi] + al[0][qk - kE[d][2]][qj - kE[d][1]][qi - kE[d][0]]);
@@ -46,9 +46,9 @@ double FluidSolver::continuity_residual(double dt, double c0, double c1, double 
         R[k][j][i] = r;
         rmax = std::max(rmax, std::abs(r));
       }
-  for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecRestoreArray(da_, Ul_[d], &u[d]));
-  for (int l = 0; l < 3; ++l) BC_PETSC(DMDAVecRestoreArray(da_, alphal_[l], &al[l]));
-  BC_PETSC(DMDAVecRestoreArray(da_, Rv, &R));
+  for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecRestoreArray(layout_.da, ghosts_.U[d], &u[d]));
+  for (int l = 0; l < 3; ++l) BC_PETSC(DMDAVecRestoreArray(layout_.da, ghosts_.alpha[l], &al[l]));
+  BC_PETSC(DMDAVecRestoreArray(layout_.da, Rv, &R));
   double gmax;
   MPI_Allreduce(&rmax, &gmax, 1, MPI_DOUBLE, MPI_MAX, comm_);
   return gmax;
@@ -61,12 +61,12 @@ void FluidSolver::assemble_pressure() {
   const double h[3] = {g.dx(0), g.dx(1), g.dx(2)};
   const bool wall = !g.periodic[1];
   const OwnedBox b = owned_box();
-  for (int d = 0; d < 3; ++d) halo_->fill(D_[d], Dl_[d]);
+  for (int d = 0; d < 3; ++d) layout_.halo->fill(work_.D[d], ghosts_.D[d]);
   PetscScalar ***D[3], ***al;
-  for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecGetArray(da_, Dl_[d], &D[d]));
-  BC_PETSC(DMDAVecGetArray(da_, alphal_[0], &al));
+  for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecGetArray(layout_.da, ghosts_.D[d], &D[d]));
+  BC_PETSC(DMDAVecGetArray(layout_.da, ghosts_.alpha[0], &al));
   double* Ae[7];
-  for (int e = 0; e < 7; ++e) Ae[e] = opP_->coef(e);
+  for (int e = 0; e < 7; ++e) Ae[e] = ops_.pressure->coef(e);
   // coefficient a_f D / h^2 of the lower d-face of cell Q (0 on walls)
   auto coef = [&](int d, int qi, int qj, int qk) -> double {
     if (wall && d == 1 && (qj <= 0 || qj >= n1)) return 0.0;
@@ -93,8 +93,8 @@ void FluidSolver::assemble_pressure() {
         }
         Ae[0][o] = diag;
       }
-  for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecRestoreArray(da_, Dl_[d], &D[d]));
-  BC_PETSC(DMDAVecRestoreArray(da_, alphal_[0], &al));
+  for (int d = 0; d < 3; ++d) BC_PETSC(DMDAVecRestoreArray(layout_.da, ghosts_.D[d], &D[d]));
+  BC_PETSC(DMDAVecRestoreArray(layout_.da, ghosts_.alpha[0], &al));
   if (solvers_.spectral_pc) {
     double gsum[6];
     MPI_Allreduce(csum, gsum, 6, MPI_DOUBLE, MPI_SUM, comm_);
@@ -102,7 +102,7 @@ void FluidSolver::assemble_pressure() {
     for (int d = 0; d < 3; ++d) c[d] = gsum[3 + d] > 0.0 ? gsum[d] / gsum[3 + d] : 0.0;
     solvers_.spectral_pc->set_coefficients(c[0], c[1], c[2]);
   }
-  const Mat A = pressure_aij_ ? aij_copy(*opP_, &Ap_) : opP_->mat();
+  const Mat A = ops_.pressure_needs_aij ? aij_copy(*ops_.pressure, &ops_.pressure_aij) : ops_.pressure->mat();
   BC_PETSC(KSPSetOperators(solvers_.pressure, A, A));
 }
 
@@ -112,12 +112,12 @@ void FluidSolver::correct(Vec pcorr) {
   const double h[3] = {g.dx(0), g.dx(1), g.dx(2)};
   const bool wall = !g.periodic[1];
   const OwnedBox b = owned_box();
-  halo_->fill(pcorr, pcl_);
+  layout_.halo->fill(pcorr, ghosts_.pc);
   PetscScalar ***pc, ***U[3], ***D[3];
-  BC_PETSC(DMDAVecGetArray(da_, pcl_, &pc));
+  BC_PETSC(DMDAVecGetArray(layout_.da, ghosts_.pc, &pc));
   for (int d = 0; d < 3; ++d) {
-    BC_PETSC(DMDAVecGetArray(da_, flow_.U[d], &U[d]));
-    BC_PETSC(DMDAVecGetArray(da_, D_[d], &D[d]));
+    BC_PETSC(DMDAVecGetArray(layout_.da, flow_.U[d], &U[d]));
+    BC_PETSC(DMDAVecGetArray(layout_.da, work_.D[d], &D[d]));
   }
   for (int k = (int)b.lo[2]; k < b.lo[2] + b.size[2]; ++k)
     for (int j = (int)b.lo[1]; j < b.lo[1] + b.size[1]; ++j)
@@ -127,32 +127,33 @@ void FluidSolver::correct(Vec pcorr) {
           U[d][k][j][i] -=
               D[d][k][j][i] * (pc[k][j][i] - pc[k - kE[d][2]][j - kE[d][1]][i - kE[d][0]]) / h[d];
         }
-  BC_PETSC(DMDAVecRestoreArray(da_, pcl_, &pc));
+  BC_PETSC(DMDAVecRestoreArray(layout_.da, ghosts_.pc, &pc));
   for (int d = 0; d < 3; ++d) {
-    BC_PETSC(DMDAVecRestoreArray(da_, flow_.U[d], &U[d]));
-    BC_PETSC(DMDAVecRestoreArray(da_, D_[d], &D[d]));
+    BC_PETSC(DMDAVecRestoreArray(layout_.da, flow_.U[d], &U[d]));
+    BC_PETSC(DMDAVecRestoreArray(layout_.da, work_.D[d], &D[d]));
   }
   // SIMPLEC: the pressure correction is consistent with the velocity correction and applied whole
   BC_PETSC(VecAXPY(flow_.P, 1.0, pcorr));
 }
 
 void FluidSolver::solve_pressure_correction(StepReport& rep, bool refresh_ghosts) {
-  BC_PETSC(VecScale(R_, -1.0));
-  BC_PETSC(MatNullSpaceRemove(solvers_.null_space, R_));
+  BC_PETSC(VecScale(work_.R, -1.0));
+  BC_PETSC(MatNullSpaceRemove(solvers_.null_space, work_.R));
   const auto res = solve_pressure(
-      comm_, solvers_.pressure, &solvers_.pressure_fallback, [this] { return aij_copy(*opP_, &Ap_); }, R_,
-      pc_, solvers_.user_pressure_atol ? -1.0 : solvers_.pressure_abs_tol);
+      comm_, solvers_.pressure, &solvers_.pressure_fallback,
+      [this] { return aij_copy(*ops_.pressure, &ops_.pressure_aij); }, work_.R, work_.pc,
+      solvers_.user_pressure_atol ? -1.0 : solvers_.pressure_abs_tol);
   if (res.used_fallback) ++counters_.pressure_fallbacks;
   rep.pressure_krylov_iterations += (int)res.iterations;
-  correct(pc_);
+  correct(work_.pc);
   if (refresh_ghosts) update_flow_ghosts();
 }
 
 double FluidSolver::relative_continuity_residual(double dt, const double c[3], double umax) {
   const auto& g = s_.grid;
   const double hmin = std::min({g.dx(0), g.dx(1), g.dx(2)});
-  for (int cc = 0; cc < 3; ++cc) halo_->fill(flow_.U[cc], Ul_[cc]);
-  const double rmax = continuity_residual(dt, c[0], c[1], c[2], R_);
+  for (int cc = 0; cc < 3; ++cc) layout_.halo->fill(flow_.U[cc], ghosts_.U[cc]);
+  const double rmax = continuity_residual(dt, c[0], c[1], c[2], work_.R);
   const double uref = std::max(
       {umax, std::abs(std::isfinite(s_.target_mean_flux_z_m_s) ? s_.target_mean_flux_z_m_s : 0.0), 1e-30});
   if (!std::isfinite(rmax) || !std::isfinite(umax))

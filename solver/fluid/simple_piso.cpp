@@ -45,12 +45,12 @@ double FluidSolver::stable_dt() const {
 }
 
 void FluidSolver::keep_momentum_operators() {
-  if (opm_[0]) return;
+  if (ops_.frozen[0]) return;
   for (int cc = 0; cc < 3; ++cc) {
-    opm_[cc] = std::make_unique<StencilOperator>(dam_);
-    BC_PETSC(DMCreateGlobalVector(da_, &bm_[cc]));
+    ops_.frozen[cc] = std::make_unique<StencilOperator>(layout_.dam);
+    BC_PETSC(DMCreateGlobalVector(layout_.da, &ops_.frozen_rhs[cc]));
   }
-  BC_PETSC(DMCreateGlobalVector(da_, &P_asm_));
+  BC_PETSC(DMCreateGlobalVector(layout_.da, &ops_.frozen_pressure));
 }
 
 // SIMPLE's iteration error, once the flow has developed, is the neighbour term that the
@@ -68,21 +68,21 @@ void FluidSolver::step_simple(double dt, const double c[3], StepReport& rep) {
   for (int it = 0; it < s_.simple_max_iterations; ++it) {
     const bool first = it == 0;
     const double G_asm = flow_.G_pa_m;
-    if (correctors > 1) BC_PETSC(VecCopy(flow_.P, P_asm_));
+    if (correctors > 1) BC_PETSC(VecCopy(flow_.P, ops_.frozen_pressure));
     // max |u* - u| and max |u*| over the components: one pass each and one reduction for all
     double loc[2] = {0.0, 0.0};
     compute_face_fluxes();
     for (int cc = 0; cc < 3; ++cc) {
-      StencilOperator& A = correctors > 1 ? *opm_[cc] : *opA_;
+      StencilOperator& A = correctors > 1 ? *ops_.frozen[cc] : *ops_.momentum;
       assemble_momentum(cc, dt, c[0], c[1], c[2], first, A);
-      if (correctors > 1) BC_PETSC(VecCopy(rhs_, bm_[cc]));
+      if (correctors > 1) BC_PETSC(VecCopy(work_.rhs, ops_.frozen_rhs[cc]));
       solve_momentum(cc, A, rep);
-      // the new iterate (in sol_) replaces the old one in flow_.U in the pass that measures the change
+      // the new iterate (in work_.sol) replaces the old one in flow_.U in the pass that measures the change
       const double* un;
       double* u;
       PetscInt n;
       BC_PETSC(VecGetLocalSize(flow_.U[cc], &n));
-      BC_PETSC(VecGetArrayRead(sol_, &un));
+      BC_PETSC(VecGetArrayRead(work_.sol, &un));
       BC_PETSC(VecGetArray(flow_.U[cc], &u));
       double d = loc[0], m = loc[1];
       bool nan = false;
@@ -96,7 +96,7 @@ void FluidSolver::step_simple(double dt, const double c[3], StepReport& rep) {
       // which the continuity check below reports
       const double inf = std::numeric_limits<double>::infinity();
       loc[0] = nan ? inf : d, loc[1] = nan ? inf : m;
-      BC_PETSC(VecRestoreArrayRead(sol_, &un));
+      BC_PETSC(VecRestoreArrayRead(work_.sol, &un));
       BC_PETSC(VecRestoreArray(flow_.U[cc], &u));
     }
     double glob[2];
@@ -153,13 +153,13 @@ void FluidSolver::step_piso(double dt, const double c[3], StepReport& rep) {
     update_flow_ghosts();
   }
   compute_face_fluxes();
-  BC_PETSC(VecCopy(flow_.P, P_asm_));
+  BC_PETSC(VecCopy(flow_.P, ops_.frozen_pressure));
   const double G_asm = flow_.G_pa_m;
   for (int cc = 0; cc < 3; ++cc) {
-    assemble_momentum(cc, dt, c[0], c[1], c[2], true, *opm_[cc]);
-    BC_PETSC(VecCopy(rhs_, bm_[cc]));
-    solve_momentum(cc, *opm_[cc], rep);
-    BC_PETSC(VecCopy(sol_, flow_.U[cc]));
+    assemble_momentum(cc, dt, c[0], c[1], c[2], true, *ops_.frozen[cc]);
+    BC_PETSC(VecCopy(work_.rhs, ops_.frozen_rhs[cc]));
+    solve_momentum(cc, *ops_.frozen[cc], rep);
+    BC_PETSC(VecCopy(work_.sol, flow_.U[cc]));
   }
   if (std::isfinite(s_.target_mean_flux_z_m_s)) apply_flux_controller();
   for (int k = 0; k < s_.piso_correctors; ++k) {
@@ -188,8 +188,8 @@ void FluidSolver::step_piso(double dt, const double c[3], StepReport& rep) {
 void FluidSolver::momentum_sweep(double G_asm) {
   const LogScope log_scope(fluid_events().momentum_sweep);
   // p - p_asm, ghosted: the pressure the frozen right-hand sides b were assembled with
-  BC_PETSC(VecWAXPY(pc_, -1.0, P_asm_, flow_.P));
-  halo_->fill(pc_, pcl_);
+  BC_PETSC(VecWAXPY(work_.pc, -1.0, ops_.frozen_pressure, flow_.P));
+  layout_.halo->fill(work_.pc, ghosts_.pc);
   const auto& g = s_.grid;
   const bool wall = !g.periodic[1];
   const OwnedBox b = owned_box();
@@ -197,15 +197,15 @@ void FluidSolver::momentum_sweep(double G_asm) {
   const std::int64_t off[3] = {1, gb.size[0], gb.size[0] * gb.size[1]};
   const double inv_rho = 1.0 / s_.density_kg_m3;
   const double *al, *dp;
-  BC_PETSC(VecGetArrayRead(alphal_[0], &al));
-  BC_PETSC(VecGetArrayRead(pcl_, &dp));
+  BC_PETSC(VecGetArrayRead(ghosts_.alpha[0], &al));
+  BC_PETSC(VecGetArrayRead(ghosts_.pc, &dp));
   for (int cc = 0; cc < 3; ++cc) {
-    opm_[cc]->apply(flow_.U[cc], sol_);  // A u
+    ops_.frozen[cc]->apply(flow_.U[cc], work_.sol);  // A u
     const double *Au, *bv, *aP;
     double* u;
-    BC_PETSC(VecGetArrayRead(sol_, &Au));
-    BC_PETSC(VecGetArrayRead(bm_[cc], &bv));
-    aP = opm_[cc]->coef(0);
+    BC_PETSC(VecGetArrayRead(work_.sol, &Au));
+    BC_PETSC(VecGetArrayRead(ops_.frozen_rhs[cc], &bv));
+    aP = ops_.frozen[cc]->coef(0);
     BC_PETSC(VecGetArray(flow_.U[cc], &u));
     const std::int64_t oc = off[cc];
     const double igrad = inv_rho / g.dx(cc);
@@ -229,17 +229,17 @@ void FluidSolver::momentum_sweep(double G_asm) {
         }
         o += nx;
       }
-    BC_PETSC(VecRestoreArrayRead(sol_, &Au));
-    BC_PETSC(VecRestoreArrayRead(bm_[cc], &bv));
+    BC_PETSC(VecRestoreArrayRead(work_.sol, &Au));
+    BC_PETSC(VecRestoreArrayRead(ops_.frozen_rhs[cc], &bv));
     BC_PETSC(VecRestoreArray(flow_.U[cc], &u));
   }
-  BC_PETSC(VecRestoreArrayRead(alphal_[0], &al));
-  BC_PETSC(VecRestoreArrayRead(pcl_, &dp));
+  BC_PETSC(VecRestoreArrayRead(ghosts_.alpha[0], &al));
+  BC_PETSC(VecRestoreArrayRead(ghosts_.pc, &dp));
 }
 
 void FluidSolver::solve_momentum(int cc, const StencilOperator& op, StepReport& rep) {
-  jacobi_inv_diag_ = inv_diag_[cc];
-  const Mat A = momentum_aij_ ? aij_copy(op, &A_) : op.mat();
+  work_.jacobi_inv_diag = work_.inv_diag[cc];
+  const Mat A = ops_.momentum_needs_aij ? aij_copy(op, &ops_.momentum_aij) : op.mat();
   BC_PETSC(KSPSetOperators(solvers_.momentum, A, A));
   if (inexact_inner_solves() && !solvers_.user_momentum_atol) {
     // 1e-2 of the initial residual, but never further than the 1e-8 of |b| of the exact solves:
@@ -250,18 +250,18 @@ void FluidSolver::solve_momentum(int cc, const StencilOperator& op, StepReport& 
       KSPNormType norm;
       BC_PETSC(KSPSetUp(solvers_.momentum));
       BC_PETSC(KSPGetNormType(solvers_.momentum, &norm));
-      solvers_.momentum_floor_jacobi = norm == KSP_NORM_PRECONDITIONED && !momentum_aij_ ? 1 : 0;
+      solvers_.momentum_floor_jacobi = norm == KSP_NORM_PRECONDITIONED && !ops_.momentum_needs_aij ? 1 : 0;
     }
     if (solvers_.momentum_floor_jacobi == 1)
-      BC_PETSC(VecPointwiseMult(sol_, rhs_, inv_diag_[cc]));
+      BC_PETSC(VecPointwiseMult(work_.sol, work_.rhs, work_.inv_diag[cc]));
     else
-      BC_PETSC(VecCopy(rhs_, sol_));
+      BC_PETSC(VecCopy(work_.rhs, work_.sol));
     PetscReal bnorm;
-    BC_PETSC(VecNorm(sol_, NORM_2, &bnorm));
+    BC_PETSC(VecNorm(work_.sol, NORM_2, &bnorm));
     set_abs_tol(solvers_.momentum, 1e-8 * bnorm);
   }
-  BC_PETSC(VecCopy(flow_.U[cc], sol_));
-  BC_PETSC(KSPSolve(solvers_.momentum, rhs_, sol_));
+  BC_PETSC(VecCopy(flow_.U[cc], work_.sol));
+  BC_PETSC(KSPSolve(solvers_.momentum, work_.rhs, work_.sol));
   KSPConvergedReason reason;
   BC_PETSC(KSPGetConvergedReason(solvers_.momentum, &reason));
   if (reason < 0)
@@ -278,13 +278,13 @@ double FluidSolver::max_abs_velocity_all() const {
 }
 
 StepReport FluidSolver::step(double dt) {
-  if (deposition_open_) throw std::logic_error("step() inside begin/end_deposition");
+  if (coupling_.open) throw std::logic_error("step() inside begin/end_deposition");
   if (!(dt > 0.0)) throw std::invalid_argument("step: dt must be > 0");
   StepReport rep;
   rep.dt_s = dt;
   double c[3];
   bdf_weights(dt, flow_.steps > 0 ? flow_.dt_prev_s : 0.0, c);
-  for (int l = 0; l < 3; ++l) halo_->fill(flow_.alpha[l], alphal_[l]);
+  for (int l = 0; l < 3; ++l) layout_.halo->fill(flow_.alpha[l], ghosts_.alpha[l]);
   compute_subgrid_viscosity();  // also refreshes nu_t's ghosts
   compute_effective_viscosity();
   update_flow_ghosts();
@@ -295,9 +295,8 @@ StepReport FluidSolver::step(double dt) {
   }
   rep.mean_pressure_gradient_pa_m = flow_.G_pa_m;
   // continuity defect of the accepted fields (for diagnostics and tests)
-  last_c_[0] = c[0], last_c_[1] = c[1], last_c_[2] = c[2];
   counters_.last_dt_s = dt;
-  counters_.last_defect = continuity_residual(dt, c[0], c[1], c[2], R_);
+  counters_.last_defect = continuity_residual(dt, c[0], c[1], c[2], work_.R);
   // rotate time levels
   for (int cc = 0; cc < 3; ++cc) {
     BC_PETSC(VecCopy(flow_.Un[cc], flow_.Unm1[cc]));
@@ -305,7 +304,7 @@ StepReport FluidSolver::step(double dt) {
   }
   BC_PETSC(VecCopy(flow_.alpha[1], flow_.alpha[2]));
   BC_PETSC(VecCopy(flow_.alpha[0], flow_.alpha[1]));
-  for (int l = 1; l < 3; ++l) halo_->fill(flow_.alpha[l], alphal_[l]);
+  for (int l = 1; l < 3; ++l) layout_.halo->fill(flow_.alpha[l], ghosts_.alpha[l]);
   flow_.time_s += dt;
   flow_.dt_prev_s = dt;
   ++flow_.steps;

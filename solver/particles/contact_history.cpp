@@ -18,30 +18,31 @@ std::uint64_t pair_key(std::int64_t a, std::int64_t b) {
 
 void DemSystem::collect_histories() {
   // Only the last evaluation's contacts (or the last restore's) hold a spring: O(contacts).
-  if (nl_.offsets.size() != s_.size() + 1) {
-    carry_.clear();
+  if (verlet_.list.offsets.size() != s_.size() + 1) {
+    carry_.springs.clear();
     return;
   }
-  pair_hist_.collect(s_.id.data(), pair_i_.data(), nl_.neighbors.data(), carry_);
+  pairs_.springs.collect(s_.id.data(), verlet_.row_of_slot.data(), verlet_.list.neighbors.data(),
+                         carry_.springs);
 }
 
 void DemSystem::restore_histories(const std::vector<std::int64_t>& ida, const std::vector<std::int64_t>& idb,
                                   const std::vector<double>& h) {
-  const std::size_t np = nl_.pair_count();
+  const std::size_t np = verlet_.list.pair_count();
   // A new list: the pairs with a history (restored below, in slot order) stand for the last
   // evaluation's contacts, and the flat row index of each slot is refreshed.
-  pair_hist_.clear();
-  pair_i_.resize(np);
+  pairs_.springs.clear();
+  verlet_.row_of_slot.resize(np);
   for (std::size_t i = 0; i < s_.size(); ++i)
-    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p)
-      pair_i_[p] = static_cast<std::uint32_t>(i);
+    for (std::uint32_t p = verlet_.list.offsets[i]; p < verlet_.list.offsets[i + 1]; ++p)
+      verlet_.row_of_slot[p] = static_cast<std::uint32_t>(i);
   if (ida.empty()) return;
   if (!restore_histories_by_row(ida, idb, h)) restore_histories_by_key(ida, idb, h);
 }
 
 void DemSystem::restore_history(std::uint32_t p, std::size_t i, std::uint32_t j, const double* hq) {
   // The carried history is seen from the lower id; the list slot sees it from its row i.
-  pair_hist_.add(p, s_.id[i] < s_.id[j] ? 1.0 : -1.0, hq);
+  pairs_.springs.add(p, s_.id[i] < s_.id[j] ? 1.0 : -1.0, hq);
 }
 
 bool DemSystem::restore_histories_by_row(const std::vector<std::int64_t>& ida,
@@ -57,45 +58,45 @@ bool DemSystem::restore_histories_by_row(const std::vector<std::int64_t>& ida,
   for (std::int64_t v : s_.id) max_id = std::max(max_id, v);
   if (max_id < 0 || static_cast<std::uint64_t>(max_id) > 8 * static_cast<std::uint64_t>(n) + 1024)
     return false;
-  slot_of_id_.assign(static_cast<std::size_t>(max_id) + 1, kNone);
+  carry_.slot_of_id.assign(static_cast<std::size_t>(max_id) + 1, kNone);
   for (std::size_t k = 0; k < n; ++k) {
-    std::uint32_t& slot = slot_of_id_[static_cast<std::size_t>(s_.id[k])];
+    std::uint32_t& slot = carry_.slot_of_id[static_cast<std::size_t>(s_.id[k])];
     if (slot != kNone) return false;
     slot = static_cast<std::uint32_t>(k);
   }
   auto slot_of = [&](std::int64_t id) {
-    return id < 0 || id > max_id ? kNone : slot_of_id_[static_cast<std::size_t>(id)];
+    return id < 0 || id > max_id ? kNone : carry_.slot_of_id[static_cast<std::size_t>(id)];
   };
-  row_start_.assign(n + 1, 0);
+  carry_.row_start.assign(n + 1, 0);
   for (std::size_t q = 0; q < ida.size(); ++q) {
     const std::uint32_t a = slot_of(ida[q]), b = slot_of(idb[q]);
-    if (a != kNone && b != kNone) ++row_start_[std::min(a, b) + 1];
+    if (a != kNone && b != kNone) ++carry_.row_start[std::min(a, b) + 1];
   }
-  for (std::size_t i = 0; i < n; ++i) row_start_[i + 1] += row_start_[i];
-  row_partner_.resize(row_start_[n]);
-  row_entry_.resize(row_start_[n]);
+  for (std::size_t i = 0; i < n; ++i) carry_.row_start[i + 1] += carry_.row_start[i];
+  carry_.row_partner.resize(carry_.row_start[n]);
+  carry_.row_entry.resize(carry_.row_start[n]);
   {
-    std::vector<std::uint32_t>& fill = row_fill_;
-    fill.assign(row_start_.begin(), row_start_.end() - 1);
+    std::vector<std::uint32_t>& fill = carry_.row_fill;
+    fill.assign(carry_.row_start.begin(), carry_.row_start.end() - 1);
     for (std::size_t q = 0; q < ida.size(); ++q) {
       const std::uint32_t a = slot_of(ida[q]), b = slot_of(idb[q]);
       if (a == kNone || b == kNone) continue;
       const std::uint32_t at = fill[std::min(a, b)]++;
-      row_partner_[at] = std::max(a, b);
-      row_entry_[at] = static_cast<std::uint32_t>(q);
+      carry_.row_partner[at] = std::max(a, b);
+      carry_.row_entry[at] = static_cast<std::uint32_t>(q);
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t e0 = row_start_[i], e1 = row_start_[i + 1];
+    const std::uint32_t e0 = carry_.row_start[i], e1 = carry_.row_start[i + 1];
     if (e0 == e1) continue;
-    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
-      const std::uint32_t j = nl_.neighbors[p];
+    for (std::uint32_t p = verlet_.list.offsets[i]; p < verlet_.list.offsets[i + 1]; ++p) {
+      const std::uint32_t j = verlet_.list.neighbors[p];
       // The first carried entry of this pair, as the search by key takes it.
       std::uint32_t e = e0;
-      while (e < e1 && row_partner_[e] != j) ++e;
+      while (e < e1 && carry_.row_partner[e] != j) ++e;
       // Only pairs that overlap now keep a history (it is reset whenever a pair separates).
       if (e == e1 || pair_overlap(i, j) <= 0.0) continue;
-      restore_history(p, i, j, &h[3 * static_cast<std::size_t>(row_entry_[e])]);
+      restore_history(p, i, j, &h[3 * static_cast<std::size_t>(carry_.row_entry[e])]);
     }
   }
   return true;
@@ -110,8 +111,8 @@ void DemSystem::restore_histories_by_key(const std::vector<std::int64_t>& ida,
     table[q] = {pair_key(ida[q], idb[q]), static_cast<std::uint32_t>(q)};
   std::sort(table.begin(), table.end());
   for (std::size_t i = 0; i < s_.size(); ++i)
-    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
-      const std::uint32_t j = nl_.neighbors[p];
+    for (std::uint32_t p = verlet_.list.offsets[i]; p < verlet_.list.offsets[i + 1]; ++p) {
+      const std::uint32_t j = verlet_.list.neighbors[p];
       if (pair_overlap(i, j) <= 0.0) continue;
       const std::int64_t a = s_.id[i], b = s_.id[j];
       const std::uint64_t key = pair_key(std::min(a, b), std::max(a, b));
@@ -119,16 +120,6 @@ void DemSystem::restore_histories_by_key(const std::vector<std::int64_t>& ida,
       if (it == table.end() || it->first != key) continue;
       restore_history(p, i, j, &h[3 * static_cast<std::size_t>(it->second)]);
     }
-}
-
-void DemSystem::rescan_wall_contacts() {
-  // After a reordering the remembered wall contacts are stale: every particle with a wall
-  // history is one (the history is zero for all others).
-  prev_wall_contacts_.assign(cfg_.walls.size(), {});
-  for (std::size_t w = 0; w < cfg_.walls.size(); ++w)
-    for (std::size_t i = 0; i < whx_[w].size(); ++i)
-      if (whx_[w][i] != 0.0 || why_[w][i] != 0.0 || whz_[w][i] != 0.0)
-        prev_wall_contacts_[w].push_back(static_cast<std::uint32_t>(i));
 }
 
 }  // namespace boycott::particles

@@ -40,8 +40,8 @@ DemState DemSystem::export_state() const {
   if (!dd_.parallel()) return export_local();
   const DemState loc = export_local();
   DemState st;
-  st.steps = steps_;
-  st.time_s = time_;
+  st.steps = counters_.steps;
+  st.time_s = counters_.time_s;
   st.n_ranks = dd_.size;
   const MPI_Comm comm = dd_.comm;
   st.store.id = gather_to_root(comm, loc.store.id);
@@ -75,16 +75,16 @@ DemState DemSystem::export_local() const {
   DemState st;
   st.store = s_;
   st.store.resize(s_.n_local);
-  st.ref_x.assign(ref_x_.begin(), ref_x_.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
-  st.ref_y.assign(ref_y_.begin(), ref_y_.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
-  st.ref_z.assign(ref_z_.begin(), ref_z_.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
+  st.ref_x.assign(verlet_.ref_x.begin(), verlet_.ref_x.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
+  st.ref_y.assign(verlet_.ref_y.begin(), verlet_.ref_y.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
+  st.ref_z.assign(verlet_.ref_z.begin(), verlet_.ref_z.begin() + static_cast<std::ptrdiff_t>(s_.n_local));
   // The local rows' pairs with a history, in list order (the histories are kept in it).
-  for (std::size_t q = 0; q < pair_hist_.slots().size(); ++q) {
-    const std::uint32_t p = pair_hist_.slots()[q];
-    if (pair_i_[p] >= s_.n_local) break;
-    const double* hq = pair_hist_.of_contact(q);
+  for (std::size_t q = 0; q < pairs_.springs.slots().size(); ++q) {
+    const std::uint32_t p = pairs_.springs.slots()[q];
+    if (verlet_.row_of_slot[p] >= s_.n_local) break;
+    const double* hq = pairs_.springs.of_contact(q);
     if (hq[0] == 0.0 && hq[1] == 0.0 && hq[2] == 0.0) continue;
-    const std::int64_t a = s_.id[pair_i_[p]], b = s_.id[nl_.neighbors[p]];
+    const std::int64_t a = s_.id[verlet_.row_of_slot[p]], b = s_.id[verlet_.list.neighbors[p]];
     const double sg = a < b ? 1.0 : -1.0;
     st.pair_id_a.push_back(std::min(a, b));
     st.pair_id_b.push_back(std::max(a, b));
@@ -94,9 +94,9 @@ DemState DemSystem::export_local() const {
   }
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w)
     for (std::size_t i = 0; i < s_.n_local; ++i)
-      st.wall_h.insert(st.wall_h.end(), {whx_[w][i], why_[w][i], whz_[w][i]});
-  st.steps = steps_;
-  st.time_s = time_;
+      st.wall_h.insert(st.wall_h.end(), {walls_.hx[w][i], walls_.hy[w][i], walls_.hz[w][i]});
+  st.steps = counters_.steps;
+  st.time_s = counters_.time_s;
   return st;
 }
 
@@ -108,13 +108,13 @@ void DemSystem::import_state(const DemState& st) {
   s_ = st.store;
   const std::size_t n = s_.size();
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
-    whx_[w].resize(n);
-    why_[w].resize(n);
-    whz_[w].resize(n);
+    walls_.hx[w].resize(n);
+    walls_.hy[w].resize(n);
+    walls_.hz[w].resize(n);
     for (std::size_t i = 0; i < n; ++i) {
-      whx_[w][i] = st.wall_h[3 * (w * n + i)];
-      why_[w][i] = st.wall_h[3 * (w * n + i) + 1];
-      whz_[w][i] = st.wall_h[3 * (w * n + i) + 2];
+      walls_.hx[w][i] = st.wall_h[3 * (w * n + i)];
+      walls_.hy[w][i] = st.wall_h[3 * (w * n + i) + 1];
+      walls_.hz[w][i] = st.wall_h[3 * (w * n + i) + 2];
     }
   }
   set_cutoff_and_uniform_properties();
@@ -124,10 +124,10 @@ void DemSystem::import_state(const DemState& st) {
   at_ref.x = st.ref_x;
   at_ref.y = st.ref_y;
   at_ref.z = st.ref_z;
-  nl_.build(at_ref, cfg_.box, cutoff_m_);
-  ref_x_ = st.ref_x;
-  ref_y_ = st.ref_y;
-  ref_z_ = st.ref_z;
+  verlet_.list.build(at_ref, cfg_.box, verlet_.cutoff_m);
+  verlet_.ref_x = st.ref_x;
+  verlet_.ref_y = st.ref_y;
+  verlet_.ref_z = st.ref_z;
   std::vector<double> h(3 * st.pair_id_a.size());
   for (std::size_t q = 0; q < st.pair_id_a.size(); ++q) {
     h[3 * q] = st.pair_hx[q];
@@ -135,9 +135,9 @@ void DemSystem::import_state(const DemState& st) {
     h[3 * q + 2] = st.pair_hz[q];
   }
   restore_histories(st.pair_id_a, st.pair_id_b, h);
-  rescan_wall_contacts();
-  steps_ = st.steps;
-  time_ = st.time_s;
+  walls_.rescan();
+  counters_.steps = st.steps;
+  counters_.time_s = st.time_s;
   initialized_ = true;
 }
 
@@ -155,52 +155,53 @@ void DemSystem::import_parallel(const DemState& st) {
   s_.resize(mine.size());
   const std::size_t n = mine.size();
   for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
-    whx_[w].resize(n);
-    why_[w].resize(n);
-    whz_[w].resize(n);
+    walls_.hx[w].resize(n);
+    walls_.hy[w].resize(n);
+    walls_.hz[w].resize(n);
     for (std::size_t k = 0; k < n; ++k) {
       const std::size_t q = 3 * (w * total + mine[k]);
-      whx_[w][k] = st.wall_h[q];
-      why_[w][k] = st.wall_h[q + 1];
-      whz_[w][k] = st.wall_h[q + 2];
+      walls_.hx[w][k] = st.wall_h[q];
+      walls_.hy[w][k] = st.wall_h[q + 1];
+      walls_.hz[w][k] = st.wall_h[q + 2];
     }
   }
   for (auto& a : pred_) a.assign(n, 0.0);  // set by the next step's first kick
   set_cutoff_and_uniform_properties();
-  carry_.a = st.pair_id_a;
-  carry_.b = st.pair_id_b;
-  carry_.h.resize(3 * st.pair_id_a.size());
+  carry_.springs.a = st.pair_id_a;
+  carry_.springs.b = st.pair_id_b;
+  carry_.springs.h.resize(3 * st.pair_id_a.size());
   for (std::size_t q = 0; q < st.pair_id_a.size(); ++q) {
-    carry_.h[3 * q] = st.pair_hx[q];
-    carry_.h[3 * q + 1] = st.pair_hy[q];
-    carry_.h[3 * q + 2] = st.pair_hz[q];
+    carry_.springs.h[3 * q] = st.pair_hx[q];
+    carry_.springs.h[3 * q + 1] = st.pair_hy[q];
+    carry_.springs.h[3 * q + 2] = st.pair_hz[q];
   }
   if (same_layout) {
     // As the uninterrupted run left it: ghosts and list of its last rebuild, at the reference
     // positions, so that the next rebuild comes at the same step. The ghosts' current positions
     // and velocities arrive with the next step's refresh.
-    ref_x_.resize(n), ref_y_.resize(n), ref_z_.resize(n);
+    verlet_.ref_x.resize(n), verlet_.ref_y.resize(n), verlet_.ref_z.resize(n);
     for (std::size_t k = 0; k < n; ++k)
-      ref_x_[k] = st.ref_x[mine[k]], ref_y_[k] = st.ref_y[mine[k]], ref_z_[k] = st.ref_z[mine[k]];
+      verlet_.ref_x[k] = st.ref_x[mine[k]], verlet_.ref_y[k] = st.ref_y[mine[k]],
+      verlet_.ref_z[k] = st.ref_z[mine[k]];
     std::vector<double> now[3] = {s_.x, s_.y, s_.z};
-    s_.x = ref_x_, s_.y = ref_y_, s_.z = ref_z_;
+    s_.x = verlet_.ref_x, s_.y = verlet_.ref_y, s_.z = verlet_.ref_z;
     exchange_ghosts();
-    nl_.build(s_, cfg_.box, cutoff_m_, s_.n_local);
+    verlet_.list.build(s_, cfg_.box, verlet_.cutoff_m, s_.n_local);
     // The histories belong to the pairs that overlap now (the current positions, the ghosts'
     // included).
     std::copy(now[0].begin(), now[0].end(), s_.x.begin());
     std::copy(now[1].begin(), now[1].end(), s_.y.begin());
     std::copy(now[2].begin(), now[2].end(), s_.z.begin());
     forward_ghosts();
-    restore_histories(carry_.a, carry_.b, carry_.h);
-    rescan_wall_contacts();
+    restore_histories(carry_.springs.a, carry_.springs.b, carry_.springs.h);
+    walls_.rescan();
   } else {
     // Another number of ranks: a fresh rebuild at the current positions (the run continues, not
     // bit for bit).
     rebuild_parallel(false);
   }
-  steps_ = st.steps;
-  time_ = st.time_s;
+  counters_.steps = st.steps;
+  counters_.time_s = st.time_s;
   initialized_ = true;
 }
 

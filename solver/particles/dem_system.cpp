@@ -1,6 +1,6 @@
-// The DEM engine's set-up and neighbour-list upkeep: configuration from a case, start-up,
-// when and how the list is rebuilt (wrapping, spatial reordering, histories carried over),
-// and the energies. The step itself is in integrator.cpp, the forces in contact_forces.cpp.
+// The DEM engine's set-up and neighbour-list upkeep: start-up, when and how the list is rebuilt
+// (wrapping, spatial reordering, histories carried over), and the energies. The configuration
+// from a case is in dem_config.cpp, the step in integrator.cpp, the forces in contact_forces.cpp.
 #include "particles/dem_system.hpp"
 
 #include <algorithm>
@@ -10,54 +10,16 @@
 #include <stdexcept>
 #include <vector>
 
-#include <fmt/format.h>
-
 #include "core/constants.hpp"
-#include "core/error.hpp"
 #include "core/timers.hpp"
 #include "particles/displacement_bound.hpp"
 #include "particles/min_image.hpp"
 
 namespace boycott::particles {
 
-bool rolling_model_enabled(const std::string& name) {
-  if (name == "constant_directional") return true;
-  if (name == "none") return false;
-  throw InputError(fmt::format("contact.rolling_model = \"{}\" is not a rolling model of this engine", name));
-}
-
-void check_contact_model(const std::string& name) {
-  if (name != "linear_spring_dashpot")
-    throw InputError(fmt::format("contact.model = \"{}\" is not a contact model of this engine", name));
-}
-
-DemConfig DemConfig::from_case(const CaseParams& p) {
-  DemConfig c;
-  c.box.lo = {0.0, 0.0, 0.0};
-  c.box.len = {p.domain.length_x_m, p.domain.width_y_m, p.domain.height_z_m};
-  c.box.periodic = {true, p.domain.periodic_y, true};
-  if (!p.domain.periodic_y) {
-    c.walls.push_back(PlaneWall{0.0, 0.0, 0.0, 0.0, 1.0, 0.0});
-    c.walls.push_back(PlaneWall{0.0, p.domain.width_y_m, 0.0, 0.0, -1.0, 0.0});
-  }
-  c.gravity_m_s2 = p.gravity_vector();
-  c.dt_s = p.time.dt_dem_s;
-  c.skin_m = p.numerics.neighbor_skin_m;
-  c.slab_excursion_m = 0.5 * c.skin_m;
-  c.contact =
-      LinearSpringDashpot(p.contact.stiffness_n_m, p.contact.restitution, p.contact.tangential_damping_ratio,
-                          p.contact.friction, p.contact.clip_attractive_normal);
-  check_contact_model(p.contact.model);
-  c.rolling_model = p.contact.rolling_model;
-  c.rolling_friction = p.contact.rolling_friction;
-  return c;
-}
-
 DemSystem::DemSystem(const DemConfig& cfg)
     : cfg_(cfg), dd_(SlabDecomposition::serial(cfg.box.lo[2], cfg.box.lo[2] + cfg.box.len[2])) {
-  whx_.resize(cfg_.walls.size());
-  why_.resize(cfg_.walls.size());
-  whz_.resize(cfg_.walls.size());
+  walls_.set_wall_count(cfg_.walls.size());
 }
 
 void DemSystem::initialize() {
@@ -71,8 +33,8 @@ void DemSystem::initialize() {
     // The ghosts carry their owner's velocities at the force time, so those come first.
     set_cutoff_and_uniform_properties();
     predict_velocities();
-    rebuild_parallel(!carry_ready_);
-    carry_ready_ = false;
+    rebuild_parallel(!carry_.ready);
+    carry_.ready = false;
     compute_forces();
     initialized_ = true;
     return;
@@ -106,11 +68,11 @@ void DemSystem::set_cutoff_and_uniform_properties() {
     imin = global_min(dd_.comm, imin);
     imax = global_max(dd_.comm, imax);
   }
-  cutoff_m_ = 2.0 * rmax + cfg_.skin_m;
-  uniform_mass_kg_ = std::isfinite(mmin) && mmin == mmax ? mmin : 0.0;
+  verlet_.cutoff_m = 2.0 * rmax + cfg_.skin_m;
+  uniform_.mass_kg = std::isfinite(mmin) && mmin == mmax ? mmin : 0.0;
   const bool same_r = std::isfinite(rmin) && rmin == rmax && imin == imax;
-  uniform_radius_m_ = same_r ? rmin : 0.0;
-  uniform_inertia_kg_m2_ = same_r ? imin : 0.0;
+  uniform_.radius_m = same_r ? rmin : 0.0;
+  uniform_.inertia_kg_m2 = same_r ? imin : 0.0;
 }
 
 void DemSystem::set_particle_properties(double r, double rho) {
@@ -140,9 +102,9 @@ void DemSystem::force_rebuild() {
 }
 
 DisplacementSpread DemSystem::local_displacement_box() const {
-  if (drift_box_fresh_) return drift_box_;
-  return displacement_box(s_.n_local, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
-                          ref_z_.data());
+  if (fused_.drift_box_fresh) return fused_.drift_box;
+  return displacement_box(s_.n_local, s_.x.data(), s_.y.data(), s_.z.data(), verlet_.ref_x.data(),
+                          verlet_.ref_y.data(), verlet_.ref_z.data());
 }
 
 bool DemSystem::needs_rebuild() const {
@@ -151,15 +113,16 @@ bool DemSystem::needs_rebuild() const {
   const std::size_t n = s_.size();
   if (n == 0) return false;
   // (one rank holds no ghost copies: n is the local count)
-  DisplacementSpread sp = n == s_.n_local ? local_displacement_box()
-                                          : displacement_box(n, s_.x.data(), s_.y.data(), s_.z.data(),
-                                                             ref_x_.data(), ref_y_.data(), ref_z_.data());
+  DisplacementSpread sp =
+      n == s_.n_local ? local_displacement_box()
+                      : displacement_box(n, s_.x.data(), s_.y.data(), s_.z.data(), verlet_.ref_x.data(),
+                                         verlet_.ref_y.data(), verlet_.ref_z.data());
   if (box_within_half_skin(sp, cfg_.skin_m)) return false;
-  sp.sum = displacement_sums(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
-                             ref_z_.data());
+  sp.sum = displacement_sums(n, s_.x.data(), s_.y.data(), s_.z.data(), verlet_.ref_x.data(),
+                             verlet_.ref_y.data(), verlet_.ref_z.data());
   const auto c = displacement_centres(sp, static_cast<double>(n));
-  const auto w = largest_offsets2(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
-                                  ref_z_.data(), c[0], c[1]);
+  const auto w = largest_offsets2(n, s_.x.data(), s_.y.data(), s_.z.data(), verlet_.ref_x.data(),
+                                  verlet_.ref_y.data(), verlet_.ref_z.data(), c[0], c[1]);
   return std::min(w[0], w[1]) > 0.25 * cfg_.skin_m * cfg_.skin_m;
 }
 
@@ -173,7 +136,7 @@ void DemSystem::wrap_periodic() {
 }
 
 void DemSystem::sort_by_cell() {
-  const auto order = nl_.bin_and_order(s_, cfg_.box, cutoff_m_);
+  const auto order = verlet_.list.bin_and_order(s_, cfg_.box, verlet_.cutoff_m);
   s_.permute(order);
   std::vector<double> tmp(order.size());
   for (auto& a : pred_) {
@@ -181,11 +144,7 @@ void DemSystem::sort_by_cell() {
     for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = a[order[k]];
     a.swap(tmp);
   }
-  for (auto* wh : {&whx_, &why_, &whz_})
-    for (auto& a : *wh) {
-      for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = a[order[k]];
-      a.swap(tmp);
-    }
+  walls_.permute(order, tmp);
 }
 
 void DemSystem::rebuild() {
@@ -194,13 +153,15 @@ void DemSystem::rebuild() {
   // Wrap periodic coordinates into the box, then store particles cell by cell.
   wrap_periodic();
   sort_by_cell();
-  nl_.build_binned(s_, cfg_.box, cutoff_m_);
-  restore_histories(carry_.a, carry_.b, carry_.h);
-  rescan_wall_contacts();
-  ref_x_ = s_.x;
-  ref_y_ = s_.y;
-  ref_z_ = s_.z;
-  ++rebuilds_;
+  verlet_.list.build_binned(s_, cfg_.box, verlet_.cutoff_m);
+  finish_rebuild(t0);
+}
+
+void DemSystem::finish_rebuild(std::chrono::steady_clock::time_point t0) {
+  restore_histories(carry_.springs.a, carry_.springs.b, carry_.springs.h);
+  walls_.rescan();
+  verlet_.set_reference(s_);
+  ++counters_.rebuilds;
   seconds_neighbor += seconds_since(t0);
 }
 
@@ -230,9 +191,9 @@ double DemSystem::spring_energy_j() const {
   double e = 0.0;
   std::size_t q = 0;
   for (std::size_t i = 0; i < s_.size(); ++i)
-    for (std::uint32_t p = nl_.offsets[i]; p < nl_.offsets[i + 1]; ++p) {
-      const double ov = pair_overlap(i, nl_.neighbors[p]);
-      const double* h = pair_hist_.of_slot(p, q);
+    for (std::uint32_t p = verlet_.list.offsets[i]; p < verlet_.list.offsets[i + 1]; ++p) {
+      const double ov = pair_overlap(i, verlet_.list.neighbors[p]);
+      const double* h = pairs_.springs.of_slot(p, q);
       if (ov > 0.0)
         e += 0.5 * kn * ov * ov + (h ? 0.5 * kt * (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]) : 0.0);
     }
@@ -242,8 +203,9 @@ double DemSystem::spring_energy_j() const {
       const double ov =
           s_.radius[i] - ((s_.x[i] - W.px) * W.nx + (s_.y[i] - W.py) * W.ny + (s_.z[i] - W.pz) * W.nz);
       if (ov > 0.0)
-        e += 0.5 * kn * ov * ov +
-             0.5 * kt * (whx_[w][i] * whx_[w][i] + why_[w][i] * why_[w][i] + whz_[w][i] * whz_[w][i]);
+        e += 0.5 * kn * ov * ov + 0.5 * kt *
+                                      (walls_.hx[w][i] * walls_.hx[w][i] + walls_.hy[w][i] * walls_.hy[w][i] +
+                                       walls_.hz[w][i] * walls_.hz[w][i]);
     }
   }
   return e;

@@ -2,6 +2,7 @@
 // The DEM engine: particles, walls, neighbour list with Verlet skin, contact histories and the
 // velocity-Verlet integrator with the coupling hook (implicit linear drag, added mass).
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <random>
@@ -9,7 +10,8 @@
 #include <vector>
 
 #include "core/case_params.hpp"
-#include "particles/contact_models.hpp"
+#include "particles/dem_config.hpp"
+#include "particles/dem_parts.hpp"
 #include "particles/displacement_bound.hpp"
 #include "particles/neighbor_list.hpp"
 #include "particles/pair_histories.hpp"
@@ -19,31 +21,6 @@
 #include "stats/running.hpp"
 
 namespace boycott::particles {
-
-struct DemConfig {
-  BoxGeometry box;
-  std::vector<PlaneWall> walls;
-  std::array<double, 3> gravity_m_s2 = {0.0, 0.0, 0.0};
-  double dt_s = 2.0e-5;
-  double skin_m = 0.3e-3;
-  /// Several ranks: how far (m) a particle may move along z past its slab before the next
-  /// rebuild moves it to its new rank. The pairs need no limit (the list's bound covers the
-  /// pairs across slab faces); this one keeps the particles with the rank of their slab, half
-  /// the skin by default (from_case), and a coupled run sets the reach of the fluid window.
-  double slab_excursion_m = 0.15e-3;
-  LinearSpringDashpot contact;
-  std::string rolling_model = "constant_directional";  ///< or "none"
-  double rolling_friction = 0.1;
-  /// Accumulate the applied drag impulse per particle (ParticleStore::drag_j*), for coupling.
-  bool track_drag_impulse = false;
-  /// No fluid (the dem_only scene): the external forces, fluid velocities and added masses are
-  /// all zero, so the kicks need not read them (a DEM step is memory-bound: 21 streams instead
-  /// of 36). Only the implicit drag beta toward rest remains. initialize() checks the zeros.
-  bool dry = false;
-
-  /// Channel of the case: periodic x and z, walls at y = 0 and y = W unless periodic_y.
-  static DemConfig from_case(const CaseParams& p);
-};
 
 /// Everything the next step depends on, for checkpoints: all particles of the run, whatever
 /// the number of ranks that wrote it.
@@ -76,9 +53,9 @@ class DemSystem {
   /// After writing radius, mass or inertia into particles() directly (a packing that grows the
   /// particles step by step): the contact loops stop taking one radius for all particles until
   /// the next initialize() or import_state() finds them equal again.
-  void particle_sizes_changed() { uniform_radius_m_ = 0.0; }
+  void particle_sizes_changed() { uniform_.radius_m = 0.0; }
   /// Whether the contact loops take one radius and moment of inertia for all particles.
-  bool equal_radii() const { return uniform_radius_m_ > 0.0; }
+  bool equal_radii() const { return uniform_.radius_m > 0.0; }
   /// Adds a particle (before `initialize`, or followed by `force_rebuild`).
   void add_particle(std::int64_t gid, double x, double y, double z, double radius_m, double density_kg_m3);
   /// Random non-overlapping insertion of `count` spheres with centres in [lo, hi] (m), at least
@@ -114,12 +91,12 @@ class DemSystem {
   /// Rebuilds the neighbour list now (re-sorts and wraps; forces and histories are kept).
   void force_rebuild();
 
-  double time_s() const { return time_; }
-  std::int64_t steps() const { return steps_; }
-  std::int64_t rebuilds() const { return rebuilds_; }
+  double time_s() const { return counters_.time_s; }
+  std::int64_t steps() const { return counters_.steps; }
+  std::int64_t rebuilds() const { return counters_.rebuilds; }
   /// Pairs in overlap at the last force evaluation (particle-particle and particle-wall).
-  std::int64_t contact_count() const { return contacts_; }
-  const NeighborList& neighbor_list() const { return nl_; }
+  std::int64_t contact_count() const { return counters_.contacts; }
+  const NeighborList& neighbor_list() const { return verlet_.list; }
 
   /// Of all particles on all ranks (collective), J.
   double kinetic_energy_j() const;
@@ -128,7 +105,7 @@ class DemSystem {
   /// Particles on all ranks (collective).
   std::int64_t global_count() const;
   /// Particles that changed rank, on this rank (arrivals), since the start.
-  std::int64_t migrations() const { return migrations_; }
+  std::int64_t migrations() const { return counters_.migrations; }
 
   /// All particles (collective): on several ranks gathered to rank 0 (the other ranks get the
   /// step and time only).
@@ -151,12 +128,22 @@ class DemSystem {
   stats::Histogram* wall_force_y_budget = nullptr;
 
  private:
+  // The force evaluation (contact_forces.cpp): pairs, then walls.
   template <class Rolling>
   void compute_forces_impl(const Rolling& rolling);
+  /// Zeroes the forces and torques that a fused kick has not already zeroed.
+  void zero_unspent_forces();
+  /// The overlapping list pairs into pairs_ (row, slot), their springs carried over; their number.
+  std::size_t find_pair_contacts();
+  template <class Rolling>
+  void add_pair_forces(const Rolling& rolling, std::size_t nc);
+  /// Returns the number of wall contacts.
+  template <class Rolling>
+  std::size_t add_wall_forces(const Rolling& rolling);
   // Several ranks (parallel_dem.cpp): the rebuild moves particles between ranks and renews the
   // ghost copies; between rebuilds the ghosts' positions and velocities are refreshed.
   bool needs_rebuild_parallel();
-  /// collect: take the contact histories from the current list (false: from carry_*, set by
+  /// collect: take the contact histories from the current list (false: from carry_, set by
   /// the caller).
   void rebuild_parallel(bool collect = true);
   void import_parallel(const DemState& st);
@@ -168,8 +155,8 @@ class DemSystem {
   /// Keeps the particles keep[0] < keep[1] < ... (local ones), with their predicted velocities
   /// and wall histories, in that order.
   void select_particles(const std::vector<std::size_t>& keep);
-  /// The list cutoff (2 r_max + skin) and uniform_mass_kg_, uniform_radius_m_,
-  /// uniform_inertia_kg_m2_ from the particles (collective on several ranks).
+  /// The list cutoff (2 r_max + skin) and uniform_ from the particles (collective on several
+  /// ranks).
   void set_cutoff_and_uniform_properties();
   void compute_forces();
   void kick(double h, bool predict);
@@ -185,13 +172,14 @@ class DemSystem {
   /// The displacement box of the local particles: the fused kick's when fresh, else a pass.
   DisplacementSpread local_displacement_box() const;
   void rebuild();
+  /// The end of every rebuild, once the new list stands: the carried springs put back into it,
+  /// the wall contacts rescanned, the reference positions taken; counted and timed from t0.
+  void finish_rebuild(std::chrono::steady_clock::time_point t0);
   /// Periodic coordinates wrapped into the box (before a rebuild bins them).
   void wrap_periodic();
   /// The particles (and their predictions and wall histories) stored cell by cell.
   void sort_by_cell();
   void collect_histories();
-  /// Rebuilds prev_wall_contacts_ from the wall histories (after a reordering or a restart).
-  void rescan_wall_contacts();
   /// r_i + r_j - |x_i - x_j| (minimum image), m; positive when the pair overlaps.
   double pair_overlap(std::size_t i, std::size_t j) const;
   void predict_velocities();
@@ -212,49 +200,15 @@ class DemSystem {
   // Several ranks: for each destination rank, the local particles it holds as ghosts, in the
   // order it stores them.
   std::vector<std::vector<std::uint32_t>> ghost_send_;
-  std::int64_t migrations_ = 0;
-  bool carry_ready_ = false;  ///< carry_* holds the histories for the next parallel rebuild
-  NeighborList nl_;
-  double cutoff_m_ = 0.0;
-  double uniform_mass_kg_ = 0.0;
-  /// The radius (m) every particle has, with one moment of inertia too (the usual monodisperse
-  /// case), else 0: the contact loops then take both as constants instead of gathering them.
-  double uniform_radius_m_ = 0.0, uniform_inertia_kg_m2_ = 0.0;
-  std::vector<double> vz_end_;   ///< v_z (m/s) after a fused pass's closing kick (advance's sums)
   std::vector<double> pred_[6];  ///< v, w (m/s, rad/s) seen by the forces: predicted to the force time
-  std::vector<double> ref_x_, ref_y_, ref_z_;
-  // This evaluation's contacts (particle i and list slot p of each, found by the first pass of
-  // the force loop, in increasing slot order).
-  std::vector<std::uint32_t> contact_i_, contact_p_;
-  // The pairs' tangential springs, per contact: the force loop reads them in order, and nothing
-  // streams the 8 in 9 list pairs that are apart.
-  PairHistories pair_hist_;
-  // Particle i of each list slot (the list's row, flattened; rebuilt with the list) and the
-  // overlap test's result per slot (scratch).
-  std::vector<std::uint32_t> pair_i_;
-  std::vector<std::uint8_t> pair_flag_;
-  // Per contact of the current block of contacts (contact_forces.cpp): force on i (N), torques on
-  // i and on j (N m), 9 arrays of the block size.
-  std::vector<double> contact_out_;
-  // Per wall, per particle: tangential displacement, m.
-  std::vector<std::vector<double>> whx_, why_, whz_;
-  // Particles touching each wall at the last evaluation, and this evaluation's (scratch).
-  std::vector<std::vector<std::uint32_t>> prev_wall_contacts_;
-  std::vector<std::uint32_t> wall_contact_;
-  CarriedHistories carry_;  ///< the springs through the next rebuild (or from a checkpoint)
-  // Scratch of restore_histories_by_row: storage slot of each id, and the carried entries per
-  // list row (partner slot, entry index).
-  std::vector<std::uint32_t> slot_of_id_, row_start_, row_fill_, row_partner_, row_entry_;
-  double time_ = 0.0;
-  std::int64_t steps_ = 0, rebuilds_ = 0, contacts_ = 0;
+  VerletState verlet_;
+  UniformProperties uniform_;
+  PairContacts pairs_;
+  WallContacts walls_;
+  HistoryCarry carry_;
+  FusedPass fused_;
+  DemCounters counters_;
   bool initialized_ = false;
-  /// The local particles' forces and torques are zero (a fused kick spent them); the next
-  /// compute_forces zeroes only the ghost copies'.
-  bool local_forces_zeroed_ = false;
-  /// The displacement box of the local particles as the last fused kick drifted them, for the
-  /// rebuild test that follows it (fresh until that test has read it).
-  DisplacementSpread drift_box_;
-  bool drift_box_fresh_ = false;
 };
 
 }  // namespace boycott::particles

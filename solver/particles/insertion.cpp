@@ -15,13 +15,9 @@ namespace boycott::particles {
 void DemSystem::add_particle(std::int64_t gid, double x, double y, double z, double r, double rho) {
   s_.add(gid, x, y, z, r, rho);
   // one of another size ends the contact loops' equal-radius path (initialize() looks again)
-  if (s_.radius.back() != uniform_radius_m_ || s_.inertia.back() != uniform_inertia_kg_m2_)
+  if (s_.radius.back() != uniform_.radius_m || s_.inertia.back() != uniform_.inertia_kg_m2)
     particle_sizes_changed();
-  for (std::size_t w = 0; w < cfg_.walls.size(); ++w) {
-    whx_[w].push_back(0.0);
-    why_[w].push_back(0.0);
-    whz_[w].push_back(0.0);
-  }
+  walls_.append_particle();
 }
 
 void DemSystem::insert_random(std::int64_t count, double r, double rho, std::array<double, 3> lo,

@@ -209,7 +209,7 @@ void DemSystem::kick_kick_drift(double h, double* vz_sum) {
   auto& g = cfg_.gravity_m_s2;
   const double dt = cfg_.dt_s;
   DisplacementBox box;
-  const double* ref[3] = {ref_x_.data(), ref_y_.data(), ref_z_.data()};
+  const double* ref[3] = {verlet_.ref_x.data(), verlet_.ref_y.data(), verlet_.ref_z.data()};
   auto pass = [&](auto record, double* rz) {
     constexpr bool R = decltype(record)::value;
     if (track)
@@ -222,15 +222,15 @@ void DemSystem::kick_kick_drift(double h, double* vz_sum) {
   if (vz_sum) {
     // v_z at the end of the step exists only inside the pass: it is written out and summed after
     // (a sum inside the loop would keep it from vectorising).
-    vz_end_.resize(n);
-    pass(std::true_type{}, vz_end_.data());
-    *vz_sum = sum_in_order(vz_end_.data(), n);
+    fused_.vz_end.resize(n);
+    pass(std::true_type{}, fused_.vz_end.data());
+    *vz_sum = sum_in_order(fused_.vz_end.data(), n);
   } else {
     pass(std::false_type{}, nullptr);
   }
-  drift_box_ = box.result();
-  drift_box_fresh_ = true;
-  local_forces_zeroed_ = true;
+  fused_.drift_box = box.result();
+  fused_.drift_box_fresh = true;
+  fused_.local_forces_zeroed = true;
   copy_ghost_predictions();
 }
 
@@ -277,8 +277,8 @@ void DemSystem::advance(int count, double* vz_sums) {
       if (vz_sums) vz_sums[k] = sum_in_order(s_.vz.data(), s_.n_local);
       seconds_integrate += seconds_since(t0);
     }
-    time_ += cfg_.dt_s;
-    ++steps_;
+    counters_.time_s += cfg_.dt_s;
+    ++counters_.steps;
   }
 }
 
@@ -296,7 +296,7 @@ int DemSystem::advance_interruptible(int count, int check_every, const std::func
 void DemSystem::advance_to_forces() {
   std::chrono::steady_clock::time_point t0;
   const bool rebuild_now = dd_.parallel() ? needs_rebuild_parallel() : needs_rebuild();
-  drift_box_fresh_ = false;  // read by the test just made; a rebuild moves the references
+  fused_.drift_box_fresh = false;  // read by the test just made; a rebuild moves the references
   if (dd_.parallel()) {
     if (rebuild_now) {
       rebuild_parallel();

@@ -17,6 +17,51 @@ int cell_coord(double p, double lo, double len, int n, bool periodic) {
   int c = static_cast<int>(f * n);
   return std::clamp(c, 0, n - 1);
 }
+
+/// Which cells neighbour a cell, per direction: the offsets (deduplicated where a periodic
+/// direction has fewer than 3 cells) and each coordinate's neighbour at wrap[d][k + 1 + o] (-1
+/// outside a wall), so that no integer division is made per particle and cell.
+struct CellNeighbourhood {
+  std::array<std::vector<int>, 3> offs, wrap;
+};
+
+CellNeighbourhood cell_neighbourhood(const std::array<int, 3>& nc, const BoxGeometry& g) {
+  CellNeighbourhood nh;
+  for (int d = 0; d < 3; ++d) {
+    if (nc[d] == 1)
+      nh.offs[d] = {0};
+    else if (nc[d] == 2)
+      nh.offs[d] = g.periodic[d] ? std::vector<int>{0, 1} : std::vector<int>{-1, 0, 1};
+    else
+      nh.offs[d] = {-1, 0, 1};
+    nh.wrap[d].resize(static_cast<std::size_t>(nc[d]) + 2);
+    for (int k = -1; k <= nc[d]; ++k)
+      nh.wrap[d][static_cast<std::size_t>(k + 1)] =
+          g.periodic[d] ? (k + nc[d]) % nc[d] : (k < 0 || k >= nc[d] ? -1 : k);
+  }
+  return nh;
+}
+
+/// The neighbour cells of cell c in the scan order (z, y, x offsets) into nb; returns their number.
+int neighbour_cells(int c, const std::array<int, 3>& nc, const CellNeighbourhood& nh, int (&nb)[27]) {
+  int n_nb = 0;
+  const int cx = c % nc[0], cy = (c / nc[0]) % nc[1], cz = c / (nc[0] * nc[1]);
+  for (int oz : nh.offs[2]) {
+    const int kz = nh.wrap[2][static_cast<std::size_t>(cz + 1 + oz)];
+    if (kz < 0) continue;
+    for (int oy : nh.offs[1]) {
+      const int ky = nh.wrap[1][static_cast<std::size_t>(cy + 1 + oy)];
+      if (ky < 0) continue;
+      for (int ox : nh.offs[0]) {
+        const int kx = nh.wrap[0][static_cast<std::size_t>(cx + 1 + ox)];
+        if (kx < 0) continue;
+        nb[n_nb++] = kx + nc[0] * (ky + nc[1] * kz);
+      }
+    }
+  }
+  return n_nb;
+}
+
 }  // namespace
 
 void NeighborList::bin(const ParticleStore& s, const BoxGeometry& g, double cutoff) {
@@ -63,36 +108,7 @@ void NeighborList::build(const ParticleStore& s, const BoxGeometry& g, double cu
   build_binned(s, g, cutoff, rows);
 }
 
-void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, double cutoff,
-                                std::size_t rows) {
-  const std::size_t n = s.size();
-  rows = std::min(rows, n);
-  const double cut2 = cutoff * cutoff;
-  // Neighbour cell offsets per direction, deduplicated where a periodic direction has < 3 cells.
-  std::array<std::vector<int>, 3> offs;
-  for (int d = 0; d < 3; ++d) {
-    if (nc_[d] == 1)
-      offs[d] = {0};
-    else if (nc_[d] == 2)
-      offs[d] = g.periodic[d] ? std::vector<int>{0, 1} : std::vector<int>{-1, 0, 1};
-    else
-      offs[d] = {-1, 0, 1};
-  }
-  // Each direction's neighbour coordinate for coordinate k and offset o at wrap[d][k + 1 + o]
-  // (-1 outside a wall): no integer division per particle and cell.
-  std::array<std::vector<int>, 3> wrap;
-  for (int d = 0; d < 3; ++d) {
-    wrap[d].resize(static_cast<std::size_t>(nc_[d]) + 2);
-    for (int k = -1; k <= nc_[d]; ++k)
-      wrap[d][static_cast<std::size_t>(k + 1)] =
-          g.periodic[d] ? (k + nc_[d]) % nc_[d] : (k < 0 || k >= nc_[d] ? -1 : k);
-  }
-  offsets.assign(n + 1, 0);
-  // Pairs are written at `count` and kept by advancing it (no branch on the distance test, which
-  // is taken about half the time in a packed bed); each row first makes room for all its
-  // candidates.
-  std::size_t count = 0;
-  neighbors.resize(std::max<std::size_t>(neighbors.capacity(), 8 * rows + 64));
+bool NeighborList::rows_stored_by_cell(std::size_t rows) {
   // With the rows [0, rows) stored cell by cell (bin_and_order; a restart at the reference
   // positions), each cell's items are its rows, a contiguous increasing index range, then its
   // ghost copies (indices >= rows, appended after the rows; the binning keeps index order within
@@ -105,6 +121,22 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
     rows_in_cell_.assign(cell_start_.size() - 1, 0);
     for (std::size_t i = 0; i < rows; ++i) ++rows_in_cell_[static_cast<std::size_t>(cell_of_[i])];
   }
+  return by_cell;
+}
+
+void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, double cutoff,
+                                std::size_t rows) {
+  const std::size_t n = s.size();
+  rows = std::min(rows, n);
+  const double cut2 = cutoff * cutoff;
+  const CellNeighbourhood nh = cell_neighbourhood(nc_, g);
+  offsets.assign(n + 1, 0);
+  // Pairs are written at `count` and kept by advancing it (no branch on the distance test, which
+  // is taken about half the time in a packed bed); each row first makes room for all its
+  // candidates.
+  std::size_t count = 0;
+  neighbors.resize(std::max<std::size_t>(neighbors.capacity(), 8 * rows + 64));
+  const bool by_cell = rows_stored_by_cell(rows);
   // The geometry as locals: through the BoxGeometry reference (which the list's own stores
   // might alias) the compiler would divide by each length again for every distance test.
   const double P0 = g.period(0), P1 = g.period(1), P2 = g.period(2);
@@ -112,8 +144,7 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
   const double* __restrict X = s.x.data();
   const double* __restrict Y = s.y.data();
   const double* __restrict Z = s.z.data();
-  // The neighbour cells of the current particle's cell, in the scan order (z, y, x offsets);
-  // particles stored by cell share them with their predecessor.
+  // Particles stored by cell share their neighbour cells with their predecessor.
   int cached = -1;
   int nb_cells[27];
   int n_nb = 0;
@@ -121,21 +152,7 @@ void NeighborList::build_binned(const ParticleStore& s, const BoxGeometry& g, do
     const int c = cell_of_[i];
     if (c != cached) {
       cached = c;
-      n_nb = 0;
-      const int cx = c % nc_[0], cy = (c / nc_[0]) % nc_[1], cz = c / (nc_[0] * nc_[1]);
-      for (int oz : offs[2]) {
-        const int kz = wrap[2][static_cast<std::size_t>(cz + 1 + oz)];
-        if (kz < 0) continue;
-        for (int oy : offs[1]) {
-          const int ky = wrap[1][static_cast<std::size_t>(cy + 1 + oy)];
-          if (ky < 0) continue;
-          for (int ox : offs[0]) {
-            const int kx = wrap[0][static_cast<std::size_t>(cx + 1 + ox)];
-            if (kx < 0) continue;
-            nb_cells[n_nb++] = kx + nc_[0] * (ky + nc_[1] * kz);
-          }
-        }
-      }
+      n_nb = neighbour_cells(c, nc_, nh, nb_cells);
     }
     const double xi = X[i], yi = Y[i], zi = Z[i];
     std::size_t candidates = 0;

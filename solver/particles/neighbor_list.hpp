@@ -41,6 +41,8 @@ class NeighborList {
 
  private:
   void bin(const ParticleStore& s, const BoxGeometry& g, double cutoff_m);
+  /// Whether the rows [0, rows) are stored cell by cell; if so, counts them per cell.
+  bool rows_stored_by_cell(std::size_t rows);
   std::array<int, 3> nc_{};
   std::vector<int> cell_of_;
   std::vector<std::uint32_t> cell_start_, cell_items_;

@@ -67,7 +67,7 @@ void DemSystem::decompose(const SlabDecomposition& d) {
   // histories; the next initialize() builds the parallel list.
   if (initialized_) {
     collect_histories();
-    carry_ready_ = true;
+    carry_.ready = true;
     initialized_ = false;
   }
   std::vector<std::size_t> keep;
@@ -80,8 +80,7 @@ void DemSystem::select_particles(const std::vector<std::size_t>& keep) {
   s_.keep_increasing(keep);
   s_.n_local = keep.size();
   for (auto& a : pred_) compact_increasing(a, keep);
-  for (auto* wh : {&whx_, &why_, &whz_})
-    for (auto& a : *wh) compact_increasing(a, keep);
+  walls_.keep_increasing(keep);
 }
 
 bool DemSystem::needs_rebuild_parallel() {
@@ -103,14 +102,14 @@ bool DemSystem::needs_rebuild_parallel() {
   for (int c = 0; c < 3; ++c) all.hi[c] = ext[c], all.lo[c] = -ext[3 + c];
   if (std::max(all.hi[2], -all.lo[2]) > cfg_.slab_excursion_m) return true;
   if (box_within_half_skin(all, cfg_.skin_m)) return false;
-  const auto local = displacement_sums(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
-                                       ref_z_.data());
+  const auto local = displacement_sums(n, s_.x.data(), s_.y.data(), s_.z.data(), verlet_.ref_x.data(),
+                                       verlet_.ref_y.data(), verlet_.ref_z.data());
   const std::vector<double> sums =
       ordered_sum(dd_.comm, std::vector<double>{local[0], local[1], local[2], static_cast<double>(n)});
   for (int c = 0; c < 3; ++c) all.sum[c] = sums[c];
   const auto c = displacement_centres(all, sums[3]);
-  auto w = largest_offsets2(n, s_.x.data(), s_.y.data(), s_.z.data(), ref_x_.data(), ref_y_.data(),
-                            ref_z_.data(), c[0], c[1]);
+  auto w = largest_offsets2(n, s_.x.data(), s_.y.data(), s_.z.data(), verlet_.ref_x.data(),
+                            verlet_.ref_y.data(), verlet_.ref_z.data(), c[0], c[1]);
   MPI_Allreduce(MPI_IN_PLACE, w.data(), 2, MPI_DOUBLE, MPI_MAX, dd_.comm);
   return std::min(w[0], w[1]) > 0.25 * cfg_.skin_m * cfg_.skin_m;
 }
@@ -129,14 +128,8 @@ void DemSystem::rebuild_parallel(bool collect) {
   migrate();
   sort_by_cell();
   exchange_ghosts();
-  nl_.build(s_, cfg_.box, cutoff_m_, s_.n_local);
-  restore_histories(carry_.a, carry_.b, carry_.h);
-  rescan_wall_contacts();
-  ref_x_ = s_.x;
-  ref_y_ = s_.y;
-  ref_z_ = s_.z;
-  ++rebuilds_;
-  seconds_neighbor += seconds_since(t0);
+  verlet_.list.build(s_, cfg_.box, verlet_.cutoff_m, s_.n_local);
+  finish_rebuild(t0);
 }
 
 void DemSystem::migrate() {
@@ -160,7 +153,8 @@ void DemSystem::migrate() {
     b.push_back(static_cast<double>(s_.id[i]));
     s_.for_each_array([&](std::vector<double>& a) { b.push_back(a[i]); });
     for (const auto& a : pred_) b.push_back(a[i]);
-    for (std::size_t w = 0; w < nw; ++w) b.insert(b.end(), {whx_[w][i], why_[w][i], whz_[w][i]});
+    for (std::size_t w = 0; w < nw; ++w)
+      b.insert(b.end(), {walls_.hx[w][i], walls_.hy[w][i], walls_.hz[w][i]});
   }
   // The shear springs of the leaving particles go with them (both partners' new ranks).
   std::sort(leaving.begin(), leaving.end());
@@ -168,13 +162,13 @@ void DemSystem::migrate() {
     auto it = std::lower_bound(leaving.begin(), leaving.end(), std::pair<std::int64_t, int>{id, -1});
     return it != leaving.end() && it->first == id ? it->second : -1;
   };
-  for (std::size_t q = 0; q < carry_.a.size(); ++q) {
-    const int da = dest_of(carry_.a[q]), db = dest_of(carry_.b[q]);
+  for (std::size_t q = 0; q < carry_.springs.a.size(); ++q) {
+    const int da = dest_of(carry_.springs.a[q]), db = dest_of(carry_.springs.b[q]);
     const auto send_to = [&](int r) {
       out_pairs[static_cast<std::size_t>(r)].insert(
           out_pairs[static_cast<std::size_t>(r)].end(),
-          {static_cast<double>(carry_.a[q]), static_cast<double>(carry_.b[q]), carry_.h[3 * q],
-           carry_.h[3 * q + 1], carry_.h[3 * q + 2]});
+          {static_cast<double>(carry_.springs.a[q]), static_cast<double>(carry_.springs.b[q]),
+           carry_.springs.h[3 * q], carry_.springs.h[3 * q + 1], carry_.springs.h[3 * q + 2]});
     };
     if (da >= 0) send_to(da);
     if (db >= 0 && db != da) send_to(db);
@@ -192,17 +186,17 @@ void DemSystem::migrate() {
     s_.for_each_array([&](std::vector<double>& a) { a.push_back(in[k++]); });
     for (auto& a : pred_) a.push_back(in[k++]);
     for (std::size_t w = 0; w < nw; ++w) {
-      whx_[w].push_back(in[k++]);
-      why_[w].push_back(in[k++]);
-      whz_[w].push_back(in[k++]);
+      walls_.hx[w].push_back(in[k++]);
+      walls_.hy[w].push_back(in[k++]);
+      walls_.hz[w].push_back(in[k++]);
     }
-    ++migrations_;
+    ++counters_.migrations;
   }
   s_.n_local = s_.id.size();
   for (std::size_t at = 0; at + 5 <= in_pairs.size(); at += 5) {
-    carry_.a.push_back(static_cast<std::int64_t>(in_pairs[at]));
-    carry_.b.push_back(static_cast<std::int64_t>(in_pairs[at + 1]));
-    carry_.h.insert(carry_.h.end(), {in_pairs[at + 2], in_pairs[at + 3], in_pairs[at + 4]});
+    carry_.springs.a.push_back(static_cast<std::int64_t>(in_pairs[at]));
+    carry_.springs.b.push_back(static_cast<std::int64_t>(in_pairs[at + 1]));
+    carry_.springs.h.insert(carry_.springs.h.end(), {in_pairs[at + 2], in_pairs[at + 3], in_pairs[at + 4]});
   }
 }
 
@@ -216,7 +210,7 @@ void DemSystem::exchange_ghosts() {
     auto& list = ghost_send_[r];
     auto& b = out[r];
     for (std::size_t i = 0; i < n; ++i) {
-      if (!(dd_.distance_to_slab(s_.z[i], static_cast<int>(r)) < cutoff_m_)) continue;
+      if (!(dd_.distance_to_slab(s_.z[i], static_cast<int>(r)) < verlet_.cutoff_m)) continue;
       list.push_back(static_cast<std::uint32_t>(i));
       b.insert(b.end(), {static_cast<double>(s_.id[i]), s_.x[i], s_.y[i], s_.z[i], s_.radius[i], s_.mass[i],
                          s_.inertia[i], pred_[0][i], pred_[1][i], pred_[2][i], pred_[3][i], pred_[4][i],

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -53,6 +55,52 @@ double centreline(const std::vector<double>& w, double W, bool slip) {
   return (1.0 - f) * w[j] + f * w[j + 1];
 }
 
+/// One row of timeseries.csv. mean_velocity() is collective: every rank evaluates the row, rank
+/// 0 writes it.
+std::vector<double> channel_row(fluid::FluidSolver& solver, const CaseParams& p, bool top_slip, double dt,
+                                const fluid::StepReport& rep) {
+  const auto w = solver.profile_y(2);
+  const double wc =
+      p.domain.periodic_y ? solver.mean_velocity(2) : centreline(w, p.domain.width_y_m, top_slip);
+  return {solver.time_s(),
+          dt,
+          solver.mean_velocity(0),
+          solver.mean_velocity(1),
+          solver.mean_velocity(2),
+          wc,
+          rep.mean_pressure_gradient_pa_m,
+          (double)rep.simple_iterations,
+          (double)rep.pressure_krylov_iterations,
+          rep.continuity_residual};
+}
+
+/// The summary keys of the flow at the end, and its largest deviation from the analytic profile
+/// where there is one (relative to the profile's largest speed).
+void report_flow(nlohmann::json& j, fluid::FluidSolver& solver, const CaseParams& p, bool top_slip) {
+  const auto w = solver.profile_y(2);
+  j["mean_velocity_m_s"] = solver.mean_velocity(2);
+  j["mean_velocity_vector_m_s"] = {solver.mean_velocity(0), solver.mean_velocity(1), solver.mean_velocity(2)};
+  j["mean_flux_z_m_s"] = solver.mean_flux_z();
+  j["centerline_velocity_m_s"] = p.domain.periodic_y
+                                     ? nlohmann::json(nullptr)
+                                     : nlohmann::json(centreline(w, p.domain.width_y_m, top_slip));
+  j["mean_pressure_gradient_pa_m"] = solver.mean_pressure_gradient_pa_m();
+  j["cfd_steps"] = solver.steps_done();
+  const auto exact = analytic_profile(p);
+  if (!exact) {
+    j["max_rel_error_vs_analytic"] = nullptr;
+    return;
+  }
+  const int ny = static_cast<int>(w.size());
+  const double h = p.domain.width_y_m / ny;
+  double emax = 0.0, ref = 0.0;
+  for (int jy = 0; jy < ny; ++jy) ref = std::max(ref, std::abs(exact((jy + 0.5) * h)));
+  ref = std::max(ref, std::abs(exact(top_slip ? p.domain.width_y_m : 0.5 * p.domain.width_y_m)));
+  for (int jy = 0; jy < ny; ++jy) emax = std::max(emax, std::abs(w[jy] - exact((jy + 0.5) * h)));
+  j["max_rel_error_vs_analytic"] = ref > 0.0 ? nlohmann::json(emax / ref) : nlohmann::json(nullptr);
+  j["analytic_centerline_velocity_m_s"] = exact(top_slip ? p.domain.width_y_m : 0.5 * p.domain.width_y_m);
+}
+
 }  // namespace
 
 int run_channel_flow(const CaseParams& p, RunContext& ctx) {
@@ -98,20 +146,7 @@ int run_channel_flow(const CaseParams& p, RunContext& ctx) {
     }
     if (!rep.converged) ++unconverged;
     if (solver.time_s() >= next_row - 1e-12 || reached_end(solver.time_s(), end)) {
-      const auto w = solver.profile_y(2);
-      const double wc = p.domain.periodic_y ? solver.mean_velocity(2)
-                                            : centreline(w, p.domain.width_y_m, settings.top_slip);
-      // mean_velocity() is collective: every rank evaluates the row, rank 0 writes it.
-      const std::vector<double> row = {solver.time_s(),
-                                       dt,
-                                       solver.mean_velocity(0),
-                                       solver.mean_velocity(1),
-                                       solver.mean_velocity(2),
-                                       wc,
-                                       rep.mean_pressure_gradient_pa_m,
-                                       (double)rep.simple_iterations,
-                                       (double)rep.pressure_krylov_iterations,
-                                       rep.continuity_residual};
+      const std::vector<double> row = channel_row(solver, p, settings.top_slip, dt, rep);
       if (csv) csv->row(row);
       next_row = solver.time_s() + every;
     }
@@ -124,29 +159,8 @@ int run_channel_flow(const CaseParams& p, RunContext& ctx) {
   base.simulated_time_s = solver.time_s();
   base.wall_time_s = clock.seconds();
   nlohmann::json j = make_summary(p, base, timers);
-  const auto w = solver.profile_y(2);
-  j["mean_velocity_m_s"] = solver.mean_velocity(2);
-  j["mean_velocity_vector_m_s"] = {solver.mean_velocity(0), solver.mean_velocity(1), solver.mean_velocity(2)};
-  j["mean_flux_z_m_s"] = solver.mean_flux_z();
-  j["centerline_velocity_m_s"] = p.domain.periodic_y
-                                     ? nlohmann::json(nullptr)
-                                     : nlohmann::json(centreline(w, p.domain.width_y_m, settings.top_slip));
-  j["mean_pressure_gradient_pa_m"] = solver.mean_pressure_gradient_pa_m();
-  j["cfd_steps"] = solver.steps_done();
+  report_flow(j, solver, p, settings.top_slip);
   j["unconverged_steps"] = unconverged;
-  if (auto exact = analytic_profile(p)) {
-    const int ny = static_cast<int>(w.size());
-    const double h = p.domain.width_y_m / ny;
-    double emax = 0.0, ref = 0.0;
-    for (int jy = 0; jy < ny; ++jy) ref = std::max(ref, std::abs(exact((jy + 0.5) * h)));
-    ref = std::max(ref, std::abs(exact(settings.top_slip ? p.domain.width_y_m : 0.5 * p.domain.width_y_m)));
-    for (int jy = 0; jy < ny; ++jy) emax = std::max(emax, std::abs(w[jy] - exact((jy + 0.5) * h)));
-    j["max_rel_error_vs_analytic"] = ref > 0.0 ? nlohmann::json(emax / ref) : nlohmann::json(nullptr);
-    j["analytic_centerline_velocity_m_s"] =
-        exact(settings.top_slip ? p.domain.width_y_m : 0.5 * p.domain.width_y_m);
-  } else {
-    j["max_rel_error_vs_analytic"] = nullptr;
-  }
   if (io) write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   if (!ctx.quiet && io)
     std::printf(

@@ -144,6 +144,67 @@ void import_coupled(const CoupledCheckpoint& c, coupling::CoupledSystem& run, co
 /// How one candidate checkpoint fared on this rank.
 enum Verdict : int { kUsable = 0, kRefused = 1, kOtherCase = 2 };
 
+/// A branch: the parent's state under this case's parameters (run_case checked what may
+/// differ); the particles take this case's size and density.
+void start_from_parent(coupling::CoupledSystem& run, const std::filesystem::path& parent, bool quiet) {
+  io::CheckpointReader r(parent);
+  import_coupled(read_coupled(r, run.params()), run, parent.string());
+  const auto& pp = run.params().particles;
+  run.dem().set_particle_properties(0.5 * pp.diameter_m, pp.density_kg_m3);
+  if (!quiet && output_rank())
+    std::fprintf(stderr, "branching from %s at t = %g s\n", parent.c_str(), run.time_s());
+}
+
+/// Reads and checks one candidate on this rank: kUsable with `r` and `state` set, or a verdict
+/// and the reason in `why`. Never throws, so that every rank reaches the reduction after it.
+int judge_checkpoint(const std::filesystem::path& ck, const std::string& id, const CaseParams& params,
+                     std::optional<io::CheckpointReader>& r, std::optional<CoupledCheckpoint>& state,
+                     std::string& why) {
+  try {
+    r.emplace(ck);
+    // The identity of the parameters it holds, in this program's scheme (a checkpoint written
+    // before case identity version 2 names its case by the older id).
+    const std::string stored =
+        r->has("case_json") ? case_id_of_json(r->string("case_json")) : r->string("case_id");
+    if (stored != id) {
+      why = fmt::format("{} belongs to case {}, not {}; it is left in place", ck.string(), stored, id);
+      return kOtherCase;
+    }
+    state = read_coupled(*r, params);
+    return kUsable;
+  } catch (const CheckpointError& e) {
+    why = e.what();
+  } catch (const std::exception& e) {
+    // What a damaged file without a hash can make a reader throw (a size beyond memory, say).
+    why = fmt::format("checkpoint {} is unreadable: {}", ck.string(), e.what());
+  }
+  return kRefused;
+}
+
+/// After resuming from candidates[k]: the newer, refused ones set aside (out of the way of this
+/// run's later checkpoints of the same steps, and of pruning), the time series cut to the
+/// checkpoint's time, and what happened said.
+void settle_after_resume(const std::vector<std::filesystem::path>& candidates, std::size_t k,
+                         const io::CheckpointReader& r, const coupling::CoupledSystem& run,
+                         const std::filesystem::path& run_dir, bool quiet) {
+  const auto& ck = candidates[k];
+  if (output_rank()) {
+    for (std::size_t j = 0; j < k; ++j) {
+      const auto kept = io::set_aside(candidates[j]);
+      std::fprintf(stderr, "refused checkpoint kept as %s\n", kept.c_str());
+    }
+    if (r.integrity() == io::Integrity::kUnverified)
+      std::fprintf(stderr,
+                   "note: %s carries no hash (written before checkpoints did): resumed from it "
+                   "unverified\n",
+                   ck.c_str());
+  }
+  truncate_csv_after(run_dir / "timeseries.csv", run.time_s());
+  if (!quiet && output_rank())
+    std::fprintf(stderr, "resuming from %s at t = %g s%s\n", ck.c_str(), run.time_s(),
+                 k > 0 ? " (an older checkpoint: the newer ones were refused)" : "");
+}
+
 }  // namespace
 
 void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run) {
@@ -158,14 +219,7 @@ std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::fi
   const auto candidates = io::checkpoints_newest_first(run_dir);
   if (candidates.empty()) {
     if (branch_checkpoint.empty()) return std::nullopt;
-    // A branch: the parent's state under this case's parameters (run_case checked what may
-    // differ); the particles take this case's size and density.
-    io::CheckpointReader r(branch_checkpoint);
-    import_coupled(read_coupled(r, run.params()), run, branch_checkpoint.string());
-    const auto& pp = run.params().particles;
-    run.dem().set_particle_properties(0.5 * pp.diameter_m, pp.density_kg_m3);
-    if (!quiet && output_rank())
-      std::fprintf(stderr, "branching from %s at t = %g s\n", branch_checkpoint.c_str(), run.time_s());
+    start_from_parent(run, branch_checkpoint, quiet);
     return 0.0;
   }
   const std::string id = case_id(run.params());
@@ -177,28 +231,7 @@ std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::fi
     std::optional<io::CheckpointReader> r;
     std::optional<CoupledCheckpoint> state;
     std::string why;
-    int verdict = kUsable;
-    try {
-      r.emplace(ck);
-      // The identity of the parameters it holds, in this program's scheme (a checkpoint written
-      // before case identity version 2 names its case by the older id).
-      const std::string stored =
-          r->has("case_json") ? case_id_of_json(r->string("case_json")) : r->string("case_id");
-      if (stored != id) {
-        verdict = kOtherCase;
-        why = fmt::format("{} belongs to case {}, not {}; it is left in place", ck.string(), stored, id);
-      } else {
-        state = read_coupled(*r, run.params());
-      }
-    } catch (const CheckpointError& e) {
-      verdict = kRefused;
-      why = e.what();
-    } catch (const std::exception& e) {
-      // What a damaged file without a hash can make a reader throw (a size beyond memory, say):
-      // refused all the same, and every rank still reaches the reduction below.
-      verdict = kRefused;
-      why = fmt::format("checkpoint {} is unreadable: {}", ck.string(), e.what());
-    }
+    const int verdict = judge_checkpoint(ck, id, run.params(), r, state, why);
     int worst = verdict;
     MPI_Allreduce(&verdict, &worst, 1, MPI_INT, MPI_MAX, run.fluid().comm());
     if (worst == kOtherCase)
@@ -211,22 +244,7 @@ std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::fi
     }
     import_coupled(*state, run, ck.string());
     load_scene(*r);
-    if (output_rank()) {
-      // Out of the way of this run's later checkpoints of the same steps, and of pruning.
-      for (std::size_t j = 0; j < k; ++j) {
-        const auto kept = io::set_aside(candidates[j]);
-        std::fprintf(stderr, "refused checkpoint kept as %s\n", kept.c_str());
-      }
-      if (r->integrity() == io::Integrity::kUnverified)
-        std::fprintf(stderr,
-                     "note: %s carries no hash (written before checkpoints did): resumed from it "
-                     "unverified\n",
-                     ck.c_str());
-    }
-    truncate_csv_after(run_dir / "timeseries.csv", run.time_s());
-    if (!quiet && output_rank())
-      std::fprintf(stderr, "resuming from %s at t = %g s%s\n", ck.c_str(), run.time_s(),
-                   k > 0 ? " (an older checkpoint: the newer ones were refused)" : "");
+    settle_after_resume(candidates, k, *r, run, run_dir, quiet);
     return state->wall_time_s;
   }
   std::string all;

@@ -19,12 +19,11 @@
 
 namespace boycott::scenes {
 
-int run_dem_only(const CaseParams& p, RunContext& ctx) {
-  WallClock clock;
-  ModelTimers timers;
-  auto dc = particles::DemConfig::from_case(p);
-  dc.dry = true;  // no fluid arrays in the kicks; Stokes drag is the beta toward rest
-  particles::DemSystem dem(dc);
+namespace {
+
+/// The particles of the case in a dry engine (no fluid arrays in the kicks), with the Stokes drag
+/// against still fluid as the implicit beta toward rest where asked.
+void set_up_particles(particles::DemSystem& dem, const CaseParams& p, ModelTimers& timers) {
   insert_case_particles(dem, p);
   auto& s = dem.particles();
   const bool stokes = p.forces.drag == "stokes";
@@ -33,19 +32,53 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
     for (std::size_t i = 0; i < s.n_local; ++i) s.beta[i] = beta;
   }
   dem.initialize();
-
-  timers.activate("dem_contacts",
-                  fmt::format("{}, k_n = {} N/m, e = {}, mu = {}{}", p.contact.model, p.contact.stiffness_n_m,
-                              p.contact.restitution, p.contact.friction,
-                              p.contact.clip_attractive_normal ? ", normal force clipped" : ""));
-  if (p.contact.rolling_model != "none" && p.contact.rolling_friction > 0.0)
-    timers.activate("rolling_friction", fmt::format("{}, mu_r = {} (timed with dem_contacts)",
-                                                    p.contact.rolling_model, p.contact.rolling_friction));
-  timers.activate("neighbor_search",
-                  fmt::format("linked cells + Verlet skin {} m", p.numerics.neighbor_skin_m));
+  particles::activate_dem_models(timers, p);
   timers.activate("integration", "velocity Verlet");
   if (stokes) timers.activate("stokes_drag", "implicit in the velocity update (timed with integration)");
+}
 
+/// The mean of a particle array over this process's particles (0 without any).
+double mean_over_particles(const particles::ParticleStore& s, const std::vector<double>& a) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < s.n_local; ++i) sum += a[i];
+  return s.n_local > 0 ? sum / static_cast<double>(s.n_local) : 0.0;
+}
+
+/// The summary: the common keys and the engine's record at the end.
+nlohmann::json dem_summary(const CaseParams& p, const particles::DemSystem& dem, SummaryBase& sb,
+                           const stats::BatchMeans& wp_avg, const ModelTimers& timers) {
+  const auto& s = dem.particles();
+  sb.particle_steps = static_cast<double>(s.n_local) * static_cast<double>(dem.steps());
+  sb.mean_settling_velocity_m_s = wp_avg.count() ? wp_avg.mean() : kUnset;
+  sb.settling_velocity_stderr_m_s = wp_avg.stderr_of_mean();
+  auto j = make_summary(p, sb, timers);
+  j["particle_count"] = s.n_local;
+  j["solid_fraction"] = p.solid_fraction();
+  j["dem_steps"] = dem.steps();
+  j["neighbor_rebuilds"] = dem.rebuilds();
+  j["contacts_final"] = dem.contact_count();
+  j["kinetic_energy_final_j"] = dem.kinetic_energy_j();
+  const double dem_seconds = dem.seconds_force + dem.seconds_neighbor + dem.seconds_integrate;
+  j["ns_per_particle_step"] = sb.particle_steps > 0 ? dem_seconds / sb.particle_steps * 1e9 : 0.0;
+  if (p.forces.drag == "stokes") {
+    // Terminal velocity of a lone particle under this drag (no buoyancy: still fluid only drags).
+    const double g_along_z = p.gravity_vector()[2];
+    j["stokes_terminal_velocity_z_m_s"] =
+        p.particle_mass_kg() * g_along_z / (3.0 * kPi * p.fluid.viscosity_pa_s * p.particles.diameter_m);
+  }
+  return j;
+}
+
+}  // namespace
+
+int run_dem_only(const CaseParams& p, RunContext& ctx) {
+  WallClock clock;
+  ModelTimers timers;
+  auto dc = particles::DemConfig::from_case(p);
+  dc.dry = true;
+  particles::DemSystem dem(dc);
+  set_up_particles(dem, p, timers);
+  const auto& s = dem.particles();
   const double dt = p.time.dt_dem_s;
   const auto nsteps = static_cast<std::int64_t>(std::llround(p.time.end_s / dt));
   const double out_every =
@@ -58,18 +91,12 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
                 false);
   stats::BatchMeans wp_avg;
   const double N = static_cast<double>(s.n_local);
-  auto mean_of_sum = [&](double sum) { return N > 0 ? sum / N : 0.0; };
-  auto mean_of = [&](const std::vector<double>& a) {
-    double sum = 0.0;
-    for (std::size_t i = 0; i < s.n_local; ++i) sum += a[i];
-    return mean_of_sum(sum);
-  };
   SummaryBase sb;
   int exit_code = kExitOk;
   // The steps run in chunks that end at each output step and where the average starts, so that
   // DemSystem::advance fuses the kicks between the steps of a chunk; it returns each step's sum
-  // of v_z (the same bits as mean_of(s.vz) after every step). Chunks of at most kChunk steps keep
-  // a stop request answered within a fraction of a second.
+  // of v_z (the same bits as the mean of s.vz after every step). Chunks of at most kChunk steps
+  // keep a stop request answered within a fraction of a second.
   constexpr std::int64_t kChunk = 200;
   std::vector<double> vz_sums;
   for (std::int64_t n = 0; n < nsteps;) {
@@ -79,15 +106,16 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
     vz_sums.resize(static_cast<std::size_t>(stop - n));
     dem.advance(static_cast<int>(stop - n), averaging ? vz_sums.data() : nullptr);
     if (averaging)
-      for (double sum : vz_sums) wp_avg.add(mean_of_sum(sum));
+      for (double sum : vz_sums) wp_avg.add(N > 0 ? sum / N : 0.0);
     n = stop;
     if (n % out_stride == 0 || n == nsteps) {
       const double ke = dem.kinetic_energy_j();
       if (!std::isfinite(ke))
         throw PhysicsError(
             fmt::format("non-finite particle kinetic energy at t = {} s (step {})", dem.time_s(), n));
-      csv.row({dem.time_s(), mean_of(s.vx), mean_of(s.vy), mean_of(s.vz), ke,
-               static_cast<double>(dem.contact_count()), static_cast<double>(dem.rebuilds())});
+      csv.row({dem.time_s(), mean_over_particles(s, s.vx), mean_over_particles(s, s.vy),
+               mean_over_particles(s, s.vz), ke, static_cast<double>(dem.contact_count()),
+               static_cast<double>(dem.rebuilds())});
       if (ctx.progress) ctx.progress(dem.time_s());
     }
     if (ctx.should_stop()) {
@@ -105,27 +133,9 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
   timers.add("dem_contacts", dem.seconds_force);
   timers.add("neighbor_search", dem.seconds_neighbor);
   timers.add("integration", dem.seconds_integrate);
-
   sb.simulated_time_s = dem.time_s();
   sb.wall_time_s = clock.seconds();
-  sb.particle_steps = N * static_cast<double>(dem.steps());
-  sb.mean_settling_velocity_m_s = wp_avg.count() ? wp_avg.mean() : kUnset;
-  sb.settling_velocity_stderr_m_s = wp_avg.stderr_of_mean();
-  auto j = make_summary(p, sb, timers);
-  j["particle_count"] = s.n_local;
-  j["solid_fraction"] = p.solid_fraction();
-  j["dem_steps"] = dem.steps();
-  j["neighbor_rebuilds"] = dem.rebuilds();
-  j["contacts_final"] = dem.contact_count();
-  j["kinetic_energy_final_j"] = dem.kinetic_energy_j();
-  const double dem_seconds = dem.seconds_force + dem.seconds_neighbor + dem.seconds_integrate;
-  j["ns_per_particle_step"] = sb.particle_steps > 0 ? dem_seconds / sb.particle_steps * 1e9 : 0.0;
-  if (stokes) {
-    // Terminal velocity of a lone particle under this drag (no buoyancy: still fluid only drags).
-    const double g_along_z = p.gravity_vector()[2];
-    j["stokes_terminal_velocity_z_m_s"] =
-        p.particle_mass_kg() * g_along_z / (3.0 * kPi * p.fluid.viscosity_pa_s * p.particles.diameter_m);
-  }
+  const auto j = dem_summary(p, dem, sb, wp_avg, timers);
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   return exit_code;
 }

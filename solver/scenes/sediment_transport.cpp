@@ -21,10 +21,13 @@
 // Checkpoints as inclined_settling: every time.checkpoint_every, at the end, and on SIGINT/SIGTERM
 // (exit 75); the same command resumes.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -121,158 +124,162 @@ double wong_parker_q(double tau) {
 double nielsen_q(double tau) {
   return tau > 0.05 ? 12.0 * std::sqrt(tau) * (tau - 0.05) : 0.0;
 }
-}  // namespace
 
-int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
-  // The geometry (theta = 0, walls in y) is checked by the pre-flight report, before any output.
-  WallClock clock;
-  ModelTimers timers;
-  coupling::CoupledOptions opt;
-  opt.zero_slurry_flux = false;
-  opt.target_mean_flux_z_m_s = p.sediment.bulk_velocity_m_s;
-  coupling::CoupledSystem run(p, opt);
-  const auto& s = run.dem().particles();
-  stats::BatchMeans q_avg, g_avg, wf_avg, vp_avg;
-  const double h_y = p.domain.width_y_m / static_cast<double>(p.domain.cells[1]);
-  Profiles profiles(static_cast<std::size_t>(p.domain.cells[1]));
-  double alpha_min_seen = 1.0, ke_max_seen = 0.0, settle_s = 0.0, wall_before = 0.0;
-  double next_out = 0.0;  // the resumed output's, s
-  timers.activate("bed_pouring", "dry DEM until the bed rests");
-  const auto resumed = resume_coupled(
-      run, ctx.out_dir, ctx.quiet,
-      [&](const io::CheckpointReader& r) {
-        for (auto [name, b] : {std::pair{"q", &q_avg}, {"g", &g_avg}, {"wf", &wf_avg}, {"vp", &vp_avg}})
-          io::load(r, fmt::format("stats.{}.", name), *b);
-        alpha_min_seen = r.scalar("stats.alpha_min_seen");
-        ke_max_seen = r.scalar("stats.ke_max_seen");
-        next_out = r.scalar("stats.next_out");
-        settle_s = r.scalar("stats.bed_pouring_time_s");
-        profiles.load(r);
-      },
-      ctx.branch_checkpoint);
-  const double A = p.domain.length_x_m * p.domain.height_z_m, H = p.domain.width_y_m;
-  const double d = p.particles.diameter_m, g = p.gravity.magnitude_m_s2;
-  const double rho_p = p.particles.density_kg_m3, rho_f = p.fluid.density_kg_m3;
-  const double q_scale = std::sqrt((rho_p / rho_f - 1.0) * g * d * d * d);
-  if (resumed) {
-    wall_before = *resumed;
-  } else {
-    insert_case_particles(run.dem(), p);
-    // The paper starts from a bed packed on the bottom: pour it dry (DEM only, still fluid left
-    // out) until it rests, before the flow starts; this time is not part of the simulated time.
-    {
-      ModelTimers::Scope sc(timers, "bed_pouring");
-      settle_s = settle_bed(run.dem(), p);
-    }
-  }
-  // Particle volume is conserved, so the bed height is the same before pouring and on resume.
-  const double h_bed = is_set(p.sediment.bed_height_m) ? p.sediment.bed_height_m
-                                                       : run.particle_volume_m3() / (A * kBedPackedFraction);
-  if (h_bed >= H)
-    throw InputError(
-        fmt::format("bed height {:.4g} m fills the channel: must be < domain.width_y = {} m", h_bed, H));
-  if (!resumed) {
-    run.start();
-    // Start the flow turbulent (see the top of this file), with the bed top as the floor and
-    // Nikuradse's k_s = 2.5 d.
-    if (p.sediment.initial_flow == "turbulent") {
-      fluid::TurbulentStartSettings ts;
-      ts.bulk_velocity_m_s = p.sediment.bulk_velocity_m_s;
-      ts.floor_m = h_bed;
-      ts.roughness_m = 2.5 * d;
-      ts.seed = static_cast<std::uint64_t>(p.seed);
-      fluid::start_turbulent_channel(run.fluid(), ts);
-    }
-  }
-  run.activate_models(timers);
-  timers.activate("flux_controller",
-                  fmt::format("G(t) holds mean alpha_f w = {} m/s", p.sediment.bulk_velocity_m_s));
+/// The bed height the flow sees, m: given, or the particles' volume packed at kBedPackedFraction
+/// over the bottom (particle volume is conserved, so the same before pouring and on resume).
+double bed_height_m(const CaseParams& p, double particle_volume_m3) {
+  const double area = p.domain.length_x_m * p.domain.height_z_m;
+  return is_set(p.sediment.bed_height_m) ? p.sediment.bed_height_m
+                                         : particle_volume_m3 / (area * kBedPackedFraction);
+}
 
-  auto transport_rate = [&] {
+/// A new run: the paper starts from a bed packed on the bottom, poured dry (DEM only, still fluid
+/// left out) until it rests, before the flow starts (this time is not simulated time); then the
+/// flow, turbulent over the bed top with Nikuradse's k_s = 2.5 d unless it starts from rest.
+/// Returns the pouring time, s.
+double pour_bed_and_start_flow(coupling::CoupledSystem& run, const CaseParams& p, ModelTimers& timers) {
+  insert_case_particles(run.dem(), p);
+  double settle_s = 0.0;
+  {
+    ModelTimers::Scope sc(timers, "bed_pouring");
+    settle_s = settle_bed(run.dem(), p);
+  }
+  const double floor_m = bed_height_m(p, run.particle_volume_m3());
+  run.start();
+  if (p.sediment.initial_flow == "turbulent") {
+    fluid::TurbulentStartSettings ts;
+    ts.bulk_velocity_m_s = p.sediment.bulk_velocity_m_s;
+    ts.floor_m = floor_m;
+    ts.roughness_m = 2.5 * p.particles.diameter_m;
+    ts.seed = static_cast<std::uint64_t>(p.seed);
+    fluid::start_turbulent_channel(run.fluid(), ts);
+  }
+  return settle_s;
+}
+
+/// What the scene records over a run and carries across its checkpoints: the transport rate,
+/// driving gradient, flux and transverse particle velocity over the window, the profiles over y,
+/// the stability record and the bed's pouring time.
+class TransportRecord {
+ public:
+  explicit TransportRecord(const CaseParams& p)
+      : p_(p),
+        h_y_(p.domain.width_y_m / static_cast<double>(p.domain.cells[1])),
+        area_(p.domain.length_x_m * p.domain.height_z_m),
+        q_scale_(std::sqrt((p.particles.density_kg_m3 / p.fluid.density_kg_m3 - 1.0) *
+                           p.gravity.magnitude_m_s2 * p.particles.diameter_m * p.particles.diameter_m *
+                           p.particles.diameter_m)),
+        profiles_(static_cast<std::size_t>(p.domain.cells[1])) {}
+
+  void load(const io::CheckpointReader& r) {
+    for (auto [name, b] : averages()) io::load(r, fmt::format("stats.{}.", name), *b);
+    alpha_min_seen_ = r.scalar("stats.alpha_min_seen");
+    ke_max_seen_ = r.scalar("stats.ke_max_seen");
+    next_out_ = r.scalar("stats.next_out");
+    settle_s_ = r.scalar("stats.bed_pouring_time_s");
+    profiles_.load(r);
+  }
+  /// A checkpoint with the record (the profiles' particle sums over ranks first, on every rank).
+  void checkpoint(const coupling::CoupledSystem& run, const std::filesystem::path& dir, double wall_s,
+                  double next_out_s) {
+    const Profiles all_profiles = profiles_.over_ranks(run);
+    checkpoint_coupled(run, dir, wall_s, [&](io::CheckpointWriter& w) {
+      for (auto [name, b] : averages()) io::save(w, fmt::format("stats.{}.", name), *b);
+      w.put("stats.alpha_min_seen", alpha_min_seen_);
+      w.put("stats.ke_max_seen", ke_max_seen_);
+      w.put("stats.next_out", next_out_s);
+      w.put("stats.bed_pouring_time_s", settle_s_);
+      all_profiles.save(w);
+    });
+  }
+  /// Samples one step; returns its time-series row, made when the output asks for it.
+  std::function<std::vector<double>()> measure(coupling::CoupledSystem& run, const coupling::CoupledStep& st);
+  /// profiles.csv, summed over ranks.
+  void write_profiles(const coupling::CoupledSystem& run, const std::filesystem::path& dir) const {
+    profiles_.over_ranks(run).write(dir / "profiles.csv", h_y_, area_);
+  }
+  /// summary.json: the common keys, q* against the Shields stress and the run's record.
+  nlohmann::json summary(const coupling::CoupledSystem& run, SummaryBase& sb, const ModelTimers& timers,
+                         double h_bed, bool resumed) const;
+
+  void set_pouring_time(double s) { settle_s_ = s; }
+  double next_out_s() const { return next_out_; }
+
+ private:
+  std::array<std::pair<const char*, stats::BatchMeans*>, 4> averages() {
+    return {{{"q", &q_avg_}, {"g", &g_avg_}, {"wf", &wf_avg_}, {"vp", &vp_avg_}}};
+  }
+  /// Particle volume flux along z per unit bed area over all ranks, m^2/s.
+  double transport_rate_m2_s(const coupling::CoupledSystem& run) const {
+    const auto& s = run.dem().particles();
     double q = 0.0;
     for (std::size_t i = 0; i < s.n_local; ++i)
       q += (4.0 / 3.0) * kPi * s.radius[i] * s.radius[i] * s.radius[i] * s.vz[i];
-    return run.global_sum(q) / A;  // m^2/s
-  };
+    return run.global_sum(q) / area_;
+  }
 
-  // A stop request is honoured inside a long fluid step too (thousands of particle sub-steps).
-  run.set_interrupt([&ctx] { return ctx.should_stop(); });
-  CoupledSceneOutput out(
-      run, ctx, timers,
-      {"time_s", "q_m2_s", "q_star", "driving_gradient_pa_m", "mean_flux_z_m_s", "mean_up_z_m_s",
-       "mean_vp_m_s", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
-      resumed.has_value(), next_out);
-  auto write_checkpoint = [&] {
-    ModelTimers::Scope sc(timers, "checkpoints");
-    const Profiles all_profiles = profiles.over_ranks(run);
-    checkpoint_coupled(run, ctx.out_dir, wall_before + clock.seconds(), [&](io::CheckpointWriter& w) {
-      for (auto [name, b] : {std::pair{"q", &q_avg}, {"g", &g_avg}, {"wf", &wf_avg}, {"vp", &vp_avg}})
-        io::save(w, fmt::format("stats.{}.", name), *b);
-      w.put("stats.alpha_min_seen", alpha_min_seen);
-      w.put("stats.ke_max_seen", ke_max_seen);
-      w.put("stats.next_out", out.next_out_s());
-      w.put("stats.bed_pouring_time_s", settle_s);
-      all_profiles.save(w);
-    });
-  };
-  SummaryBase sb;
-  const auto measure = [&](const coupling::CoupledStep& st, bool&) {
-    const double t = run.time_s();
-    const double q = transport_rate();
-    const double G = run.fluid().mean_pressure_gradient_pa_m();
-    alpha_min_seen = std::min(alpha_min_seen, run.coupler().totals().min_alpha_f);
-    ke_max_seen = std::max(ke_max_seen, run.dem().kinetic_energy_j());
-    if (t > p.time.average_from.time_s + 1e-12) {
-      q_avg.add(q);
-      g_avg.add(G);
-      wf_avg.add(run.fluid().mean_flux_z());
-      vp_avg.add(run.mean_particle_velocity(1));
-      profiles.add(run.fluid(), s, h_y);
-    }
-    return [&run, t, q, q_scale, G, dt_s = st.dt_s,
-            iterations = st.fluid.simple_iterations]() -> std::vector<double> {
-      return {t,
-              q,
-              q / q_scale,
-              G,
-              run.fluid().mean_flux_z(),
-              run.mean_particle_velocity(2),
-              run.mean_particle_velocity(1),
-              dt_s,
-              static_cast<double>(iterations),
-              run.coupler().totals().min_alpha_f,
-              run.dem().kinetic_energy_j()};
-    };
-  };
-  const int exit_code = run_coupled_steps(
-      run, out, [] {}, measure, write_checkpoint, sb);
-  out.flush();
-  profiles.over_ranks(run).write(ctx.out_dir / "profiles.csv", h_y, A);
-  run.report_timers(timers);
+  const CaseParams& p_;
+  double h_y_, area_;  ///< fluid cell height (m) and bed area (m^2)
+  double q_scale_;     ///< sqrt((s - 1) g d^3), m^2/s: q* = q / q_scale
+  stats::BatchMeans q_avg_, g_avg_, wf_avg_, vp_avg_;
+  Profiles profiles_;
+  double alpha_min_seen_ = 1.0, ke_max_seen_ = 0.0, settle_s_ = 0.0;
+  double next_out_ = 0.0;  ///< the resumed output's next row, s
+};
 
-  sb.simulated_time_s = run.time_s();
-  sb.wall_time_s = wall_before + clock.seconds();
-  const std::int64_t particles = run.dem().global_count();
-  sb.particle_steps = static_cast<double>(particles) * static_cast<double>(run.dem().steps());
-  sb.mean_settling_velocity_m_s = vp_avg.count() ? vp_avg.mean() : kUnset;
-  sb.settling_velocity_stderr_m_s = vp_avg.stderr_of_mean();
-  auto j = make_summary(p, sb, timers);
+std::function<std::vector<double>()> TransportRecord::measure(coupling::CoupledSystem& run,
+                                                              const coupling::CoupledStep& st) {
+  const double t = run.time_s();
+  const double q = transport_rate_m2_s(run);
+  const double G = run.fluid().mean_pressure_gradient_pa_m();
+  alpha_min_seen_ = std::min(alpha_min_seen_, run.coupler().totals().min_alpha_f);
+  ke_max_seen_ = std::max(ke_max_seen_, run.dem().kinetic_energy_j());
+  if (t > p_.time.average_from.time_s + 1e-12) {
+    q_avg_.add(q);
+    g_avg_.add(G);
+    wf_avg_.add(run.fluid().mean_flux_z());
+    vp_avg_.add(run.mean_particle_velocity(1));
+    profiles_.add(run.fluid(), run.dem().particles(), h_y_);
+  }
+  return [&run, t, q, q_scale = q_scale_, G, dt_s = st.dt_s,
+          iterations = st.fluid.simple_iterations]() -> std::vector<double> {
+    return {t,
+            q,
+            q / q_scale,
+            G,
+            run.fluid().mean_flux_z(),
+            run.mean_particle_velocity(2),
+            run.mean_particle_velocity(1),
+            dt_s,
+            static_cast<double>(iterations),
+            run.coupler().totals().min_alpha_f,
+            run.dem().kinetic_energy_j()};
+  };
+}
+
+nlohmann::json TransportRecord::summary(const coupling::CoupledSystem& run, SummaryBase& sb,
+                                        const ModelTimers& timers, double h_bed, bool resumed) const {
+  const double H = p_.domain.width_y_m, d = p_.particles.diameter_m, g = p_.gravity.magnitude_m_s2;
+  const double rho_p = p_.particles.density_kg_m3, rho_f = p_.fluid.density_kg_m3;
+  sb.mean_settling_velocity_m_s = vp_avg_.count() ? vp_avg_.mean() : kUnset;
+  sb.settling_velocity_stderr_m_s = vp_avg_.stderr_of_mean();
+  auto j = make_summary(p_, sb, timers);
   j["ranks"] = run.rank_report();
-  const double q = q_avg.count() ? q_avg.mean() : kUnset;
-  const double Gm = g_avg.count() ? g_avg.mean() : kUnset;
+  const double q = q_avg_.count() ? q_avg_.mean() : kUnset;
+  const double Gm = g_avg_.count() ? g_avg_.mean() : kUnset;
   const double tau_b = -Gm * (H - h_bed);
   const double tau_star = tau_b / ((rho_p - rho_f) * g * d);
-  const double q_star = q / q_scale;
-  j["bulk_velocity_target_m_s"] = p.sediment.bulk_velocity_m_s;
-  j["mean_flux_z_m_s"] = wf_avg.count() ? wf_avg.mean() : kUnset;
+  const double q_star = q / q_scale_;
+  j["bulk_velocity_target_m_s"] = p_.sediment.bulk_velocity_m_s;
+  j["mean_flux_z_m_s"] = wf_avg_.count() ? wf_avg_.mean() : kUnset;
   j["transport_rate_m2_s"] = q;
-  j["transport_rate_stderr_m2_s"] = q_avg.stderr_of_mean();
+  j["transport_rate_stderr_m2_s"] = q_avg_.stderr_of_mean();
   j["q_star"] = q_star;
-  j["q_star_stderr"] = q_avg.stderr_of_mean() / q_scale;
+  j["q_star_stderr"] = q_avg_.stderr_of_mean() / q_scale_;
   j["mean_driving_gradient_pa_m"] = Gm;
   j["bed_height_m"] = h_bed;
-  j["bed_pouring_time_s"] = settle_s;
-  j["resumed_from_checkpoint"] = resumed.has_value();
+  j["bed_pouring_time_s"] = settle_s_;
+  j["resumed_from_checkpoint"] = resumed;
   j["bed_shear_stress_pa"] = tau_b;
   j["shields_stress"] = tau_star;
   const double qwp = wong_parker_q(tau_star), qn = nielsen_q(tau_star);
@@ -281,18 +288,68 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   // Relative distance to each curve (null where the curve gives no transport).
   j["wong_parker_rel_error"] = qwp > 0.0 ? nlohmann::json((q_star - qwp) / qwp) : nlohmann::json(nullptr);
   j["nielsen_rel_error"] = qn > 0.0 ? nlohmann::json((q_star - qn) / qn) : nlohmann::json(nullptr);
-  j["particle_count"] = particles;
-  j["min_fluid_fraction"] = alpha_min_seen;
-  j["max_kinetic_energy_j"] = ke_max_seen;
+  j["particle_count"] = run.dem().global_count();
+  j["min_fluid_fraction"] = alpha_min_seen_;
+  j["max_kinetic_energy_j"] = ke_max_seen_;
   j["cfd_steps"] = run.steps();
   j["dem_steps"] = run.dem().steps();
   j["pressure_solver_fallbacks"] = run.pressure_fallbacks();
   j["unconverged_fluid_steps"] = run.unconverged_fluid_steps();
+  return j;
+}
+
+}  // namespace
+
+int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
+  // The geometry (theta = 0, walls in y, a bed below the top) is checked by the pre-flight.
+  WallClock clock;
+  ModelTimers timers;
+  coupling::CoupledOptions opt;
+  opt.zero_slurry_flux = false;
+  opt.target_mean_flux_z_m_s = p.sediment.bulk_velocity_m_s;
+  coupling::CoupledSystem run(p, opt);
+  TransportRecord record(p);
+  double wall_before = 0.0;
+  timers.activate("bed_pouring", "dry DEM until the bed rests");
+  const auto resumed = resume_coupled(
+      run, ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) { record.load(r); },
+      ctx.branch_checkpoint);
+  if (resumed)
+    wall_before = *resumed;
+  else
+    record.set_pouring_time(pour_bed_and_start_flow(run, p, timers));
+  const double h_bed = bed_height_m(p, run.particle_volume_m3());
+  run.activate_models(timers);
+  timers.activate("flux_controller",
+                  fmt::format("G(t) holds mean alpha_f w = {} m/s", p.sediment.bulk_velocity_m_s));
+  // A stop request is honoured inside a long fluid step too (thousands of particle sub-steps).
+  run.set_interrupt([&ctx] { return ctx.should_stop(); });
+  CoupledSceneOutput out(
+      run, ctx, timers,
+      {"time_s", "q_m2_s", "q_star", "driving_gradient_pa_m", "mean_flux_z_m_s", "mean_up_z_m_s",
+       "mean_vp_m_s", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
+      resumed.has_value(), record.next_out_s());
+  const auto write_checkpoint = [&] {
+    ModelTimers::Scope sc(timers, "checkpoints");
+    record.checkpoint(run, ctx.out_dir, wall_before + clock.seconds(), out.next_out_s());
+  };
+  SummaryBase sb;
+  const int exit_code = run_coupled_steps(
+      run, out, [] {}, [&](const coupling::CoupledStep& st, bool&) { return record.measure(run, st); },
+      write_checkpoint, sb);
+  out.flush();
+  record.write_profiles(run, ctx.out_dir);
+  run.report_timers(timers);
+  sb.simulated_time_s = run.time_s();
+  sb.wall_time_s = wall_before + clock.seconds();
+  sb.particle_steps = static_cast<double>(run.dem().global_count()) * static_cast<double>(run.dem().steps());
+  const auto j = record.summary(run, sb, timers, h_bed, resumed.has_value());
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   if (!ctx.quiet && output_rank())
     std::printf(
         "sediment_transport: t = %.4g s, q* = %.4g, tau* = %.4g (Wong-Parker q* %.4g, Nielsen %.4g)\n",
-        run.time_s(), q_star, tau_star, qwp, qn);
+        run.time_s(), j["q_star"].get<double>(), j["shields_stress"].get<double>(),
+        j["q_star_wong_parker"].get<double>(), j["q_star_nielsen"].get<double>());
   return exit_code;
 }
 
@@ -306,6 +363,10 @@ void sediment_transport_checks(const CaseParams& p, SceneFindings& f) {
   if (p.domain.periodic_y)
     f.errors.push_back(
         "domain.periodic_y = true for sediment_transport: must be false (a bed on the wall y = 0)");
+  const double h_bed = bed_height_m(p, static_cast<double>(p.particles.count) * p.particle_volume_m3());
+  if (h_bed >= p.domain.width_y_m)
+    f.errors.push_back(fmt::format("bed height {:.4g} m fills the channel: must be < domain.width_y = {} m",
+                                   h_bed, p.domain.width_y_m));
   if (p.domain.top_wall != "slip")
     f.warnings.push_back(
         fmt::format("domain.top_wall = \"{}\" for sediment_transport: the paper's top is a slip "

@@ -33,6 +33,42 @@
 
 namespace boycott::scenes {
 
+namespace {
+
+/// The isolated terminal velocity from the case's drag law, m/s (unset without drag: there is
+/// none).
+double terminal_speed_m_s(const CaseParams& p) {
+  return p.forces.drag == "none" ? kUnset : coupling::visit_drag_law(p.forces.drag, [&](const auto& law) {
+    return coupling::terminal_slip_speed(law, 1.0, p.particles.diameter_m, p.particles.density_kg_m3,
+                                         p.fluid.density_kg_m3, p.fluid.viscosity_pa_s,
+                                         p.gravity.magnitude_m_s2);
+  });
+}
+
+/// The summary keys that compare the run with an isolated sphere in an unbounded fluid: the
+/// terminal velocity along g, the initial acceleration from rest, the Stokes response time.
+void report_against_isolated_sphere(nlohmann::json& j, const CaseParams& p, double wt, double acc0) {
+  const double vt = terminal_speed_m_s(p);
+  const auto g = p.gravity_vector();
+  const double gmag = p.gravity.magnitude_m_s2;
+  const double ref_wz = gmag > 0 ? vt * g[2] / gmag : kUnset;  // settles along g in an unbounded fluid
+  const double rp = p.particles.density_kg_m3, rf = p.fluid.density_kg_m3;
+  const double cam = p.forces.added_mass ? 0.5 : 0.0;
+  const double acc_ref = (p.forces.pressure_gradient ? (rp - rf) : rp) * g[2] / (rp + cam * rf);
+  const double d = p.particles.diameter_m, nu = p.fluid.viscosity_pa_s / rf;
+  j["terminal_velocity_m_s"] = wt;
+  j["terminal_velocity_reference_m_s"] = ref_wz;
+  j["rel_error"] = is_set(ref_wz) && ref_wz != 0.0 ? (wt - ref_wz) / ref_wz : kUnset;
+  j["reynolds_number_reference"] = vt * d / nu;
+  j["cell_size_over_diameter"] = p.domain.length_x_m / static_cast<double>(p.domain.cells[0]) / d;
+  j["initial_acceleration_z_m_s2"] = acc0;
+  j["initial_acceleration_reference_z_m_s2"] = acc_ref;
+  j["response_time_s"] = rp * d * d / (18.0 * p.fluid.viscosity_pa_s);
+  j["dt_dem_over_response_time"] = p.time.dt_dem_s / (rp * d * d / (18.0 * p.fluid.viscosity_pa_s));
+}
+
+}  // namespace
+
 int run_single_particle(const CaseParams& p, RunContext& ctx) {
   WallClock clock;
   ModelTimers timers;
@@ -60,21 +96,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   }
   run.activate_models(timers);
   run.set_interrupt([&ctx] { return ctx.should_stop(); });
-
-  // Without drag there is no terminal velocity (the reference is then left unset).
-  const double vt =
-      p.forces.drag == "none" ? kUnset : coupling::visit_drag_law(p.forces.drag, [&](const auto& law) {
-        return coupling::terminal_slip_speed(law, 1.0, p.particles.diameter_m, p.particles.density_kg_m3,
-                                             p.fluid.density_kg_m3, p.fluid.viscosity_pa_s,
-                                             p.gravity.magnitude_m_s2);
-      });
-  const auto g = p.gravity_vector();
-  const double gmag = p.gravity.magnitude_m_s2;
-  const double ref_wz = gmag > 0 ? vt * g[2] / gmag : kUnset;  // settles along g in an unbounded fluid
-  const double rp = p.particles.density_kg_m3, rf = p.fluid.density_kg_m3;
-  const double cam = p.forces.added_mass ? 0.5 : 0.0;
-  const double acc_ref = (p.forces.pressure_gradient ? (rp - rf) : rp) * g[2] / (rp + cam * rf);
-  const double d = p.particles.diameter_m, nu = p.fluid.viscosity_pa_s / rf;
+  const double d = p.particles.diameter_m, nu = p.fluid.viscosity_pa_s / p.fluid.density_kg_m3;
 
   CoupledSceneOutput out(run, ctx, timers,
                          {"time_s", "wp_m_s", "up_m_s", "vp_m_s", "mean_wf_m_s", "slurry_velocity_m_s",
@@ -122,15 +144,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
   sb.settling_velocity_stderr_m_s = wp_avg.stderr_of_mean();
   auto j = make_summary(p, sb, timers);
   j["ranks"] = run.rank_report();
-  j["terminal_velocity_m_s"] = wt;
-  j["terminal_velocity_reference_m_s"] = ref_wz;
-  j["rel_error"] = is_set(ref_wz) && ref_wz != 0.0 ? (wt - ref_wz) / ref_wz : kUnset;
-  j["reynolds_number_reference"] = vt * d / nu;
-  j["cell_size_over_diameter"] = p.domain.length_x_m / static_cast<double>(p.domain.cells[0]) / d;
-  j["initial_acceleration_z_m_s2"] = acc0;
-  j["initial_acceleration_reference_z_m_s2"] = acc_ref;
-  j["response_time_s"] = rp * d * d / (18.0 * p.fluid.viscosity_pa_s);
-  j["dt_dem_over_response_time"] = p.time.dt_dem_s / (rp * d * d / (18.0 * p.fluid.viscosity_pa_s));
+  report_against_isolated_sphere(j, p, wt, acc0);
   j["resumed_from_checkpoint"] = resumed.has_value();
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   return exit_code;
