@@ -15,10 +15,14 @@ MeanError mean_error(const std::vector<double>& x, const AutocorrelationError& e
   m.stderr_of_mean = m.dof = m.covering_error = std::numeric_limits<double>::quiet_NaN();
   const std::size_t n = x.size();
   if (n < 8) return m;
-  // As many batches as the conservative count allows at kCorrelationTimesPerBatch each, two at
-  // least (also where no count could be made: NaN compares false), kMaxBatches at most.
+  // As many batches as the conservative count of correlation spans (never more than of tau_int)
+  // allows at kCorrelationTimesPerBatch each, two at least (also where no count could be made:
+  // NaN compares false), kMaxBatches at most.
+  const double count = std::isnan(e.span_times)          ? e.correlation_times
+                       : std::isnan(e.correlation_times) ? e.span_times
+                                                         : std::min(e.correlation_times, e.span_times);
   std::size_t k = 2;
-  const double batches = std::floor(e.correlation_times / MeanError::kCorrelationTimesPerBatch);
+  const double batches = std::floor(count / MeanError::kCorrelationTimesPerBatch);
   if (batches > 2.0)
     k = static_cast<std::size_t>(
         std::min({batches, static_cast<double>(n / 4), static_cast<double>(MeanError::kMaxBatches)}));
@@ -26,8 +30,7 @@ MeanError mean_error(const std::vector<double>& x, const AutocorrelationError& e
   // neighbours' correlation lives; a tenth of the series at most, and where no count was made.
   const double most = MeanError::kGapFraction * static_cast<double>(n);
   const auto gaps = static_cast<std::size_t>(
-      std::isfinite(e.correlation_times) && e.correlation_times > 0.0
-          ? std::min(most, static_cast<double>(k - 1) * static_cast<double>(n) / e.correlation_times)
+      std::isfinite(count) && count > 0.0 ? std::min(most, static_cast<double>(k - 1) * static_cast<double>(n) / count)
           : most);
   const std::size_t len = (n - gaps) / k;
   // Batch j starts at j (n - len) / (k - 1): the first at 0, the last ending at n, the samples
