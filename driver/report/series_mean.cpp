@@ -44,7 +44,7 @@ SeriesMean column_mean(const std::string& name, const std::vector<double>& x, st
   const std::string warning = stats::window_warning(w, name, m.transient_end);
   if (!warning.empty()) m.warnings.push_back(warning);
   if (cut.estimated && cut.start > static_cast<std::int64_t>(first) &&
-      stats::transient_biases_mean(x, static_cast<std::int64_t>(first), cut.start))
+      stats::transient_biases_mean(x, static_cast<std::int64_t>(first), cut.detected))
     m.warnings.push_back(fmt::format("the start-up transient of {} ends at {:.4g}, after the window's start, and "
                                      "the samples between shift the mean beyond their noise: average from there",
                                      name, m.transient_end));

@@ -81,7 +81,7 @@ double report_transient(nlohmann::json& j, const std::string& what, const stats:
     for (double v : s.before_dt) d += v;
     return d;
   }();
-  if (warn && cut.start > n_before && stats::transient_biases_mean(x, n_before, cut.start))
+  if (warn && cut.start > n_before && stats::transient_biases_mean(x, n_before, cut.detected))
     add_warning(
         j, fmt::format("the start-up transient of {} ends at {:.3g} s, after time.average_from = {:g} s, "
                        "and the samples between shift the mean beyond their noise: average from {:.3g} s "

@@ -5,47 +5,72 @@
 #include <limits>
 
 #include "stats/autocorrelation.hpp"
+#include "stats/distributions.hpp"
 
 namespace boycott::stats {
+
+namespace {
+
+// The mean of x[from, from + len).
+double segment_mean(const std::vector<double>& x, std::int64_t from, std::int64_t len) {
+  double m = 0.0;
+  for (std::int64_t i = from; i < from + len; ++i) m += x[static_cast<std::size_t>(i)];
+  return m / static_cast<double>(len);
+}
+
+// The reference: the last `count` segments of `len` samples (the last one ending at the series'
+// end), their mean, the scatter of their means (the variance of one segment's mean, estimated
+// without a model of the correlation) and the variance of the samples.
+struct Reference {
+  std::int64_t count = 0;
+  double mean = 0.0, segment_var = 0.0, var = 0.0;
+};
+Reference reference(const std::vector<double>& x, std::int64_t len, std::int64_t count) {
+  Reference r{count};
+  const auto n = static_cast<std::int64_t>(x.size());
+  std::vector<double> means(static_cast<std::size_t>(count));
+  for (std::int64_t j = 0; j < count; ++j) {
+    means[static_cast<std::size_t>(j)] = segment_mean(x, n - (j + 1) * len, len);
+    r.mean += means[static_cast<std::size_t>(j)] / static_cast<double>(count);
+  }
+  for (double m : means) r.segment_var += (m - r.mean) * (m - r.mean) / static_cast<double>(count - 1);
+  for (std::int64_t i = n - count * len; i < n; ++i)
+    r.var += (x[static_cast<std::size_t>(i)] - r.mean) * (x[static_cast<std::size_t>(i)] - r.mean) /
+             static_cast<double>(count * len);
+  return r;
+}
+
+}  // namespace
 
 TransientEnd transient_end(const std::vector<double>& x) {
   TransientEnd cut;
   const auto n = static_cast<std::int64_t>(x.size());
   if (n < 16) return cut;
-  const std::vector<double> ref(x.begin() + n / 2, x.end());
-  const auto e = autocorrelation_error(ref);
-  if (!std::isfinite(e.tau_int_upper)) return cut;
-  cut.estimated = true;
-  double var = 0.0;
-  for (double v : ref) var += (v - e.mean) * (v - e.mean);
-  var /= static_cast<double>(ref.size());
-  // The long-run variance of a sample mean, at the upper end of tau_int: a test that errs towards
-  // calling a segment stationary (its cuts then come from the data, not from an estimate that dipped).
-  const double long_run_var = 2.0 * var * e.tau_int_upper;
   const std::int64_t len = std::max<std::int64_t>(1, n / (2 * TransientEnd::kSegments));
-  const std::int64_t segments = std::min<std::int64_t>(TransientEnd::kSegments, n / 2 / len);
-  const double diff_var = long_run_var * (1.0 / static_cast<double>(len) + 1.0 / static_cast<double>(ref.size()));
+  const std::int64_t refs = (n - n / 2) / len;
+  if (refs < 4) return cut;
+  const Reference ref = reference(x, len, refs);
+  if (!(ref.segment_var > 0.0)) return cut;
+  cut.estimated = true;
+  // A segment's mean less the reference's: the segment's variance and the reference's, as if
+  // independent; Student's t at the reference's refs - 1 degrees of freedom.
+  const double q =
+      student_t_quantile(1.0 - TransientEnd::kFalseAlarm / 2.0, static_cast<double>(refs - 1));
+  const double diff_var = ref.segment_var * (1.0 + 1.0 / static_cast<double>(refs));
+  const std::int64_t segments = std::min<std::int64_t>(TransientEnd::kSegments, (n - refs * len) / len);
   std::int64_t end = 0;
   for (std::int64_t j = 0, clean = 0; j < segments && clean < 2; ++j) {
-    double mean = 0.0, spread = 0.0;
-    for (std::int64_t i = j * len; i < (j + 1) * len; ++i) {
-      mean += x[static_cast<std::size_t>(i)];
-      spread += (x[static_cast<std::size_t>(i)] - e.mean) * (x[static_cast<std::size_t>(i)] - e.mean);
-    }
-    mean /= static_cast<double>(len);
-    spread /= static_cast<double>(len);
-    const double d = std::abs(mean - e.mean);
-    const bool differs = (d > 0.0 && d * d > TransientEnd::kMeanZ * TransientEnd::kMeanZ * diff_var) ||
-                         spread > TransientEnd::kSpreadFactor * var;
-    if (differs) {
-      end = j + 1;
-      clean = 0;
-    } else {
-      ++clean;
-    }
+    const double m = segment_mean(x, j * len, len);
+    double spread = 0.0;
+    for (std::int64_t i = j * len; i < (j + 1) * len; ++i)
+      spread += (x[static_cast<std::size_t>(i)] - m) * (x[static_cast<std::size_t>(i)] - m) / static_cast<double>(len);
+    const bool differs = (m - ref.mean) * (m - ref.mean) > q * q * diff_var || spread > TransientEnd::kSpreadFactor * ref.var;
+    clean = differs ? 0 : clean + 1;
+    if (differs) end = j + 1;
   }
   cut.detected = end * len;
-  cut.start = std::min<std::int64_t>(n / 2, std::llround(TransientEnd::kGuard * static_cast<double>(cut.detected)));
+  cut.start =
+      std::min<std::int64_t>(n / 2, std::llround(TransientEnd::kGuard * static_cast<double>(cut.detected)));
   return cut;
 }
 

@@ -6,43 +6,50 @@
 
 namespace boycott::stats {
 
-/// Where a series' start-up transient ends, by a test that a stationary series passes: the first
-/// half is cut into kSegments segments, and each is compared with the second half (the
-/// reference, taken as stationary): its mean, against the reference's mean within kMeanZ standard
-/// errors of their difference (the reference's long-run variance 2 s^2 tau_int at the upper end
-/// of tau_int's one-sigma range, stats/autocorrelation.hpp), and its spread about that mean,
-/// within kSpreadFactor times the reference's variance (a swing that averages out, as stages I and
-/// II of a settling run can, shows in the spread). The transient is detected to end after the last
-/// segment that fails before two that pass; the window is cut kGuard times as far in (at most
-/// half the series), since a decay that a segment can no longer tell from noise still biases a
-/// mean over many segments (a decay exp(-t / tau_d) detected to end at t* leaves
-/// exp(-kGuard t* / tau_d) of itself).
+/// Where a series' start-up transient ends, by a test that a stationary series passes: the
+/// series is cut into segments of n / (2 kSegments) samples; the second half (the reference,
+/// taken as stationary) holds kSegments of them, and the first half's segments are compared with
+/// it in turn: a segment's mean against the reference's mean, within Student's t (at kSegments - 1
+/// degrees of freedom, two-sided kFalseAlarm) times the scatter of the reference's own segment
+/// means, and its spread within kSpreadFactor times the reference's variance (a swing that
+/// averages out, as stages I and II of a settling run can, shows in the spread). The transient
+/// is detected to end after the last segment that fails before two that pass (`detected`); the
+/// window is cut kGuard times as far in (`start`, at most half the series), since a decay that a
+/// segment can no longer tell from noise still biases a mean over many segments (a decay
+/// exp(-t / tau_d) detected to end at t* leaves exp(-kGuard t* / tau_d) of itself).
 ///
-/// Why a test and not an optimum: the earlier rule cut where the effective samples of what
+/// Why the scatter of the reference's segments and not a correlation time: it is the variance of
+/// a segment's mean whatever the correlation inside a segment, an oscillation's part-periods and
+/// a slow part included, where 2 s^2 tau_int / len is not (an oscillation's tau_int can be far
+/// below its envelope's decay time, or have no estimate at all: such series went uncut).
+/// Why a test and not an optimum: the rule before issue 61 cut where the effective samples of what
 /// followed were most (Chodera 2016) or MSER least (White 1997); each chooses the tail whose
 /// batches happen to agree, so its error is small by selection: after such a cut the error
-/// covered 0.56 on stationary AR(1) series of 50 correlation times, and 68 % of them were cut.
-/// A test cuts a stationary series only when a segment fails by chance (a few per cent), and then
-/// mostly a segment or two; the error of what is kept is the ordinary one (docs/validation.md,
-/// "Transients").
+/// covered 0.52-0.64 on stationary series, most of which it cut. A test cuts a stationary series
+/// only when a segment fails by chance (~5 % of series), and then mostly a segment or two; the
+/// error of what is kept is the ordinary one (docs/validation.md, "Transients").
+/// 20 segments and a guard of 3.5: a swing that ends at 1.4 % of the window costs < 10 % of it;
+/// longer segments (10, guard 5) cut more of a weak slow decay under an oscillation, but throw
+/// away a quarter of a window whose transient is a short swing.
 struct TransientEnd {
   std::int64_t start = 0;     ///< first sample of the stationary part: the cut
   std::int64_t detected = 0;  ///< where the segments stop differing from the reference
-  bool estimated = false;     ///< false: no reference estimate (fewer than 16 samples, or none)
-  static constexpr int kSegments = 10;
-  static constexpr double kMeanZ = 2.5;
+  bool estimated = false;     ///< false: no test (fewer than 16 samples, or a constant reference)
+  static constexpr int kSegments = 20;
+  static constexpr double kFalseAlarm = 0.02;
   static constexpr double kSpreadFactor = 4.0;
-  static constexpr double kGuard = 3.0;
+  static constexpr double kGuard = 3.5;
 };
 TransientEnd transient_end(const std::vector<double>& x);
 
-/// Whether the samples between `from` and `start` (the detected end of the transient, from <
-/// start) are a transient that matters rather than noise: their mean differs from the stationary
-/// part's by more than kTransientSignificance standard errors of the difference, the head's
-/// error taken as if it were more of the stationary part (its own would be inflated by a trend).
-/// 2.25 rather than 2 because the cut was chosen where the head looks most unlike the rest: on
-/// stationary AR(1) series it fires for 7 % (2: 11 %), on a transient that biases the mean by one
-/// standard error for 93 % (tests TransientEnd.*).
+/// Whether the samples between `from` and `start` (where the transient is detected to end,
+/// TransientEnd::detected, from < start) are a transient that matters rather than noise: their
+/// mean differs from the rest's by more than kTransientSignificance standard errors of the
+/// difference, the head's error taken as if it were more of the stationary part (its own would be
+/// inflated by a trend). Judged up to `detected`, not the cut: the guard beyond it would dilute
+/// the head with stationary samples. 2.25 rather than 2 because the end was found where the head
+/// looks unlike the rest: on stationary AR(1) series of 200 correlation times it fires for 2 %, on
+/// a transient that biases the mean by one standard error for 95 % (tests TransientEnd.*).
 bool transient_biases_mean(const std::vector<double>& x, std::int64_t from, std::int64_t start);
 inline constexpr double kTransientSignificance = 2.25;
 

@@ -336,12 +336,14 @@ TransientStats transient_stats(const std::function<double(double)>& transient, s
   for (int k = 0; k < series; ++k) {
     auto x = ar.series(n);
     for (std::size_t t = 0; t < n; ++t) x[t] += transient(static_cast<double>(t));
-    const auto cut = transient_end(x).start;
+    const auto found = transient_end(x);
+    const auto cut = found.start;
     double residual = 0.0;
     for (auto t = static_cast<std::size_t>(cut); t < n; ++t) residual += transient(static_cast<double>(t));
     residual /= static_cast<double>(n - cut);
     s.unbiased += residual < 0.5 * std::sqrt(2.0 * kTau / static_cast<double>(n - cut)) ? 1.0 / series : 0.0;
-    s.warned += transient_biases_mean(x, 0, cut) ? 1.0 / series : 0.0;
+    // The warning as the runs judge it: the head up to where the transient was detected to end.
+    s.warned += transient_biases_mean(x, 0, found.detected) ? 1.0 / series : 0.0;
     s.discarded += static_cast<double>(cut) / n / series;
     s.past += static_cast<double>(cut) >= end ? 1.0 / series : 0.0;
   }
