@@ -171,7 +171,7 @@ TEST(FamilyCoverage, AnAutomaticWindowCutsFewStationarySeriesAndItsErrorCovers) 
     const char* family;
     double settled;
   };
-  const Figure figures[] = {{"ar1", NAN}, {"two_scales", NAN}, {"oscillation", NAN}};
+  const Figure figures[] = {{"ar1", 0.6854}, {"two_scales", 0.6566}, {"oscillation", 0.6915}};
   std::uint64_t seed = 63000;
   for (const auto& f : figures) {
     const AutoFigures a = auto_window_figures(f.family, 50.0, 0.0, ++seed);
@@ -185,7 +185,10 @@ TEST(FamilyCoverage, AnAutomaticWindowLeavesLessThanHalfAStandardErrorOfAStrongT
     const char* family;
     double coverage, unbiased;
   };
-  const Figure figures[] = {{"ar1", NAN, NAN}, {"two_scales", NAN, NAN}, {"oscillation", NAN, NAN}};
+  // Settled, not the promise: on the two-scale and oscillating families a weak slow decay under
+  // the fast noise is cut too early (unbiased 0.86 and 0.47, coverage 0.63 and 0.65; issue 61
+  // asks 0.9 and 0.65-0.71; docs/validation.md, "Transients").
+  const Figure figures[] = {{"ar1", 0.6716, 0.9279}, {"two_scales", 0.6326, 0.8605}, {"oscillation", 0.6468, 0.4671}};
   std::uint64_t seed = 64000;
   for (const auto& f : figures) {
     const AutoFigures a = auto_window_figures(f.family, 50.0, 3.0, ++seed);

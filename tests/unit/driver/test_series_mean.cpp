@@ -88,7 +88,8 @@ TEST(SeriesMean, OnTheCommitted75DegreeRowsItAgreesWithTheRunsSummaryWithinTheSa
   // The full-size 75 deg run's rows (every 0.01 s) against its summary (every step, ~0.9 ms):
   // the mean of the rows from 5 s differs from the mean of the steps by the sampling of a
   // series whose correlation time is ~0.3 s, well inside the error; the errors, both from the
-  // window's two halves, agree to the same degree.
+  // window's two halves, agree to the same degree. Measured: -193.51 +- 4.71 mm/s from the 500
+  // rows, -193.89 +- 4.92 from the 5695 steps (0.08 errors apart, errors 4 % apart).
   const std::string dir = BOYCOTT_SOURCE_DIR "/docs/results/";
   const auto summary = nlohmann::json::parse(slurp(dir + "runs/9592e8d74a5a4760.json"));
   const auto t = parse_series_table(slurp(dir + "timeseries/9592e8d74a5a4760.csv"), "75 deg rows");
