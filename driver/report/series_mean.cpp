@@ -19,16 +19,17 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // One column over rows [first, n): the window's error as a run reports it, its transient end
-// found over the whole column. `t0` and `dt` place row k at t0 + k dt (s, or rows).
-SeriesMean column_mean(const std::string& name, const std::vector<double>& x, std::size_t first, double t0,
-                       double dt) {
+// found over the whole column. Row k is at time[k] (s, or the row index); the window ends one mean
+// spacing after its last row, as a run's window ends one step after its last sample.
+SeriesMean column_mean(const std::string& name, const std::vector<double>& x, std::size_t first,
+                       const std::vector<double>& time) {
   SeriesMean m;
   m.name = name;
   m.velocity = name.size() > 4 && name.ends_with("_m_s");
   const std::vector<double> window(x.begin() + static_cast<std::ptrdiff_t>(first), x.end());
   m.samples = window.size();
-  m.average_from = t0 + static_cast<double>(first) * dt;
-  const double now = t0 + static_cast<double>(x.size()) * dt;
+  m.average_from = time[first];
+  const double now = time.back() + (time.back() - time[first]) / static_cast<double>(window.size() - 1);
   const stats::WindowError w = stats::window_error(window, m.average_from, now);
   m.mean = w.e.mean;
   m.error = w.err.covering_error;
@@ -40,7 +41,7 @@ SeriesMean column_mean(const std::string& name, const std::vector<double>& x, st
   m.tau_int_upper = w.correlation_time_upper_s();
   m.correlation_times = w.e.correlation_times;
   const stats::TransientEnd cut = stats::transient_end(x);
-  m.transient_end = cut.estimated ? t0 + static_cast<double>(cut.start) * dt : kNaN;
+  m.transient_end = cut.estimated ? time[static_cast<std::size_t>(cut.start)] : kNaN;
   const std::string warning = stats::window_warning(w, name, m.transient_end);
   if (!warning.empty()) m.warnings.push_back(warning);
   if (cut.estimated && cut.start > static_cast<std::int64_t>(first) &&
@@ -73,16 +74,14 @@ AverageFrom parse_average_from(const std::string& s) {
 std::vector<SeriesMean> series_means(const SeriesTable& t, const std::vector<std::string>& wanted,
                                      const AverageFrom& from) {
   const std::size_t n = t.columns.front().size();
-  // Row k at t0 + k dt: the time column's first value and mean spacing, or the row index.
-  const double t0 = t.time_s ? t.time_s->front() : 0.0;
-  const double dt = t.time_s ? (t.time_s->back() - t.time_s->front()) / static_cast<double>(n - 1) : 1.0;
+  // Row k's time: the time column, or the row index.
+  std::vector<double> time(n);
+  for (std::size_t k = 0; k < n; ++k) time[k] = t.time_s ? (*t.time_s)[k] : static_cast<double>(k);
   std::size_t first = 0;
   if (from.from) {
-    if (t.time_s)
-      first = static_cast<std::size_t>(std::lower_bound(t.time_s->begin(), t.time_s->end(), *from.from - 1e-9 * dt) -
-                                       t.time_s->begin());
-    else
-      first = static_cast<std::size_t>(std::max(0.0, std::ceil(*from.from)));
+    // The first row at or after T (a rounding below T in the file's digits counts as at T).
+    const double slack = 1e-9 * std::max(1.0, std::abs(*from.from));
+    first = static_cast<std::size_t>(std::lower_bound(time.begin(), time.end(), *from.from - slack) - time.begin());
     if (first + 8 > n)
       throw InputError(fmt::format("--average-from {:g} leaves {} rows of {}: the error of a mean needs 8 at least",
                                    *from.from, first < n ? n - first : 0, n));
@@ -103,7 +102,7 @@ std::vector<SeriesMean> series_means(const SeriesTable& t, const std::vector<std
       const stats::TransientEnd cut = stats::transient_end(t.columns[c]);
       start = cut.estimated ? static_cast<std::size_t>(cut.start) : 0;
     }
-    rows.push_back(column_mean(t.names[c], t.columns[c], start, t0, dt));
+    rows.push_back(column_mean(t.names[c], t.columns[c], start, time));
   }
   return rows;
 }

@@ -67,6 +67,9 @@ SeriesTable parse_series_table(const std::string& text, const std::string& path)
       if (v) values.push_back(*v);
     if (values.size() != raw[c].size() || values.empty()) continue;  // not numeric
     if (c == 0 && timed) {
+      for (std::size_t k = 1; k < values.size(); ++k)
+        if (!(values[k] > values[k - 1]))
+          throw InputError(fmt::format("the time in '{}' does not increase at row {}", path, k + 2));
       t.time_s = std::move(values);
     } else {
       t.names.push_back(header[c]);

@@ -2,7 +2,7 @@
 // A CSV of series as `boycott stats mean` reads it: a header of column names, then rows of
 // numbers; the first column is the time (s) when it is named `t` or `time_s`. Whatever a user's
 // file gets wrong is refused with one sentence (InputError): no numeric column, a ragged row, a
-// NaN or infinity, fewer than 8 rows.
+// NaN or infinity, fewer than 8 rows, a time that does not increase.
 #include <optional>
 #include <string>
 #include <vector>

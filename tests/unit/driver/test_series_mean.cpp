@@ -81,6 +81,7 @@ TEST(SeriesMean, BadInputIsRefusedWithOneSentence) {
   EXPECT_TRUE(refused(sample_csv(100) + "1.0,2.0\n", {}, ""));               // a ragged row
   EXPECT_TRUE(refused(sample_csv(100), {}, "0.95"));                         // 5 rows left
   EXPECT_TRUE(refused(sample_csv(100), {}, "soon"));                         // not a time
+  EXPECT_TRUE(refused("t,a\n0,1\n2,1\n1,1\n3,1\n4,1\n5,1\n6,1\n7,1\n", {}, ""));  // time goes back
   EXPECT_FALSE(refused(sample_csv(100), {}, "auto"));
 }
 
@@ -88,7 +89,7 @@ TEST(SeriesMean, OnTheCommitted75DegreeRowsItAgreesWithTheRunsSummaryWithinTheSa
   // The full-size 75 deg run's rows (every 0.01 s) against its summary (every step, ~0.9 ms):
   // the mean of the rows from 5 s differs from the mean of the steps by the sampling of a
   // series whose correlation time is ~0.3 s, well inside the error; the errors, both from the
-  // window's two halves, agree to the same degree. Measured: -193.51 +- 4.71 mm/s from the 500
+  // window's two halves, agree to the same degree. Measured: -193.51 +- 4.71 mm/s from the 481
   // rows, -193.89 +- 4.92 from the 5695 steps (0.08 errors apart, errors 4 % apart).
   const std::string dir = BOYCOTT_SOURCE_DIR "/docs/results/";
   const auto summary = nlohmann::json::parse(slurp(dir + "runs/9592e8d74a5a4760.json"));
