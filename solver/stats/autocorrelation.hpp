@@ -1,5 +1,7 @@
 #pragma once
 // The error of the mean of a correlated series from its integrated autocorrelation time (Sokal).
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -55,6 +57,13 @@ struct AutocorrelationError {
   double span_times = 0.0;         ///< N / span_upper, the conservative count of spans
   /// Whether the error is to be doubted: fewer than kWarnCorrelationTimes, or no closed window.
   bool doubtful() const { return !window_closed || !(correlation_times >= kWarnCorrelationTimes); }
+  /// The count that decides how long batches must be: the smaller of correlation_times and
+  /// span_times, whichever has an estimate (NaN where neither has).
+  double batch_count() const {
+    if (std::isnan(span_times)) return correlation_times;
+    if (std::isnan(correlation_times)) return span_times;
+    return std::min(correlation_times, span_times);
+  }
   static constexpr double kWarnCorrelationTimes = 20.0;
   static constexpr double kMinCorrelationTimes = 5.0;
   static constexpr double kWindowFactor = 6.0;  ///< c

@@ -26,12 +26,12 @@ bool PrecisionTarget::reached(const std::vector<double>& series, double window_f
   if (first_stage_at_ == 0) {
     const AutocorrelationError e = autocorrelation_error(x);
     last_rel_error_ = std::abs(e.covering_error / e.mean);
-    if (e.correlation_times >= kMinCorrelationTimes)
+    if (e.batch_count() >= kMinCorrelationTimes)
       first_stage_at_ = cut + static_cast<std::int64_t>(std::ceil(kFirstStageFactor * static_cast<double>(nx)));
     return false;
   }
   // The first stage: the plan, fixed once.
-  const MeanError m = mean_error(x, autocorrelation_error(x));
+  const MeanError m = mean_error(x, autocorrelation_error(x), kFirstStageMaxBatches);
   double mean = 0.0;
   for (double v : x) mean += v / static_cast<double>(nx);
   plan_.n0 = nx;

@@ -12,28 +12,35 @@ namespace boycott::stats {
 /// the rule adaptive replicas follow (stats/point_error.hpp): the stop is planned once, not judged
 /// at every check.
 /// - The first check at which the window holds kMinCorrelationTimes correlation times (counted
-///   conservatively, AutocorrelationError::correlation_times) fixes the first stage:
-///   kFirstStageFactor times as many samples.
-/// - At the first stage (n0 samples) the window's own error (mean_error: batch means, at most 8)
-///   has standard error se0 at dof0 degrees of freedom; the run is planned to stop at
-///   max(n0, n0 (t_dof0 se0 / (target |mean|))^2) samples, and stops there (TwoStagePlan).
+///   conservatively, AutocorrelationError::batch_count) fixes the first stage: kFirstStageFactor
+///   times as many samples.
+/// - At the first stage (n0 samples) the window's batch means (mean_error, at most
+///   kFirstStageMaxBatches) give a standard error se0 at dof0 degrees of freedom; the run is
+///   planned to stop at max(n0, n0 (t_dof0 se0 / (target |mean|))^2) samples, and stops there
+///   (TwoStagePlan).
 /// - It then reports se0 sqrt(n0 / n) times t at dof0 (two_stage_error), below the target by
 ///   construction. The length depends on se0 alone, so the mean over it scatters as if the
-///   length had been fixed in advance, and t at dof0 covers it.
+///   length had been fixed in advance, and t at dof0 covers it if se0 is unbiased.
+/// Why at most 4 batches at the first stage: the whole plan rests on se0, and batches of a first
+/// stage of ~200 counted correlation times are, with 8 of them, only a few times the slow part's
+/// time on sums of AR(1) processes 3-30 apart (whose tau_int a slow part of small weight hardly
+/// moves): neighbours correlate and se0 comes out low (coverage 0.63 at the stop; 4 batches:
+/// 0.65; docs/validation.md, "Series that are not AR(1)"). The price: t_3 instead of t_7, a run
+/// ~20 % longer where the target decides the stop.
 /// Why not stop when the error first meets the target, confirmed over a while (the earlier rule):
 /// the stop then comes where the estimate dipped; with Sokal's error, which a slow part of the
 /// series biases low, it covered 0.57-0.60 on sums of AR(1) processes; with batch means, whose
 /// few degrees of freedom make them noisy, 0.62 on AR(1). Why the first stage lies well past the
 /// first count of 50: the count is itself an estimate, and the runs that reach it first are those
 /// whose tau_int was estimated low; four times as far, three quarters of the first stage's data
-/// were not yet seen when it was fixed, and its batches are ~4x longer (a first stage at twice
-/// the count covered 0.63 on the sums, at four times 0.65-0.66; docs/validation.md, "Early stop").
+/// were not yet seen when it was fixed.
 /// Checks fall on a fixed schedule of sample counts, so a resumed run checks where the
 /// uninterrupted one did; the state goes into checkpoints.
 class PrecisionTarget {
  public:
   static constexpr double kMinCorrelationTimes = 50.0;
   static constexpr double kFirstStageFactor = 4.0;
+  static constexpr int kFirstStageMaxBatches = 4;
   static constexpr std::int64_t kFirstCheck = 50;  ///< samples
 
   /// target: time.target_rel_error (NaN: no target, never stops). cut_transient: the window is

@@ -10,7 +10,7 @@
 
 namespace boycott::stats {
 
-MeanError mean_error(const std::vector<double>& x, const AutocorrelationError& e) {
+MeanError mean_error(const std::vector<double>& x, const AutocorrelationError& e, int max_batches) {
   MeanError m;
   m.stderr_of_mean = m.dof = m.covering_error = std::numeric_limits<double>::quiet_NaN();
   const std::size_t n = x.size();
@@ -18,14 +18,12 @@ MeanError mean_error(const std::vector<double>& x, const AutocorrelationError& e
   // As many batches as the conservative count of correlation spans (never more than of tau_int)
   // allows at kCorrelationTimesPerBatch each, two at least (also where no count could be made:
   // NaN compares false), kMaxBatches at most.
-  const double count = std::isnan(e.span_times)          ? e.correlation_times
-                       : std::isnan(e.correlation_times) ? e.span_times
-                                                         : std::min(e.correlation_times, e.span_times);
+  const double count = e.batch_count();
   std::size_t k = 2;
   const double batches = std::floor(count / MeanError::kCorrelationTimesPerBatch);
   if (batches > 2.0)
     k = static_cast<std::size_t>(
-        std::min({batches, static_cast<double>(n / 4), static_cast<double>(MeanError::kMaxBatches)}));
+        std::min({batches, static_cast<double>(n / 4), static_cast<double>(max_batches)}));
   // One correlation time (its upper end) left out at each border between batches, where the
   // neighbours' correlation lives; a tenth of the series at most, and where no count was made.
   const double most = MeanError::kGapFraction * static_cast<double>(n);

@@ -54,8 +54,10 @@ struct MeanError {
   static constexpr double kCorrelationTimesPerBatch = 20.0;
   static constexpr int kMaxBatches = 8;
 };
-/// `e` is autocorrelation_error(x).
-MeanError mean_error(const std::vector<double>& x, const AutocorrelationError& e);
+/// `e` is autocorrelation_error(x); at most max_batches batches (the first stage of a precision
+/// target asks fewer: stats/precision_target.hpp).
+MeanError mean_error(const std::vector<double>& x, const AutocorrelationError& e,
+                     int max_batches = MeanError::kMaxBatches);
 /// summary.json's error_method: "gapped_batch_means", "two_halves", "two_stage" (a run the
 /// precision target stopped), "sokal_autocorrelation" (runs of earlier builds) or "none".
 const char* error_method_name(MeanError::Basis b);

@@ -95,7 +95,7 @@ double target_coverage(const std::string& name, double goal, std::uint64_t seed)
   const Family make = family(name);
   int covered = 0, stopped = 0;
   for (int s = 0; s < kSeries; ++s) {
-    const FamilySeries f = make(5.0 * goal, rng);
+    const FamilySeries f = make(12.0 * goal, rng);
     const double rel = one_sigma_t_factor(7.0) * std::sqrt(2.0 * f.tau_int / (goal * f.slowest));
     PrecisionTarget target(rel);
     std::vector<double> w;
