@@ -1,5 +1,6 @@
 // boycott: the command-line front end; its subcommands are set up and run by case_cli.cpp,
-// study_cli.cpp, query_cli.cpp and stats_cli.cpp (for users: README.md, "Running a case", "Studies", "Outputs").
+// study_cli.cpp, query_cli.cpp and stats_cli.cpp (for users: README.md, "Running a case", "Studies",
+// "Outputs").
 #include <cstdio>
 #include <string_view>
 

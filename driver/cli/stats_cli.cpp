@@ -36,14 +36,17 @@ int run_stats_mean(const MeanArgs& a) {
 
 Command setup_stats_mean(CLI::App* parent) {
   auto a = std::make_shared<MeanArgs>();
-  auto* cmd = parent->add_subcommand(
-      "mean",
-      "the mean of each column of a CSV series and its covering (~68 %) error, by the rules a run's summary.json "
-      "uses: batch means (the two halves at least) with Student's t, the correlation time, the start-up transient");
-  cmd->add_option("series", a->path, "CSV file: a header of names, rows of numbers; a first column named t or "
-                                     "time_s is the time (s)")
+  auto* cmd = parent->add_subcommand("mean",
+                                     "the mean of each column of a CSV series and its covering (~68 %) "
+                                     "error, by the rules a run's summary.json "
+                                     "uses: batch means (the two halves at least) with Student's t, the "
+                                     "correlation time, the start-up transient");
+  cmd->add_option("series", a->path,
+                  "CSV file: a header of names, rows of numbers; a first column named t or "
+                  "time_s is the time (s)")
       ->required();
-  cmd->add_option("--column", a->columns, "only this column (repeat for more); default: every numeric column");
+  cmd->add_option("--column", a->columns,
+                  "only this column (repeat for more); default: every numeric column");
   cmd->add_option("--average-from", a->average_from,
                   "average from this time (s; a row index without a time column), or 'auto': from where each "
                   "column's start-up transient is detected to end; default: every row");

@@ -46,13 +46,16 @@ SeriesMean column_mean(const std::string& name, const std::vector<double>& x, st
   if (!warning.empty()) m.warnings.push_back(warning);
   if (cut.estimated && cut.start > static_cast<std::int64_t>(first) &&
       stats::transient_biases_mean(x, static_cast<std::int64_t>(first), cut.detected))
-    m.warnings.push_back(fmt::format("the start-up transient of {} ends at {:.4g}, after the window's start, and "
-                                     "the samples between shift the mean beyond their noise: average from there",
-                                     name, m.transient_end));
+    m.warnings.push_back(
+        fmt::format("the start-up transient of {} ends at {:.4g}, after the window's start, and "
+                    "the samples between shift the mean beyond their noise: average from there",
+                    name, m.transient_end));
   return m;
 }
 
-std::string num(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : ""; }
+std::string num(double v) {
+  return std::isfinite(v) ? fmt::format("{:.6g}", v) : "";
+}
 
 }  // namespace
 
@@ -81,10 +84,12 @@ std::vector<SeriesMean> series_means(const SeriesTable& t, const std::vector<std
   if (from.from) {
     // The first row at or after T (a rounding below T in the file's digits counts as at T).
     const double slack = 1e-9 * std::max(1.0, std::abs(*from.from));
-    first = static_cast<std::size_t>(std::lower_bound(time.begin(), time.end(), *from.from - slack) - time.begin());
+    first = static_cast<std::size_t>(std::lower_bound(time.begin(), time.end(), *from.from - slack) -
+                                     time.begin());
     if (first + 8 > n)
-      throw InputError(fmt::format("--average-from {:g} leaves {} rows of {}: the error of a mean needs 8 at least",
-                                   *from.from, first < n ? n - first : 0, n));
+      throw InputError(
+          fmt::format("--average-from {:g} leaves {} rows of {}: the error of a mean needs 8 at least",
+                      *from.from, first < n ? n - first : 0, n));
   }
   std::vector<std::size_t> picked;
   for (const auto& w : wanted) {
@@ -110,25 +115,43 @@ std::vector<SeriesMean> series_means(const SeriesTable& t, const std::vector<std
 std::string format_series_means(const std::vector<SeriesMean>& rows, ListingFormat format, bool timed) {
   const bool all_velocity = std::all_of(rows.begin(), rows.end(), [](const auto& r) { return r.velocity; });
   const std::string error = all_velocity ? "error_m_s" : "error", unit = timed ? "_s" : "_rows";
-  const std::vector<std::string> head{"column",      "mean",       "samples",          error,  "basis",
-                                      "dof",         "tau_int" + unit, "tau_int_upper" + unit, "correlation_times",
-                                      "average_from" + unit, "transient_end" + unit, "warnings"};
+  const std::vector<std::string> head{"column",
+                                      "mean",
+                                      "samples",
+                                      error,
+                                      "basis",
+                                      "dof",
+                                      "tau_int" + unit,
+                                      "tau_int_upper" + unit,
+                                      "correlation_times",
+                                      "average_from" + unit,
+                                      "transient_end" + unit,
+                                      "warnings"};
   if (format == ListingFormat::kJson) {
     nlohmann::json j = nlohmann::json::array();
     auto val = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
     for (const auto& r : rows)
-      j.push_back({{"column", r.name}, {"mean", val(r.mean)}, {"samples", r.samples},
-                   {r.velocity ? "error_m_s" : "error", val(r.error)}, {"stderr", val(r.stderr_of_mean)},
-                   {"basis", r.basis}, {"batches", r.batches}, {"dof", val(r.dof)}, {head[6], val(r.tau_int)},
-                   {head[7], val(r.tau_int_upper)}, {"correlation_times", val(r.correlation_times)},
-                   {head[9], val(r.average_from)}, {head[10], val(r.transient_end)}, {"warnings", r.warnings}});
+      j.push_back({{"column", r.name},
+                   {"mean", val(r.mean)},
+                   {"samples", r.samples},
+                   {r.velocity ? "error_m_s" : "error", val(r.error)},
+                   {"stderr", val(r.stderr_of_mean)},
+                   {"basis", r.basis},
+                   {"batches", r.batches},
+                   {"dof", val(r.dof)},
+                   {head[6], val(r.tau_int)},
+                   {head[7], val(r.tau_int_upper)},
+                   {"correlation_times", val(r.correlation_times)},
+                   {head[9], val(r.average_from)},
+                   {head[10], val(r.transient_end)},
+                   {"warnings", r.warnings}});
     return j.dump(2) + "\n";
   }
   std::vector<std::vector<std::string>> cells;
   for (const auto& r : rows)
-    cells.push_back({r.name, num(r.mean), std::to_string(r.samples), num(r.error), r.basis, num(r.dof), num(r.tau_int),
-                     num(r.tau_int_upper), num(r.correlation_times), num(r.average_from), num(r.transient_end),
-                     fmt::format("{}", fmt::join(r.warnings, " | "))});
+    cells.push_back({r.name, num(r.mean), std::to_string(r.samples), num(r.error), r.basis, num(r.dof),
+                     num(r.tau_int), num(r.tau_int_upper), num(r.correlation_times), num(r.average_from),
+                     num(r.transient_end), fmt::format("{}", fmt::join(r.warnings, " | "))});
   if (format == ListingFormat::kCsv) {
     std::string out = csv_line(head);
     for (const auto& c : cells) out += csv_line(c);

@@ -54,8 +54,8 @@ SeriesTable parse_series_table(const std::string& text, const std::string& path)
     for (std::size_t c = 0; c < cells.size(); ++c) {
       const auto v = number_of(cells[c]);
       if (v && !std::isfinite(*v))
-        throw InputError(fmt::format("row {} of '{}' holds {} in column '{}': a series with gaps has no mean", row,
-                                     path, cells[c], header[c]));
+        throw InputError(fmt::format("row {} of '{}' holds {} in column '{}': a series with gaps has no mean",
+                                     row, path, cells[c], header[c]));
       raw[c].push_back(v);
     }
   }

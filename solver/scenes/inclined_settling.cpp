@@ -257,7 +257,8 @@ nlohmann::json SettlingRecord::summary(const coupling::CoupledSystem& run, Summa
   // A run its precision target stopped reports the target's two-stage error, over the window its
   // first stage fixed.
   const stats::TwoStagePlan* plan = sb.status == kStatusConverged ? &target_.plan() : nullptr;
-  const stats::ChosenWindow chosen = averaging_window(p_.time.average_from, steps_, wp_series_, run.time_s(), plan);
+  const stats::ChosenWindow chosen =
+      averaging_window(p_.time.average_from, steps_, wp_series_, run.time_s(), plan);
   const stats::WindowError wp_err = stats::window_error(chosen.window, chosen.from_s, run.time_s(), plan);
   nlohmann::json j = report_settling_velocity(sb, chosen, wp_err, timers);
   const bool chose = p_.time.average_from.automatic && wp_series_whole_;
@@ -297,7 +298,8 @@ nlohmann::json SettlingRecord::report_settling_velocity(SummaryBase& sb, const s
     j["target_rel_error"] = p_.time.target_rel_error;
     // Met: it stopped the run, or the window's own error meets it at the end.
     const double covering_rel = std::abs(wp_err.err.covering_error / sb.mean_settling_velocity_m_s);
-    j["target_met"] = sb.status == kStatusConverged || (wp_series_whole_ && covering_rel < p_.time.target_rel_error);
+    j["target_met"] =
+        sb.status == kStatusConverged || (wp_series_whole_ && covering_rel < p_.time.target_rel_error);
   }
   return j;
 }

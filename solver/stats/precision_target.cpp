@@ -18,7 +18,8 @@ bool PrecisionTarget::reached(const std::vector<double>& series, double window_f
   // The run's own window: from where the transient is detected to end (no step lengths here).
   std::int64_t cut = 0;
   if (cut_transient_) {
-    const ChosenWindow c = cut_at_transient(StepSeries{{}, {}, {}, true, false}, series, window_from_s, now_s);
+    const ChosenWindow c =
+        cut_at_transient(StepSeries{{}, {}, {}, true, false}, series, window_from_s, now_s);
     cut = static_cast<std::int64_t>(series.size() - c.window.size());
   }
   const std::vector<double> x(series.begin() + cut, series.end());
@@ -27,7 +28,8 @@ bool PrecisionTarget::reached(const std::vector<double>& series, double window_f
     const AutocorrelationError e = autocorrelation_error(x);
     last_rel_error_ = std::abs(e.covering_error / e.mean);
     if (e.batch_count() >= kMinCorrelationTimes)
-      first_stage_at_ = cut + static_cast<std::int64_t>(std::ceil(kFirstStageFactor * static_cast<double>(nx)));
+      first_stage_at_ =
+          cut + static_cast<std::int64_t>(std::ceil(kFirstStageFactor * static_cast<double>(nx)));
     return false;
   }
   // The first stage: the plan, fixed once.
@@ -40,16 +42,23 @@ bool PrecisionTarget::reached(const std::vector<double>& series, double window_f
   plan_.mean0 = mean;
   plan_.cut = cut;
   const double need = std::pow(m.covering_error / (target_ * std::abs(mean)), 2) * static_cast<double>(nx);
-  plan_.planned = cut + std::max<std::int64_t>(nx, std::isfinite(need) ? static_cast<std::int64_t>(std::ceil(need))
-                                                                       : std::numeric_limits<std::int64_t>::max() / 2);
+  plan_.planned =
+      cut + std::max<std::int64_t>(nx, std::isfinite(need) ? static_cast<std::int64_t>(std::ceil(need))
+                                                           : std::numeric_limits<std::int64_t>::max() / 2);
   last_rel_error_ = std::abs(m.covering_error / mean) *
                     std::sqrt(static_cast<double>(nx) / static_cast<double>(plan_.planned - cut));
   return n >= plan_.planned;
 }
 
 std::vector<double> PrecisionTarget::to_state() const {
-  return {static_cast<double>(next_check_), static_cast<double>(first_stage_at_), static_cast<double>(plan_.n0),
-          plan_.se0, plan_.dof0, plan_.mean0, static_cast<double>(plan_.planned), static_cast<double>(plan_.cut)};
+  return {static_cast<double>(next_check_),
+          static_cast<double>(first_stage_at_),
+          static_cast<double>(plan_.n0),
+          plan_.se0,
+          plan_.dof0,
+          plan_.mean0,
+          static_cast<double>(plan_.planned),
+          static_cast<double>(plan_.cut)};
 }
 
 void PrecisionTarget::from_state(const std::vector<double>& v) {

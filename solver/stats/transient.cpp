@@ -54,8 +54,7 @@ TransientEnd transient_end(const std::vector<double>& x) {
   cut.estimated = true;
   // A segment's mean less the reference's: the segment's variance and the reference's, as if
   // independent; Student's t at the reference's refs - 1 degrees of freedom.
-  const double q =
-      student_t_quantile(1.0 - TransientEnd::kFalseAlarm / 2.0, static_cast<double>(refs - 1));
+  const double q = student_t_quantile(1.0 - TransientEnd::kFalseAlarm / 2.0, static_cast<double>(refs - 1));
   const double diff_var = ref.segment_var * (1.0 + 1.0 / static_cast<double>(refs));
   const std::int64_t segments = std::min<std::int64_t>(TransientEnd::kSegments, (n - refs * len) / len);
   std::int64_t end = 0;
@@ -63,8 +62,10 @@ TransientEnd transient_end(const std::vector<double>& x) {
     const double m = segment_mean(x, j * len, len);
     double spread = 0.0;
     for (std::int64_t i = j * len; i < (j + 1) * len; ++i)
-      spread += (x[static_cast<std::size_t>(i)] - m) * (x[static_cast<std::size_t>(i)] - m) / static_cast<double>(len);
-    const bool differs = (m - ref.mean) * (m - ref.mean) > q * q * diff_var || spread > TransientEnd::kSpreadFactor * ref.var;
+      spread += (x[static_cast<std::size_t>(i)] - m) * (x[static_cast<std::size_t>(i)] - m) /
+                static_cast<double>(len);
+    const bool differs =
+        (m - ref.mean) * (m - ref.mean) > q * q * diff_var || spread > TransientEnd::kSpreadFactor * ref.var;
     clean = differs ? 0 : clean + 1;
     if (differs) end = j + 1;
   }

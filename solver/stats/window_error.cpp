@@ -28,7 +28,8 @@ MeanError mean_error(const std::vector<double>& x, const AutocorrelationError& e
   // neighbours' correlation lives; a tenth of the series at most, and where no count was made.
   const double most = MeanError::kGapFraction * static_cast<double>(n);
   const auto gaps = static_cast<std::size_t>(
-      std::isfinite(count) && count > 0.0 ? std::min(most, static_cast<double>(k - 1) * static_cast<double>(n) / count)
+      std::isfinite(count) && count > 0.0
+          ? std::min(most, static_cast<double>(k - 1) * static_cast<double>(n) / count)
           : most);
   const std::size_t len = (n - gaps) / k;
   // Batch j starts at j (n - len) / (k - 1): the first at 0, the last ending at n, the samples

@@ -12,7 +12,9 @@ namespace boycott::testing {
 
 /// AR(1) with unit stationary variance and integrated autocorrelation time tau_int (steps):
 /// phi = (2 tau_int - 1) / (2 tau_int + 1), since tau_int = (1 + phi) / (2 (1 - phi)).
-inline double ar1_phi(double tau_int) { return (2.0 * tau_int - 1.0) / (2.0 * tau_int + 1.0); }
+inline double ar1_phi(double tau_int) {
+  return (2.0 * tau_int - 1.0) / (2.0 * tau_int + 1.0);
+}
 
 /// Adds `scale` times a stationary AR(1) of integrated time tau_int to x.
 inline void add_ar1(std::vector<double>& x, double tau_int, double scale, std::mt19937_64& rng) {

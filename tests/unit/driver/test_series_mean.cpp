@@ -74,13 +74,13 @@ TEST(SeriesMean, BadInputIsRefusedWithOneSentence) {
     }
     return false;
   };
-  EXPECT_TRUE(refused("a,b\nx,y\nz,w\n", {}, ""));                          // no numeric column
-  EXPECT_TRUE(refused(sample_csv(100), {"nope"}, ""));                       // unknown column
-  EXPECT_TRUE(refused(sample_csv(7), {}, ""));                               // fewer than 8 rows
-  EXPECT_TRUE(refused("t,a\n0,1\n1,nan\n2,3\n", {}, ""));                    // a NaN
-  EXPECT_TRUE(refused(sample_csv(100) + "1.0,2.0\n", {}, ""));               // a ragged row
-  EXPECT_TRUE(refused(sample_csv(100), {}, "0.95"));                         // 5 rows left
-  EXPECT_TRUE(refused(sample_csv(100), {}, "soon"));                         // not a time
+  EXPECT_TRUE(refused("a,b\nx,y\nz,w\n", {}, ""));                                // no numeric column
+  EXPECT_TRUE(refused(sample_csv(100), {"nope"}, ""));                            // unknown column
+  EXPECT_TRUE(refused(sample_csv(7), {}, ""));                                    // fewer than 8 rows
+  EXPECT_TRUE(refused("t,a\n0,1\n1,nan\n2,3\n", {}, ""));                         // a NaN
+  EXPECT_TRUE(refused(sample_csv(100) + "1.0,2.0\n", {}, ""));                    // a ragged row
+  EXPECT_TRUE(refused(sample_csv(100), {}, "0.95"));                              // 5 rows left
+  EXPECT_TRUE(refused(sample_csv(100), {}, "soon"));                              // not a time
   EXPECT_TRUE(refused("t,a\n0,1\n2,1\n1,1\n3,1\n4,1\n5,1\n6,1\n7,1\n", {}, ""));  // time goes back
   EXPECT_FALSE(refused(sample_csv(100), {}, "auto"));
 }
