@@ -20,7 +20,8 @@ namespace boycott::stats {
 /// exponential decay), so one correlation time (the upper end of its estimate) is left out at each
 /// border, at most a tenth of the series (kGapFraction; a tenth too where no count could be made).
 /// k is as many batches of kCorrelationTimesPerBatch correlation times as the conservative count
-/// (AutocorrelationError::correlation_times) allows, two at least and kMaxBatches at most: the two
+/// (AutocorrelationError::batch_count: of tau_int, or of correlation spans where those are fewer,
+/// as in an oscillation whose lobes cancel in tau_int) allows, two at least and kMaxBatches at most: the two
 /// halves of the series (basis two_halves, 1 degree of freedom, t = 1.84) in runs of fewer than 60
 /// counted correlation times, where no count could be made, and always in short series.
 ///
@@ -29,8 +30,9 @@ namespace boycott::stats {
 /// a true tau_int says nothing of the time over which neighbouring batches correlate, which is the
 /// slow part's (for an oscillation, its envelope's decay time). Batches of 20 estimated correlation
 /// times are then a few slow ones long: neighbours correlate, and the error falls short on such
-/// series (covering 0.65 at 50-100 slowest times) or, on a quasi-periodic one whose tau_int is
-/// small, the negative correlation of neighbours makes it too wide (0.72-0.74). A cap lets the
+/// series (without the cap 0.652-0.658 at 50-200 slowest times, with it 0.658-0.676), while on an
+/// oscillation whose tau_int is small many short batches carry part-periods that make the error
+/// too wide (0.79, counted by tau_int; 0.69 by spans). A cap lets the
 /// batches grow with the window, so that whatever the data hide, the correlation of neighbours
 /// falls as 1 / N; its price is small: t_7 times the scatter of an 8-batch error is 1.04 true
 /// standard errors on average, against 1.00 with many batches (docs/validation.md, "One run").
