@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "stats/distributions.hpp"
 #include "stats/transient.hpp"
 
 namespace boycott::stats {
@@ -41,13 +42,24 @@ bool PrecisionTarget::reached(const std::vector<double>& series, double window_f
   plan_.dof0 = m.dof;
   plan_.mean0 = mean;
   plan_.cut = cut;
-  const double need = std::pow(m.covering_error / (target_ * std::abs(mean)), 2) * static_cast<double>(nx);
-  plan_.planned =
-      cut + std::max<std::int64_t>(nx, std::isfinite(need) ? static_cast<std::int64_t>(std::ceil(need))
-                                                           : std::numeric_limits<std::int64_t>::max() / 2);
-  last_rel_error_ = std::abs(m.covering_error / mean) *
-                    std::sqrt(static_cast<double>(nx) / static_cast<double>(plan_.planned - cut));
+  plan_length();
   return n >= plan_.planned;
+}
+
+void PrecisionTarget::plan_length() {
+  // n0 (t_dof0 se0 / (target |mean0|))^2 samples, at least n0 (no estimate: never).
+  const double rel0 = se0_rel_covering();
+  const double need = std::pow(rel0 / target_, 2) * static_cast<double>(plan_.n0);
+  plan_.planned =
+      plan_.cut + std::max<std::int64_t>(plan_.n0, std::isfinite(need)
+                                                       ? static_cast<std::int64_t>(std::ceil(need))
+                                                       : std::numeric_limits<std::int64_t>::max() / 2);
+  last_rel_error_ =
+      rel0 * std::sqrt(static_cast<double>(plan_.n0) / static_cast<double>(plan_.planned - plan_.cut));
+}
+
+double PrecisionTarget::se0_rel_covering() const {
+  return std::abs(plan_.se0 * one_sigma_t_factor(plan_.dof0) / plan_.mean0);
 }
 
 std::vector<double> PrecisionTarget::to_state() const {
@@ -72,6 +84,9 @@ void PrecisionTarget::from_state(const std::vector<double>& v) {
   plan_.mean0 = v[5];
   plan_.planned = static_cast<std::int64_t>(v[6]);
   plan_.cut = static_cast<std::int64_t>(v[7]);
+  // The length for this run's target (a resumed run may ask another): Stein's plan from the
+  // same first stage.
+  if (plan_.set() && active()) plan_length();
 }
 
 }  // namespace boycott::stats

@@ -66,6 +66,10 @@ class PrecisionTarget {
   void from_state(const std::vector<double>& v);
 
  private:
+  /// plan_.planned and last_rel_error_ from the first stage in plan_ and target_.
+  void plan_length();
+  /// The first stage's covering error relative to its mean, t_dof0 se0 / |mean0|.
+  double se0_rel_covering() const;
   double target_;
   bool cut_transient_;
   double last_rel_error_ = std::numeric_limits<double>::quiet_NaN();
