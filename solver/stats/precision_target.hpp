@@ -21,21 +21,24 @@ namespace boycott::stats {
 /// - It then reports se0 sqrt(n0 / n) times t at dof0 (two_stage_error), below the target by
 ///   construction. The length depends on se0 alone, so the mean over it scatters as if the
 ///   length had been fixed in advance, and t at dof0 covers it if se0 is unbiased.
+///
 /// Why at most 4 batches at the first stage: the whole plan rests on se0, and batches of a first
 /// stage of ~200 counted correlation times are, with 8 of them, only a few times the slow part's
 /// time on sums of AR(1) processes 3-30 apart (whose tau_int a slow part of small weight hardly
-/// moves): neighbours correlate and se0 comes out low (coverage 0.63 at the stop; 4 batches:
-/// 0.65; docs/validation.md, "Series that are not AR(1)"). The price: t_3 instead of t_7, a run
-/// ~20 % longer where the target decides the stop.
-/// Why not stop when the error first meets the target, confirmed over a while (the earlier rule):
-/// the stop then comes where the estimate dipped; with Sokal's error, which a slow part of the
-/// series biases low, it covered 0.57-0.60 on sums of AR(1) processes; with batch means, whose
-/// few degrees of freedom make them noisy, 0.62 on AR(1). Why the first stage lies well past the
-/// first count of 50: the count is itself an estimate, and the runs that reach it first are those
-/// whose tau_int was estimated low; four times as far, three quarters of the first stage's data
-/// were not yet seen when it was fixed.
-/// Checks fall on a fixed schedule of sample counts, so a resumed run checks where the
-/// uninterrupted one did; the state goes into checkpoints.
+/// moves): neighbours correlate and se0 comes out low (coverage 0.633 at the stop over 2 000
+/// such series; 4 batches: 0.673; docs/validation.md, "Series that are not AR(1)"). The price: t_3 instead of
+/// t_7, a run ~20 % longer where the target decides the stop.
+///
+/// Why not stop when the error first meets the
+/// target, confirmed over a while (the earlier rule): the stop then comes where the estimate dipped; with
+/// Sokal's error, which a slow part of the series biases low, it covered 0.57-0.60 on sums of AR(1)
+/// processes; with batch means, whose few degrees of freedom make them noisy, 0.62 on AR(1). Why the first
+/// stage lies well past the first count of 50: the count is itself an estimate, and the runs that reach it
+/// first are those whose tau_int was estimated low; four times as far, three quarters of the first stage's
+/// data were not yet seen when it was fixed.
+///
+/// Checks fall on a fixed schedule of sample counts, so a resumed
+/// run checks where the uninterrupted one did; the state goes into checkpoints.
 class PrecisionTarget {
  public:
   static constexpr double kMinCorrelationTimes = 50.0;
