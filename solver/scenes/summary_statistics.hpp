@@ -16,8 +16,8 @@
 namespace boycott::scenes {
 
 /// The summary keys of a time average's error, `prefix` + stderr_m_s, error_m_s (the covering
-/// half-width), error_dof (all three from WindowError::err), error_method ("batch_means"
-/// or "two_halves"), error_batches, correlation_time_s, correlation_time_upper_s, effective_samples,
+/// half-width), error_dof (all three from WindowError::err), error_method ("gapped_batch_means",
+/// "two_halves", or "two_stage" where time.target_rel_error stopped the run), error_batches, correlation_time_s, correlation_time_upper_s, effective_samples,
 /// window_correlation_times (Sokal's diagnostics); null where not available. With `warn` (a
 /// finished run), a warning goes to j["warnings"] and stderr when the window holds fewer than ~20
 /// correlation times, saying what the error then rests on. `what` names the quantity.
