@@ -17,12 +17,12 @@ namespace boycott::scenes {
 
 /// The summary keys of a time average's error, `prefix` + stderr_m_s, error_m_s (the covering
 /// half-width), error_dof (all three from WindowError::err), error_method ("gapped_batch_means",
-/// "two_halves", or "two_stage" where time.target_rel_error stopped the run), error_batches, correlation_time_s, correlation_time_upper_s, effective_samples,
-/// window_correlation_times (Sokal's diagnostics); null where not available. With `warn` (a
-/// finished run), a warning goes to j["warnings"] and stderr when the window holds fewer than ~20
-/// correlation times, saying what the error then rests on. `what` names the quantity.
-/// `transient_end_s` (NaN: not known) shapes the advice: average from where the detected transient
-/// ends when that is before the window, else run longer.
+/// "two_halves", or "two_stage" where time.target_rel_error stopped the run), error_batches,
+/// correlation_time_s, correlation_time_upper_s, effective_samples, window_correlation_times (Sokal's
+/// diagnostics); null where not available. With `warn` (a finished run), a warning goes to j["warnings"] and
+/// stderr when the window holds fewer than ~20 correlation times, saying what the error then rests on. `what`
+/// names the quantity. `transient_end_s` (NaN: not known) shapes the advice: average from where the detected
+/// transient ends when that is before the window, else run longer.
 void report_window_error(nlohmann::json& j, const std::string& prefix, const std::string& what,
                          const stats::WindowError& w, bool warn,
                          double transient_end_s = std::numeric_limits<double>::quiet_NaN());

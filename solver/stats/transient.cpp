@@ -70,8 +70,16 @@ TransientEnd transient_end(const std::vector<double>& x) {
     if (differs) end = j + 1;
   }
   cut.detected = end * len;
-  cut.start =
-      std::min<std::int64_t>(n / 2, std::llround(TransientEnd::kGuard * static_cast<double>(cut.detected)));
+  if (end > 0) {
+    // The reference's correlation span, its upper end (samples): how long the series remembers.
+    const AutocorrelationError e = autocorrelation_error(std::vector<double>(x.end() - refs * len, x.end()));
+    const double span = std::isfinite(e.span_times) && e.span_times > 0.0
+                            ? static_cast<double>(refs * len) / e.span_times
+                            : 0.0;
+    cut.start =
+        std::min<std::int64_t>(n / 2, std::llround(TransientEnd::kGuard * static_cast<double>(cut.detected) +
+                                                   TransientEnd::kGuardSpans * span));
+  }
   return cut;
 }
 

@@ -125,7 +125,7 @@ TEST(FamilyCoverage, ARunTheTargetStopsCoversTwoThirdsOnEveryFamily) {
     const char* family;
     double goal, settled;
   };
-  const Figure figures[] = {{"ar1", 300, NAN}, {"two_scales", 300, NAN}, {"oscillation", 300, NAN}};
+  const Figure figures[] = {{"ar1", 300, 0.6766}, {"two_scales", 300, 0.6698}, {"oscillation", 300, NAN}};
   std::uint64_t seed = 62000;
   for (const auto& f : figures) expect_figure(target_coverage(f.family, f.goal, ++seed), f.settled, f.family);
 }
