@@ -125,7 +125,7 @@ TEST(FamilyCoverage, ARunTheTargetStopsCoversTwoThirdsOnEveryFamily) {
     const char* family;
     double goal, settled;
   };
-  const Figure figures[] = {{"ar1", 300, 0.6766}, {"two_scales", 300, 0.6698}, {"oscillation", 300, NAN}};
+  const Figure figures[] = {{"ar1", 300, 0.6766}, {"two_scales", 300, 0.6698}, {"oscillation", 300, 0.6915}};
   std::uint64_t seed = 62000;
   for (const auto& f : figures) expect_figure(target_coverage(f.family, f.goal, ++seed), f.settled, f.family);
 }
@@ -174,7 +174,7 @@ TEST(FamilyCoverage, AnAutomaticWindowCutsFewStationarySeriesAndItsErrorCovers) 
     const char* family;
     double settled;
   };
-  const Figure figures[] = {{"ar1", 0.6854}, {"two_scales", 0.6566}, {"oscillation", 0.6915}};
+  const Figure figures[] = {{"ar1", 0.6840}, {"two_scales", 0.6577}, {"oscillation", 0.6929}};
   std::uint64_t seed = 63000;
   for (const auto& f : figures) {
     const AutoFigures a = auto_window_figures(f.family, 50.0, 0.0, ++seed);
@@ -183,21 +183,24 @@ TEST(FamilyCoverage, AnAutomaticWindowCutsFewStationarySeriesAndItsErrorCovers) 
   }
 }
 
-TEST(FamilyCoverage, AnAutomaticWindowLeavesLessThanHalfAStandardErrorOfAStrongTransient) {
+TEST(FamilyCoverage, AnAutomaticWindowCutsAStrongTransientOfAr1ToBelowHalfAStandardErrorAndKeepsItsFigures) {
   struct Figure {
     const char* family;
     double coverage, unbiased;
   };
-  // Settled, not the promise: on the two-scale and oscillating families a weak slow decay under
-  // the fast noise is cut too early (unbiased 0.86 and 0.47, coverage 0.63 and 0.65; issue 61
-  // asks 0.9 and 0.65-0.71; docs/validation.md, "Transients").
+  // Settled, not the promise: on the two-scale and oscillating families a slow decay under the
+  // fast noise is cut too early (unbiased 0.64 and 0.33, coverage 0.63; issue 61 asks 0.9 and
+  // 0.65-0.71; docs/validation.md, "Series that are not AR(1)").
   const Figure figures[] = {
-      {"ar1", 0.6716, 0.9279}, {"two_scales", 0.6326, 0.8605}, {"oscillation", 0.6468, 0.4671}};
+      {"ar1", 0.6892, 0.9989}, {"two_scales", 0.6302, 0.6433}, {"oscillation", 0.6252, 0.3296}};
   std::uint64_t seed = 64000;
   for (const auto& f : figures) {
     const AutoFigures a = auto_window_figures(f.family, 50.0, 3.0, ++seed);
     EXPECT_NEAR(a.coverage, f.coverage, kBand) << f.family;
     EXPECT_NEAR(a.unbiased, f.unbiased, kBand) << f.family;
+    if (std::string(f.family) == "ar1") {
+      EXPECT_GE(a.unbiased, 0.9);
+    }
   }
 }
 
@@ -236,7 +239,7 @@ TEST(FamilyCoverage, BlockBootstrapOfThe75DegreeRunsFluctuationsIsCovered) {
   struct Figure {
     double window, settled;
   };
-  for (const Figure f : {Figure{50.0, 0.6803}, Figure{100.0, 0.6904}}) {
+  for (const Figure f : {Figure{50.0, 0.6783}, Figure{100.0, 0.6868}}) {
     std::mt19937_64 rng(65000 + static_cast<int>(f.window));
     std::uniform_int_distribution<std::size_t> start(0, x.size() - 1);
     const auto n = static_cast<std::size_t>(f.window * e.tau_int);
