@@ -76,9 +76,7 @@ TransientEnd transient_end(const std::vector<double>& x) {
     const double span = std::isfinite(e.span_times) && e.span_times > 0.0
                             ? static_cast<double>(refs * len) / e.span_times
                             : 0.0;
-    cut.start =
-        std::min<std::int64_t>(n / 2, std::llround(TransientEnd::kGuard * static_cast<double>(cut.detected) +
-                                                   TransientEnd::kGuardSpans * span));
+    cut.start = std::min<std::int64_t>(n / 2, cut.detected + std::llround(TransientEnd::kGuardSpans * span));
   }
   return cut;
 }

@@ -14,7 +14,7 @@ namespace boycott::stats {
 /// means, and its spread within kSpreadFactor times the reference's variance (a swing that
 /// averages out, as stages I and II of a settling run can, shows in the spread). The transient
 /// is detected to end after the last segment that fails before two that pass (`detected`); the
-/// window is cut kGuard times as far in plus kGuardSpans correlation spans of the reference (the
+/// window is cut kGuardSpans correlation spans of the reference further in (the
 /// upper end of AutocorrelationError::span; at most half the series): a decay that a segment can
 /// no longer tell from noise still biases a mean over many segments, and a decay as slow as the
 /// series' own memory is what the segments see least.
@@ -29,11 +29,12 @@ namespace boycott::stats {
 /// covered 0.52-0.64 on stationary series, most of which it cut. A test cuts a stationary series
 /// only when a segment fails by chance (~5 % of series), and then mostly a segment or two; the
 /// error of what is kept is the ordinary one (docs/validation.md, "Transients").
-/// 20 segments, 1.5 times the detected end plus 5 spans: a swing that ends at 1.4 % of the window
-/// costs < 10 % of it, a strong fast decay on white noise is cut where it has fallen to the noise
-/// (tests TransientEnd.*, TransientReport.*). A guard of 3.5 times the detected end (or 10
-/// segments and 5 times) cut more of a weak slow decay under a two-scale or oscillating series,
-/// but threw away a quarter of a window whose transient is short.
+/// 20 segments and 5 spans: a swing that ends at 1.4 % of the window costs < 10 % of it, a strong
+/// fast decay on white noise is cut where it has fallen to the noise (tests TransientEnd.*,
+/// TransientReport.*). A guard of 3.5 times the detected end (or 10 segments and 5 times) cut
+/// more of a weak slow decay under a two-scale or oscillating series, but threw away a quarter of
+/// a window whose transient is short and cut such a decay at twice the time it had fallen to the
+/// noise; 1.5 times plus 5 spans still cut it 20 % too late where the steps are uneven.
 struct TransientEnd {
   std::int64_t start = 0;     ///< first sample of the stationary part: the cut
   std::int64_t detected = 0;  ///< where the segments stop differing from the reference
@@ -41,7 +42,6 @@ struct TransientEnd {
   static constexpr int kSegments = 20;
   static constexpr double kFalseAlarm = 0.02;
   static constexpr double kSpreadFactor = 4.0;
-  static constexpr double kGuard = 1.5;
   static constexpr double kGuardSpans = 5.0;
 };
 TransientEnd transient_end(const std::vector<double>& x);
