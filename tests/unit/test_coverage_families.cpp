@@ -174,7 +174,7 @@ TEST(FamilyCoverage, AnAutomaticWindowCutsFewStationarySeriesAndItsErrorCovers) 
     const char* family;
     double settled;
   };
-  const Figure figures[] = {{"ar1", 0.6840}, {"two_scales", 0.6577}, {"oscillation", 0.6929}};
+  const Figure figures[] = {{"ar1", 0.6836}, {"two_scales", 0.6576}, {"oscillation", 0.6929}};
   std::uint64_t seed = 63000;
   for (const auto& f : figures) {
     const AutoFigures a = auto_window_figures(f.family, 50.0, 0.0, ++seed);
@@ -189,10 +189,10 @@ TEST(FamilyCoverage, AnAutomaticWindowCutsAStrongTransientOfAr1ToBelowHalfAStand
     double coverage, unbiased;
   };
   // Settled, not the promise: on the two-scale and oscillating families a slow decay under the
-  // fast noise is cut too early (unbiased 0.64 and 0.33, coverage 0.63; issue 61 asks 0.9 and
+  // fast noise is cut too early (unbiased 0.33 and 0.17, coverage 0.63 and 0.62; issue 61 asks 0.9 and
   // 0.65-0.71; docs/validation.md, "Series that are not AR(1)").
   const Figure figures[] = {
-      {"ar1", 0.6892, 0.9989}, {"two_scales", 0.6302, 0.6433}, {"oscillation", 0.6252, 0.3296}};
+      {"ar1", 0.6838, 0.9938}, {"two_scales", 0.6267, 0.3297}, {"oscillation", 0.6217, 0.1683}};
   std::uint64_t seed = 64000;
   for (const auto& f : figures) {
     const AutoFigures a = auto_window_figures(f.family, 50.0, 3.0, ++seed);
@@ -239,7 +239,7 @@ TEST(FamilyCoverage, BlockBootstrapOfThe75DegreeRunsFluctuationsIsCovered) {
   struct Figure {
     double window, settled;
   };
-  for (const Figure f : {Figure{50.0, 0.6783}, Figure{100.0, 0.6868}}) {
+  for (const Figure f : {Figure{50.0, 0.6870}, Figure{100.0, 0.6829}}) {
     std::mt19937_64 rng(65000 + static_cast<int>(f.window));
     std::uniform_int_distribution<std::size_t> start(0, x.size() - 1);
     const auto n = static_cast<std::size_t>(f.window * e.tau_int);
