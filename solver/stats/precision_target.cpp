@@ -28,7 +28,12 @@ bool PrecisionTarget::reached(const std::vector<double>& series, double window_f
   if (first_stage_at_ == 0) {
     const AutocorrelationError e = autocorrelation_error(x);
     last_rel_error_ = std::abs(e.covering_error / e.mean);
-    if (e.batch_count() >= kMinCorrelationTimes)
+    // Counted on tau_int; on spans only where tau_int has no estimate (an oscillation whose lobes
+    // cancel): the span's sum of |rho| gathers noise over its long window, so at hundreds of
+    // samples per correlation time (a run's <w_p>, every step) it counts far fewer than there are
+    // and put the first stage past the end of a run that holds 500 correlation times.
+    const double count = std::isfinite(e.correlation_times) ? e.correlation_times : e.span_times;
+    if (count >= kMinCorrelationTimes)
       first_stage_at_ =
           cut + static_cast<std::int64_t>(std::ceil(kFirstStageFactor * static_cast<double>(nx)));
     return false;

@@ -12,7 +12,8 @@ namespace boycott::stats {
 /// the rule adaptive replicas follow (stats/point_error.hpp): the stop is planned once, not judged
 /// at every check.
 /// - The first check at which the window holds kMinCorrelationTimes correlation times (counted
-///   conservatively, AutocorrelationError::batch_count) fixes the first stage: kFirstStageFactor
+///   conservatively, AutocorrelationError::correlation_times; spans where tau_int has no estimate)
+///   fixes the first stage: kFirstStageFactor
 ///   times as many samples.
 /// - At the first stage (n0 samples) the window's batch means (mean_error, at most
 ///   kFirstStageMaxBatches) give a standard error se0 at dof0 degrees of freedom; the run is
