@@ -48,7 +48,7 @@ std::vector<Command> setup_case_commands(CLI::App& app, int argc, char** argv,
                                          std::vector<std::string>** petsc_options);
 /// `boycott study run|status|plan|submit|collect`.
 std::vector<Command> setup_study_commands(CLI::App& app);
-/// `boycott query curve|validation|work-precision|cases`.
+/// `boycott query curve|peak|validation|work-precision|cases`.
 std::vector<Command> setup_query_commands(CLI::App& app);
 /// `boycott stats mean`.
 std::vector<Command> setup_stats_commands(CLI::App& app);

@@ -11,6 +11,8 @@
 #include "driver/report/curve.hpp"
 #include "driver/report/curve_query.hpp"
 #include "driver/report/listing_format.hpp"
+#include "driver/report/peak.hpp"
+#include "driver/report/peak_query.hpp"
 #include "driver/report/validation_query.hpp"
 #include "driver/report/work_precision.hpp"
 #include "driver/run/runner.hpp"
@@ -55,11 +57,37 @@ int run_query_curve(const QueryArgs& a) {
   std::fputs(format_curve(pts, format).c_str(), stdout);
   if (!a.plot.empty()) {
     const auto paper = parse_paper_values(paper_reference_csv());
+    const auto peaks = query_peak(db, a.study, a.group);
     write_plot(a.plot, curve_plot(pts, fmt::format("study {}", a.study), a.overlay_paper ? &paper : nullptr,
-                                  plot_format)
+                                  plot_format, &peaks)
                            .data);
   }
   return 0;
+}
+
+int run_query_peak(const QueryArgs& a) {
+  const auto format = parse_listing_format(a.format);
+  auto db = open_for_query(a.db);
+  require_study(db, a.study);
+  const auto rows = query_peak(db, a.study, a.group);
+  if (rows.empty())
+    throw InputError(fmt::format("no curve of study '{}'{} in '{}' has a finished point with an error",
+                                 a.study, a.group.empty() ? "" : " group '" + a.group + "'", a.db));
+  std::fputs(format_peak(rows, format).c_str(), stdout);
+  return 0;
+}
+
+Command setup_query_peak(CLI::App* parent) {
+  auto a = std::make_shared<QueryArgs>();
+  auto* cmd = parent->add_subcommand("peak",
+                                     "per curve, the angle and <<w_p>> of its peak with their 68 % "
+                                     "intervals, r_acc there, the points it rests "
+                                     "on and whether it is resolved");
+  add_db(cmd, *a);
+  cmd->add_option("--study", a->study, "study name")->required();
+  cmd->add_option("--group", a->group, "only this group");
+  add_format(cmd, a->format);
+  return {cmd, [a] { return run_query_peak(*a); }};
 }
 
 Command setup_query_curve(CLI::App* parent) {
@@ -141,8 +169,8 @@ Command setup_query_cases(CLI::App* parent) {
 std::vector<Command> setup_query_commands(CLI::App& app) {
   auto* group = app.add_subcommand("query", "read results from a study database");
   group->require_subcommand(1);
-  return {setup_query_curve(group), setup_query_validation(group), setup_query_work_precision(group),
-          setup_query_cases(group)};
+  return {setup_query_curve(group), setup_query_peak(group), setup_query_validation(group),
+          setup_query_work_precision(group), setup_query_cases(group)};
 }
 
 }  // namespace boycott::driver::cli

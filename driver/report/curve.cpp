@@ -120,7 +120,9 @@ std::vector<double> replica_values(const CurvePoint& p, int panel) {
 /// The two panels of `query curve --plot`, their legend and caption.
 class CurveFigure {
  public:
-  CurveFigure(const std::vector<CurvePoint>& pts, const std::vector<PaperValue>* paper) : pts_(pts) {
+  CurveFigure(const std::vector<CurvePoint>& pts, const std::vector<PaperValue>* paper,
+              const std::vector<PeakRow>* peaks)
+      : pts_(pts), peaks_(peaks) {
     for (const auto& p : pts)
       if (std::find(series_.begin(), series_.end(), series_of(p)) == series_.end())
         series_.push_back(series_of(p));
@@ -160,6 +162,7 @@ class CurveFigure {
         lo = std::min(lo, v->first - v->second);
         hi = std::max(hi, v->first + v->second);
       }
+      for (const auto& box : peak_boxes(panel)) lo = std::min(lo, box.v_lo), hi = std::max(hi, box.v_hi);
       for (double r : replica_values(p, panel)) lo = std::min(lo, r), hi = std::max(hi, r);
     }
     for (const auto& v : overlay_)
@@ -214,10 +217,49 @@ class CurveFigure {
     }
   }
 
+  /// Each curve's peak on a panel: its angle and value with their 68 % intervals, its colour.
+  struct PeakBox {
+    double x, x_lo, x_hi, v, v_lo, v_hi;
+    const char* color;
+  };
+  std::vector<PeakBox> peak_boxes(int panel) const {
+    std::vector<PeakBox> out;
+    if (!peaks_) return out;
+    for (const auto& r : *peaks_) {
+      const std::string name = r.setting.empty() ? r.group : r.group + " " + r.setting;
+      const auto g = std::find(series_.begin(), series_.end(), name);
+      if (g == series_.end() || r.points < 3) continue;
+      const char* color = report::color(static_cast<std::size_t>(g - series_.begin()));
+      if (panel == 0) {
+        const double v = r.w_m_s * 1e3, e = r.peak.y_error() * 1e3;
+        out.push_back({r.peak.x, r.peak.x_low, r.peak.x_high, v, v - e, v + e, color});
+      } else if (r.r_acc) {
+        const double e = r.r_acc_err.value_or(0.0);
+        out.push_back({r.peak.x, r.peak.x_low, r.peak.x_high, *r.r_acc, *r.r_acc - e, *r.r_acc + e, color});
+      }
+    }
+    return out;
+  }
+
+  void draw_peaks(plot::Canvas& c, const Panel& pn, int panel) const {
+    for (const auto& b : peak_boxes(panel)) {
+      const double x0 = pn.px(b.x_lo), x1 = pn.px(b.x_hi), y0 = pn.py(b.v_hi), y1 = pn.py(b.v_lo);
+      const std::vector<double> dash{4, 3};
+      c.line(x0, y0, x1, y0, b.color, 1.2, dash, "peak");
+      c.line(x0, y1, x1, y1, b.color, 1.2, dash);
+      c.line(x0, y0, x0, y1, b.color, 1.2, dash);
+      c.line(x1, y0, x1, y1, b.color, 1.2, dash);
+      const double x = pn.px(b.x), y = pn.py(b.v);
+      c.line(x - 6, y - 6, x + 6, y + 6, b.color, 1.5);
+      c.line(x - 6, y + 6, x + 6, y - 6, b.color, 1.5);
+    }
+  }
+
   void draw_panel(plot::Canvas& c, int panel) const {
     const Panel pn = layout(panel);
     draw_axes(c, pn, panel);
     for (std::size_t g = 0; g < series_.size(); ++g) draw_series(c, pn, panel, g);
+    draw_peaks(c, pn, panel);
     const char* quantity = panel == 0 ? "mean_settling_velocity_m_s" : "r_acc";
     const double scale = panel == 0 ? 1e3 : 1.0;
     for (const auto& v : overlay_) {
@@ -260,10 +302,13 @@ class CurveFigure {
            (std::any_of(pts_.begin(), pts_.end(), [](const CurvePoint& p) { return p.n_replicas > 1; })
                 ? "; faint dots: replicas (seeds)"
                 : "") +
-           (any_without_error ? "; open markers: no error available" : "");
+           (any_without_error ? "; open markers: no error available" : "") +
+           (peaks_ && !peak_boxes(0).empty() ? "; dashed boxes: each curve's peak, 68 % in angle and value"
+                                             : "");
   }
 
   const std::vector<CurvePoint>& pts_;
+  const std::vector<PeakRow>* peaks_;
   std::vector<std::string> series_;
   std::vector<PaperValue> overlay_;
   std::string paper_groups_;
@@ -272,8 +317,9 @@ class CurveFigure {
 }  // namespace
 
 plot::Plot curve_plot(const std::vector<CurvePoint>& pts, const std::string& title,
-                      const std::vector<PaperValue>* paper, plot::Format format) {
-  const CurveFigure figure(pts, paper);
+                      const std::vector<PaperValue>* paper, plot::Format format,
+                      const std::vector<PeakRow>* peaks) {
+  const CurveFigure figure(pts, paper, peaks);
   return plot::render(1000, 470, format, [&](plot::Canvas& c) { figure.draw(c, title); });
 }
 

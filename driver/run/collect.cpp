@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "core/run_status.hpp"
 #include "driver/run/recording.hpp"
+#include "driver/run/refine_rounds.hpp"
 #include "driver/run/run_tree.hpp"
 #include "driver/run/slurm_commands.hpp"
 #include "driver/run/solver_process.hpp"
@@ -210,9 +211,11 @@ CollectResult collect_run_folders(Database& db, const Study& study, const fs::pa
 }
 
 int study_collect(const std::string& study_file, const std::string& db_path, int retries) {
-  const Study study = expand_study_file(study_file);
+  Study study = expand_study_file(study_file);
   Database db(db_path, OpenMode::kCreate);
   const fs::path root = runs_root(db_path);
+  // Points [refine] added (by study submit) are cases of the study: their folders are collected.
+  add_recorded_refinements(db, study);
   prepare_study_database(db, study, root);
   const CollectResult r = collect_run_folders(db, study, root);
   update_run_tree(study, db_path, root);

@@ -16,10 +16,12 @@
 #include "driver/report/listing_format.hpp"
 #include "driver/report/report_util.hpp"
 #include "driver/run/progress.hpp"
+#include "driver/run/refine_rounds.hpp"
 #include "driver/run/run_tree.hpp"
 #include "driver/run/runner.hpp"
 #include "driver/store/store.hpp"
 #include "driver/study/cost_model.hpp"
+#include "driver/study/refine.hpp"
 
 namespace fs = std::filesystem;
 
@@ -191,6 +193,49 @@ std::string plan_per_group(const Study& study, const nlohmann::json& rows) {
                      kListEveryCaseMax);
 }
 
+/// The most a study's [refine] may still add: per curve, the points max_points leaves, each with
+/// as many replicas as its group may run, at the cost of the curve's first case with refine's set
+/// applied; the rounds run one after another, the curves of a round side by side.
+struct RefineBudget {
+  long long cases = 0;
+  double core_s = 0.0, wall_s = 0.0;
+  report::TextTable table{{"group", "setting", "added", "may add", "core time at most"},
+                          {false, false, true, true, true}};
+  nlohmann::json rows = nlohmann::json::array();
+};
+
+RefineBudget refine_budget(const Study& study, const CostModel& model, int jobs, int ranks) {
+  RefineBudget b;
+  std::vector<std::vector<double>> rounds;  // rounds[r]: core-seconds of the cases of round r
+  for (const auto& curve : refine_series(study)) {
+    const int added =
+        static_cast<int>(std::count_if(curve.cases.begin(), curve.cases.end(), [](const StudyCase* c) {
+          return c->refine_round >= 0 && c->replica == 0;
+        }));
+    const int left = std::max(0, study.refine->max_points - added);
+    const auto plan = study.replica_plans.find(curve.group);
+    const int replicas = plan == study.replica_plans.end() ? 1 : plan->second.max;
+    const double point_s =
+        model.core_s(work_of(refined_case(study, curve, curve.first->params.gravity.angle_deg, 0)));
+    const long long cases = static_cast<long long>(left) * replicas;
+    b.cases += cases;
+    b.core_s += static_cast<double>(cases) * point_s;
+    for (int r = 0; r < left; ++r) {
+      if (rounds.size() <= static_cast<std::size_t>(r)) rounds.emplace_back();
+      for (int k = 0; k < replicas; ++k) rounds[static_cast<std::size_t>(r)].push_back(point_s);
+    }
+    b.table.add({curve.group, curve.setting.empty() ? "-" : curve.setting, std::to_string(added),
+                 std::to_string(cases), duration(static_cast<double>(cases) * point_s)});
+    b.rows.push_back({{"group", curve.group},
+                      {"setting", curve.setting},
+                      {"added_points", added},
+                      {"max_cases", cases},
+                      {"max_core_s", static_cast<double>(cases) * point_s}});
+  }
+  for (const auto& r : rounds) b.wall_s += study_wall_s(r, jobs, ranks);
+  return b;
+}
+
 /// What each scene's estimates rest on: its fitted runs, or the default model with its constants.
 void print_cost_models(const Study& study, const CostModel& model) {
   std::map<std::string, bool> scenes;
@@ -210,10 +255,11 @@ void print_cost_models(const Study& study, const CostModel& model) {
 int study_plan(const PlanOptions& opt) {
   const ListingFormat format = parse_listing_format(opt.format);
   if (opt.jobs < 1 || opt.ranks < 1) throw InputError("--jobs and --ranks must be at least 1");
-  const Study study = expand_study_file(opt.study_file);
+  Study study = expand_study_file(opt.study_file);
   // The plan reads an existing database and creates none.
   std::optional<Database> db;
   if (!opt.db_path.empty() && fs::exists(opt.db_path)) db.emplace(opt.db_path, OpenMode::kReadOnly);
+  if (db) add_recorded_refinements(*db, study);
   std::map<std::string, CaseState> states;
   std::vector<MeasuredCost> finished;
   if (db) {
@@ -225,20 +271,25 @@ int study_plan(const PlanOptions& opt) {
   const CostModel model(finished);
   const PlanRows plan = plan_rows(study, opt, states, finished, model);
   const double wall = study_wall_s(plan.pending_costs, opt.jobs, opt.ranks);
+  const RefineBudget refine = refine_budget(study, model, opt.jobs, opt.ranks);
   if (format == ListingFormat::kCsv) {
     std::fputs(plan_csv(plan.rows).c_str(), stdout);
     return 0;
   }
   if (format == ListingFormat::kJson) {
-    std::printf("%s\n", nlohmann::json{{"study", study.name},
-                                       {"cases", plan.rows},
-                                       {"jobs", opt.jobs},
-                                       {"ranks", opt.ranks},
-                                       {"remaining_cases", plan.pending_costs.size()},
-                                       {"estimated_wall_s", wall},
-                                       {"estimated_core_s_all_cases", plan.total_core_s}}
-                            .dump(1)
-                            .c_str());
+    nlohmann::json j{{"study", study.name},
+                     {"cases", plan.rows},
+                     {"jobs", opt.jobs},
+                     {"ranks", opt.ranks},
+                     {"remaining_cases", plan.pending_costs.size()},
+                     {"estimated_wall_s", wall},
+                     {"estimated_core_s_all_cases", plan.total_core_s}};
+    if (study.refine)
+      j["refinement"] = {{"max_cases", refine.cases},
+                         {"max_core_s", refine.core_s},
+                         {"max_wall_s", refine.wall_s},
+                         {"curves", refine.rows}};
+    std::printf("%s\n", j.dump(1).c_str());
     return 0;
   }
   std::printf("study %s: %s, %zu to run\n", study.name.c_str(),
@@ -251,6 +302,16 @@ int study_plan(const PlanOptions& opt) {
   std::printf("estimated wall time of the cases to run: %s on %s x %s (parallel efficiency %.2f)\n",
               duration(wall).c_str(), count_of(opt.jobs, "job").c_str(), count_of(opt.ranks, "rank").c_str(),
               ranks_efficiency(opt.ranks));
+  if (study.refine) {
+    std::printf(
+        "[refine] may add at most %s to its curves (max_points %d a curve, each point with its replicas), "
+        "estimated at most %s of core time, %s of wall time on %s x %s after the cases above; at most %s "
+        "all told:\n%s",
+        count_of(refine.cases, "case").c_str(), study.refine->max_points, duration(refine.core_s).c_str(),
+        duration(refine.wall_s).c_str(), count_of(opt.jobs, "job").c_str(),
+        count_of(opt.ranks, "rank").c_str(), duration(wall + refine.wall_s).c_str(),
+        refine.table.str().c_str());
+  }
   print_cost_models(study, model);
   return 0;
 }

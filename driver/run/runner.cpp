@@ -14,11 +14,14 @@
 #include "core/error.hpp"
 #include "driver/report/curve.hpp"
 #include "driver/report/curve_query.hpp"
+#include "driver/report/peak.hpp"
+#include "driver/report/peak_query.hpp"
 #include "driver/report/report_util.hpp"
 #include "driver/report/validation_query.hpp"
 #include "driver/run/collect.hpp"
 #include "driver/run/plan.hpp"
 #include "driver/run/progress.hpp"
+#include "driver/run/refine_rounds.hpp"
 #include "driver/run/replica_rounds.hpp"
 #include "driver/run/run_tree.hpp"
 #include "driver/run/scheduler.hpp"
@@ -32,15 +35,53 @@
 namespace fs = std::filesystem;
 
 namespace boycott::driver {
+namespace {
+
+/// The cases the next round adds: replicas first (a point's error decides the refinement), then
+/// refined points; none when neither has any to add.
+std::vector<StudyCase> next_round(Database& db, const Study& s, int retries, std::set<std::string>& told) {
+  if (has_replica_target(s)) {
+    const ReplicaRound round = next_replica_round(db, s);
+    if (!round.added.empty()) {
+      std::fprintf(stderr, "replicas: %zu points get one more (%d within the target, %d at replicas_max)\n",
+                   round.added.size(), round.precise, round.at_max);
+      return round.added;
+    }
+  }
+  if (!s.refine) return {};
+  const RefineRound round = next_refine_round(db, s, retries);
+  print_refine_round(round, told);
+  return round.added;
+}
+
+/// The settling curve where the study has one, with its peaks under [refine]; otherwise (ergun,
+/// single_particle, channel_flow, sediment_transport) each finished case's validation errors
+/// against their tolerances.
+void print_study_results(Database& db, const Study& study, int done) {
+  const auto curve = query_curve(db, study.name);
+  if (curve.empty() && done > 0) {
+    std::fputs(format_validation(query_validation(db, study.name), ListingFormat::kTable).c_str(), stdout);
+    return;
+  }
+  std::fputs(format_curve(curve, ListingFormat::kTable).c_str(), stdout);
+  if (study.refine && !curve.empty()) {
+    std::printf("peak (query peak):\n");
+    std::fputs(format_peak(query_peak(db, study.name), ListingFormat::kTable).c_str(), stdout);
+  }
+}
+
+}  // namespace
 
 int study_run(const StudyRunOptions& opt) {
   if (opt.jobs < 1) throw InputError(fmt::format("--jobs = {} must be >= 1", opt.jobs));
   if (opt.retries < 0) throw InputError(fmt::format("--retries = {} must be >= 0", opt.retries));
   if (opt.ranks < 1) throw InputError(fmt::format("--ranks = {} must be >= 1", opt.ranks));
   // The whole study is expanded and validated before the database is touched.
-  const Study study = expand_study_file(opt.study_file);
+  Study study = expand_study_file(opt.study_file);
   Database db(opt.db_path, OpenMode::kCreate);
   const fs::path root = runs_root(opt.db_path);
+  // The points [refine] added in earlier runs are cases of the study as its file lists them.
+  add_recorded_refinements(db, study);
   prepare_study_database(db, study, root);
   // What Slurm tasks (study submit) left in the run folders; the cases still in Slurm jobs stay
   // theirs.
@@ -69,21 +110,21 @@ int study_run(const StudyRunOptions& opt) {
   scheduler.set_planned_case_wall_s(plan.mean_case_wall_s);
   bool stopped = scheduler.run();
   std::string storage_stop = scheduler.storage_stop();
-  // replicas_target_rel_error: more replicas, round by round, where the scatter is too large.
+  // Rounds: replicas where a point's scatter is too large (replicas_target_rel_error), then
+  // points where a curve's peak is not known well enough ([refine]), until neither adds a case.
   Study grown = study;
-  while (!stopped && storage_stop.empty() && has_replica_target(grown)) {
-    const ReplicaRound round = next_replica_round(db, grown);
-    if (round.added.empty()) break;
-    std::fprintf(stderr, "replicas: %zu points get one more (%d within the target, %d at replicas_max)\n",
-                 round.added.size(), round.precise, round.at_max);
-    grown.cases.insert(grown.cases.end(), round.added.begin(), round.added.end());
+  std::set<std::string> told;
+  while (!stopped && storage_stop.empty()) {
+    std::vector<StudyCase> more = next_round(db, grown, opt.retries, told);
+    if (more.empty()) break;
+    grown.cases.insert(grown.cases.end(), more.begin(), more.end());
     register_study(db, grown);
     update_run_tree(grown, opt.db_path, root);
     auto more_states = case_states(db, grown.name, opt.retries);
     std::erase_if(more_states, [&](const CaseState& s) { return collected.in_slurm.count(s.id) > 0; });
-    Scheduler more(db, grown, more_states, opt, root, solver);
-    stopped = more.run();
-    storage_stop = more.storage_stop();
+    Scheduler more_runs(db, grown, more_states, opt, root, solver);
+    stopped = more_runs.run();
+    storage_stop = more_runs.storage_stop();
   }
   if (!storage_stop.empty()) {
     std::fprintf(stderr, "error: study %s stopped: %s; once the storage works again, run the same command\n",
@@ -104,13 +145,7 @@ int study_run(const StudyRunOptions& opt) {
   }
   std::printf("study %s: %d of %s done, %d failed\n", study.name.c_str(), done,
               count_of(n_total, "case").c_str(), failed);
-  // The settling curve where the study has one; otherwise (ergun, single_particle, channel_flow,
-  // sediment_transport) each finished case's validation errors against their tolerances.
-  const auto curve = query_curve(db, study.name);
-  if (!curve.empty() || done == 0)
-    std::fputs(format_curve(curve, ListingFormat::kTable).c_str(), stdout);
-  else
-    std::fputs(format_validation(query_validation(db, study.name), ListingFormat::kTable).c_str(), stdout);
+  print_study_results(db, study, done);
   return failed > 0 ? kExitFailure : kExitOk;
 }
 
@@ -131,7 +166,7 @@ std::vector<CaseState> case_states_now(Database& db, const std::string& db_path,
 
 int study_status(const std::string& study_file, const std::string& db_path, int retries,
                  ListingFormat format) {
-  const Study study = expand_study_file(study_file);
+  Study study = expand_study_file(study_file);
   // A status reads a database and creates none: a missing one is most likely a mistyped path
   // (the cases of a study not yet run are listed by `study plan`).
   if (!fs::exists(db_path))
@@ -141,6 +176,7 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
                     db_path, study_file));
   std::optional<Database> db;
   db.emplace(db_path, OpenMode::kReadOnly);
+  add_recorded_refinements(*db, study);
   std::map<std::string, CaseState> known;
   for (auto& s : case_states_now(*db, db_path, study.name, retries)) known[s.id] = s;
   // Cases submitted to Slurm (study submit): their array task and, where squeue answers, its state.

@@ -20,6 +20,7 @@
 #include "core/error.hpp"
 #include "core/version.hpp"
 #include "driver/run/collect.hpp"
+#include "driver/run/refine_rounds.hpp"
 #include "driver/run/run_tree.hpp"
 #include "driver/run/slurm_commands.hpp"
 #include "driver/run/solver_process.hpp"
@@ -301,10 +302,11 @@ fs::path submission_folder(const std::string& db_path, const std::string& study)
 
 /// The cases a dry run would submit: neither done nor failed in the database as it is (none yet:
 /// every case). Reads only.
-std::vector<const StudyCase*> pending_dry_run(const Study& study, const std::string& db_path, int retries) {
+std::vector<const StudyCase*> pending_dry_run(Study& study, const std::string& db_path, int retries) {
   std::map<std::string, CaseStatus> status;
   if (fs::exists(db_path)) {
     Database db(db_path, OpenMode::kReadOnly);
+    add_recorded_refinements(db, study);
     for (const auto& s : case_states(db, study.name, retries)) status[s.id] = s.status;
   }
   std::vector<const StudyCase*> pending;
@@ -349,6 +351,21 @@ std::vector<const StudyCase*> pending_to_submit(Database& db, const Study& study
   return pending;
 }
 
+/// The cases to submit (pending_to_submit) with the points [refine] recorded before, and those its
+/// next round adds where a curve's cases have all finished: each submit/collect round adds the
+/// next points.
+std::vector<const StudyCase*> submittable(Database& db, Study& study, const fs::path& root, int retries) {
+  add_recorded_refinements(db, study);
+  auto pending = pending_to_submit(db, study, root, retries);
+  if (!study.refine) return pending;
+  const RefineRound round = next_refine_round(db, study, retries);
+  std::set<std::string> told;
+  print_refine_round(round, told);
+  if (round.added.empty()) return pending;
+  study.cases.insert(study.cases.end(), round.added.begin(), round.added.end());
+  return pending_to_submit(db, study, root, retries);
+}
+
 /// Writes the pending cases' case files, the tasks file and the script, and submits the script;
 /// returns the job id sbatch gave.
 std::int64_t submit_array(const std::vector<const StudyCase*>& pending, const ScriptPaths& paths,
@@ -375,15 +392,15 @@ std::int64_t submit_array(const std::vector<const StudyCase*>& pending, const Sc
 
 int study_submit(const SlurmSubmitOptions& opt) {
   validate(opt);
-  const Study study = expand_study_file(opt.study_file);
+  Study study = expand_study_file(opt.study_file);
   const std::string db_path = fs::absolute(opt.db_path).lexically_normal().string();
   const fs::path root = runs_root(db_path);
   auto solver = solver_argv(opt.solver_command);
 
   std::optional<Database> db;
   if (!opt.dry_run) db.emplace(db_path, OpenMode::kCreate);
-  const std::vector<const StudyCase*> pending =
-      db ? pending_to_submit(*db, study, root, opt.retries) : pending_dry_run(study, db_path, opt.retries);
+  std::vector<const StudyCase*> pending =
+      db ? submittable(*db, study, root, opt.retries) : pending_dry_run(study, db_path, opt.retries);
   if (pending.empty()) {
     std::printf("study %s: nothing to submit\n", study.name.c_str());
     return 0;

@@ -71,7 +71,8 @@ void move_case_rows(Database& db, const OldCase& c, const fs::path& runs_root) {
         "DELETE FROM study_cases WHERE case_id = ?1",
         "UPDATE OR IGNORE case_values SET case_id = ?2 WHERE case_id = ?1",
         "DELETE FROM case_values WHERE case_id = ?1", "UPDATE results SET case_id = ?2 WHERE case_id = ?1",
-        "UPDATE attempts SET case_id = ?2 WHERE case_id = ?1"})
+        "UPDATE attempts SET case_id = ?2 WHERE case_id = ?1",
+        "UPDATE refined_points SET case_id = ?2 WHERE case_id = ?1"})
     db.prepare(sql).bind(1, c.id).bind(2, c.new_id).run();
   // The attempts' folders moved with the case (unless it merged into another's).
   if (!fs::exists(runs_root / c.id))

@@ -49,34 +49,38 @@ void register_study(Database& db, const Study& s) {
     // Membership follows the study file as it is now (groups may have been renamed).
     db.prepare("DELETE FROM study_cases WHERE study = ?1").bind(1, s.name).run();
     std::int64_t pos = 0;
-    for (const auto& c : s.cases) {
-      // The same case may come back with a raised time.end (not part of its identity): the stored
-      // parameters follow the study, so that a result short of the new end is no longer done.
-      db.prepare(
-            "INSERT INTO cases(id, scene, angle_deg, params_json, created_at) VALUES (?1,?2,?3,?4,?5) "
-            "ON CONFLICT(id) DO UPDATE SET params_json = excluded.params_json")
-          .bind(1, c.id)
-          .bind(2, c.params.scene)
-          .bind(3, c.params.gravity.angle_deg)
-          .bind(4, to_json(c.params).dump())
-          .bind(5, now)
-          .run();
-      db.prepare(
-            "INSERT OR IGNORE INTO study_cases(study, group_name, case_id, position) VALUES (?1,?2,?3,?4)")
-          .bind(1, s.name)
-          .bind(2, c.group)
-          .bind(3, c.id)
-          .bind(4, pos++)
-          .run();
-      for (const auto& [k, v] : c.swept)
-        db.prepare("INSERT OR IGNORE INTO case_values(case_id, key, value, value_num) VALUES (?1,?2,?3,?4)")
-            .bind(1, c.id)
-            .bind(2, k)
-            .bind(3, v)
-            .bind(4, number_of(v))
-            .run();
-    }
+    for (const auto& c : s.cases) write_case_rows(db, s.name, c, pos++, now);
   });
+}
+
+void write_case_rows(Database& db, const std::string& study, const StudyCase& c,
+                     std::optional<std::int64_t> position, const std::string& now) {
+  // The same case may come back with a raised time.end (not part of its identity): the stored
+  // parameters follow the study, so that a result short of the new end is no longer done.
+  db.prepare(
+        "INSERT INTO cases(id, scene, angle_deg, params_json, created_at) VALUES (?1,?2,?3,?4,?5) "
+        "ON CONFLICT(id) DO UPDATE SET params_json = excluded.params_json")
+      .bind(1, c.id)
+      .bind(2, c.params.scene)
+      .bind(3, c.params.gravity.angle_deg)
+      .bind(4, to_json(c.params).dump())
+      .bind(5, now)
+      .run();
+  db.prepare(
+        "INSERT OR IGNORE INTO study_cases(study, group_name, case_id, position) VALUES (?1, ?2, ?3, "
+        "IFNULL(?4, (SELECT IFNULL(MAX(position), -1) + 1 FROM study_cases WHERE study = ?1)))")
+      .bind(1, study)
+      .bind(2, c.group)
+      .bind(3, c.id)
+      .bind(4, position)
+      .run();
+  for (const auto& [k, v] : c.swept)
+    db.prepare("INSERT OR IGNORE INTO case_values(case_id, key, value, value_num) VALUES (?1,?2,?3,?4)")
+        .bind(1, c.id)
+        .bind(2, k)
+        .bind(3, v)
+        .bind(4, number_of(v))
+        .run();
 }
 
 std::int64_t begin_attempt(Database& db, const std::string& case_id, int ranks, const std::string& run_dir) {

@@ -15,6 +15,10 @@ namespace boycott::driver {
 
 /// Inserts the study, its cases and their swept values (existing cases are kept as they are).
 void register_study(Database& db, const Study& s);
+/// Inside a transaction: the case's row (its parameters updated if it exists), its membership of
+/// `study` at `position` (unset: after the study's last) and its swept values.
+void write_case_rows(Database& db, const std::string& study, const StudyCase& c,
+                     std::optional<std::int64_t> position, const std::string& now);
 
 /// Opens an attempt; closes any attempt of the case left open by a driver that died.
 std::int64_t begin_attempt(Database& db, const std::string& case_id, int ranks, const std::string& run_dir);

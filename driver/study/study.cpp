@@ -17,6 +17,7 @@
 #include "core/key_docs.hpp"
 #include "core/scene_specs.hpp"
 #include "core/toml_lookup.hpp"
+#include "driver/study/refine.hpp"
 
 namespace boycott::driver {
 namespace {
@@ -375,17 +376,65 @@ void expand_group(Study& s, const Group& g, const CaseParams& base, const std::v
     }
 }
 
+/// Refuses a study of more than kMaxStudyCases cases before any is expanded: one sentence with
+/// the count and the limit.
+void check_case_count(const std::string& study, const std::vector<Group>& groups,
+                      const std::vector<Axis>& axes, const std::map<std::string, ReplicaPlan>& plans) {
+  long double total = 0;
+  for (const auto& g : groups) {
+    long double n = plans.at(g.name).replicas;
+    for (const auto* list : {&g.axes, &axes})
+      for (const auto& ax : *list) n *= static_cast<long double>(ax.points.size());
+    total += n;
+  }
+  if (total > static_cast<long double>(kMaxStudyCases))
+    throw InputError(
+        fmt::format("study '{}' expands to {:.0f} cases, more than the {} a study may hold: split it into "
+                    "several studies",
+                    study, static_cast<double>(total), kMaxStudyCases));
+}
+
+/// Whether group g sweeps the refined key; if it does, every key zipped with it must be in
+/// refine's set (an added angle needs its own value of them), and max_r_acc needs a 90 deg point.
+bool check_refine_axes(const RefinePlan& plan, const Group& g, const std::vector<Axis>& study_axes) {
+  for (const auto* list : {&g.axes, &study_axes})
+    for (const auto& ax : *list) {
+      const auto at = std::find(ax.keys.begin(), ax.keys.end(), plan.key);
+      if (at == ax.keys.end()) continue;
+      for (const auto& k : ax.keys)
+        if (k != plan.key &&
+            std::none_of(plan.set.begin(), plan.set.end(), [&](const auto& kv) { return kv.first == k; }))
+          throw InputError(fmt::format(
+              "[refine]: '{}' is zipped with '{}' (group '{}'): give the added points' value in [refine] set",
+              k, plan.key, g.name));
+      const auto col = static_cast<std::size_t>(at - ax.keys.begin());
+      const bool has_90 =
+          std::any_of(ax.points.begin(), ax.points.end(), [&](const std::vector<StudyValue>& pt) {
+            return pt[col].node->value<double>().value_or(-1.0) == 90.0;
+          });
+      if (plan.objective == "max_r_acc" && !has_90)
+        throw InputError(
+            fmt::format("[refine]: objective = \"max_r_acc\" needs a 90 deg point in every curve (r_acc "
+                        "divides by it); group '{}' "
+                        "has none",
+                        g.name));
+      return true;
+    }
+  return false;
+}
+
 /// The expansion of a parsed study; `at_group` follows the [[group]] being read or expanded, so
 /// that an error in a key's value can be traced to its line.
 Study expand_study(const toml::table& root, const std::string& text, const std::string& origin,
                    std::optional<std::size_t>& at_group) {
   static const std::set<std::string> kTopKeys = {
-      "name", "base", "group", "matrix", "zip", "replicas", "replicas_max", "replicas_target_rel_error"};
+      "name",  "base", "group", "matrix", "zip", "replicas", "replicas_max", "replicas_target_rel_error",
+      "refine"};
   for (const auto& [k, node] : root)
     if (!kTopKeys.count(std::string(k.str())))
       throw InputError(
           fmt::format("{}: unknown study key '{}' (expected name, base, group, matrix, zip, replicas, "
-                      "replicas_target_rel_error, replicas_max)",
+                      "replicas_target_rel_error, replicas_max, refine)",
                       origin, k.str()));
   const ReplicaKeys study_replicas = read_replica_keys(root, origin);
 
@@ -400,13 +449,21 @@ Study expand_study(const toml::table& root, const std::string& text, const std::
   const std::vector<Group> groups = read_groups(root, origin, at_group);
   const auto axes = read_axes(root);
   std::map<std::string, std::string> seen;  // id -> "group (values)"
+  for (const auto& g : groups)
+    s.replica_plans[g.name] = resolve_replicas(study_replicas, g.replicas, fmt::format("group '{}'", g.name));
+  check_case_count(s.name, groups, axes, s.replica_plans);
+  s.refine = read_refine_plan(text, origin);
+  bool refined = false;
   for (const auto& g : groups) {
     at_group = g.index;
     s.groups.push_back(g.name);
-    const ReplicaPlan plan = resolve_replicas(study_replicas, g.replicas, fmt::format("group '{}'", g.name));
-    s.replica_plans[g.name] = plan;
-    expand_group(s, g, base, axes, plan, seen);
+    if (s.refine) refined = check_refine_axes(*s.refine, g, axes) || refined;
+    expand_group(s, g, base, axes, s.replica_plans[g.name], seen);
   }
+  if (s.refine && !refined)
+    throw InputError(
+        fmt::format("[refine]: key '{}' is swept by no group ([matrix] or [zip], the study's or a group's)",
+                    s.refine->key));
   return s;
 }
 

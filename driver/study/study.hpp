@@ -23,6 +23,8 @@ struct StudyCase {
   /// it is without replicas, and point_id is its id.
   int replica = 0;
   std::string point_id;
+  /// -1 for a case the study file lists; k for a point [refine] added in round k of its curve.
+  int refine_round = -1;
 };
 
 /// How many replicas each point of a group runs: `replicas = N` (top level or in a [[group]]);
@@ -36,12 +38,32 @@ struct ReplicaPlan {
   static constexpr int kStageOneMin = 3;  ///< replicas an adaptive point starts with, at least
 };
 
+/// A study's [refine] table (driver/study/refine.hpp): points of `key` added around each curve's
+/// maximum until its position is known to `resolution` (68 %), the points around it cannot be told
+/// apart, or `max_points` are added.
+struct RefinePlan {
+  std::string key;
+  std::string objective = "max_abs_settling";  ///< or max_r_acc
+  double resolution = 0.0;
+  int max_points = 4;
+  /// Keys set on the added points (those zipped with `key`: a new angle's time.end), TOML text.
+  std::vector<std::pair<std::string, std::string>> set;
+  static constexpr int kMaxPointsLimit = 50;
+};
+
+/// A study may list at most this many cases (groups x matrix x zip x replicas): every command
+/// holds each case's parameters (1.1 kB) and checks each one, 3-4.5 kB and 0.1-0.15 ms of CPU a
+/// case all told (docs/performance.md, "Large studies"); a larger one is refused, from its axes'
+/// lengths, before a case is made or anything is written.
+inline constexpr long long kMaxStudyCases = 100000;
+
 struct Study {
   std::string name;
   std::string source_text;          ///< the study file as read, stored in the database
   std::vector<std::string> groups;  ///< in file order
   std::vector<StudyCase> cases;     ///< group by group, matrix x zip within each, then replicas
   std::map<std::string, ReplicaPlan> replica_plans;  ///< by group
+  std::optional<RefinePlan> refine;
 };
 
 /// Replica k of the point whose replica 0 is `replica0`: the same case with seed + k. InputError

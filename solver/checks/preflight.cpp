@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/scene_specs.hpp"
 #include "coupling/drag_laws.hpp"
+#include "coupling/drag_stability.hpp"
 
 namespace boycott::checks {
 
@@ -173,6 +174,31 @@ double check_settling_scales(const CaseParams& p, Preflight& r) {
   return wt;
 }
 
+/// The exchange of a packed bed (random close packing, alpha_f 0.36, slip -> 0): the step its
+/// particles allow (coupling/drag_stability.hpp) against time.dt_cfd.
+void check_packed_exchange(const CaseParams& p, Preflight& r) {
+  constexpr double kPackedAlphaF = 0.36;
+  const double d = p.particles.diameter_m, rho_f = p.fluid.density_kg_m3, mu = p.fluid.viscosity_pa_s;
+  const double beta = coupling::visit_drag_law(
+      p.forces.drag, [&](const auto& law) { return law.beta(kPackedAlphaF, 0.0, d, rho_f, mu); });
+  const double m_added = p.forces.added_mass ? 0.5 * rho_f * p.particle_volume_m3() : 0.0;
+  const double bound = coupling::drag_stable_dt_s(kPackedAlphaF, (p.particle_mass_kg() + m_added) / beta);
+  add_item(r, "packed_bed_stable_dt", bound, "s",
+           "largest dt_cfd of a stable exchange in a packed bed (alpha_f 0.36)");
+  if (bound >= p.time.dt_cfd_s) return;
+  if (p.numerics.drag_dt_limit)
+    r.warnings.push_back(fmt::format(
+        "where the particles pack (alpha_f ~0.36) the CFD step is cut from time.dt_cfd = {:.3g} s to "
+        "about {:.3g} s (numerics.drag_dt_limit): up to {:.1f}x the fluid's cost there",
+        p.time.dt_cfd_s, bound, p.time.dt_cfd_s / bound));
+  else
+    r.warnings.push_back(fmt::format(
+        "numerics.drag_dt_limit = false and time.dt_cfd = {:.3g} s exceeds the {:.3g} s a packed bed's "
+        "particle-fluid exchange is stable at: a bed that forms will oscillate step by step until the "
+        "run stops with alpha_f outside (0, 1]",
+        p.time.dt_cfd_s, bound));
+}
+
 /// Contacts: resolution of a binary collision and the overlap at the impact speed (the terminal
 /// speed `wt` in a fluid, a fall across the channel width when dry).
 void check_contacts(const CaseParams& p, double wt, Preflight& r) {
@@ -247,6 +273,7 @@ Preflight preflight(const CaseParams& p, int ranks) {
   if (fluid) check_kernel_resolution(p, r);
   if (!sc.particles_move) return r;
   const double wt = fluid && p.forces.drag != "none" ? check_settling_scales(p, r) : 0.0;
+  if (fluid && p.forces.drag != "none") check_packed_exchange(p, r);
   check_contacts(p, wt, r);
   check_likely_slips(p, fluid, r);
   return r;

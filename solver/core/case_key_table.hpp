@@ -162,6 +162,8 @@ void visit_keys(P& p, V&& visitor) {
     "how the fluid is read at the particles (trilinear: from each field's own nodes, wall rules)");
   v("numerics.vorticity", p.numerics.vorticity, choice(vorticity_names()),
     "where the lift's vorticity is formed (cell_centres: 2-cell central; edges: compact)");
+  v("numerics.drag_dt_limit", p.numerics.drag_dt_limit, any(),
+    "lower dt_cfd where packed particles would relax past the fluid's lagged counterflow");
 
   v("output.timeseries_every", p.output.timeseries_every_s, optional(positive("s")),
     "simulated time between rows of timeseries.csv (unset: every step)");
@@ -192,10 +194,11 @@ struct LateKey {
   const char* key;
   const char* old_behaviour;  ///< the value as JSON text (valid TOML too)
 };
-inline constexpr std::array<LateKey, 4> kLateKeys{{{"numerics.sampling", "\"kernel\""},
+inline constexpr std::array<LateKey, 5> kLateKeys{{{"numerics.sampling", "\"kernel\""},
                                                    {"numerics.simple_correctors", "1"},
                                                    {"forces.lift", "\"saffman\""},
-                                                   {"numerics.vorticity", "\"cell_centres\""}}};
+                                                   {"numerics.vorticity", "\"cell_centres\""},
+                                                   {"numerics.drag_dt_limit", "false"}}};
 
 /// Sets one key from its TOML text (a bare word is a string); false for an unknown key
 /// (case_parse.cpp).

@@ -118,10 +118,17 @@ CoupledStep CoupledSystem::step() {
   if (interrupted_) throw std::logic_error("CoupledSystem::step after an interrupted step");
   // One count over ranks per step (a collective), for the test below and the stop checks.
   const double per_substep = interrupt_ ? work_per_substep() : 0.0;
-  const bool long_step = opt_.move_particles && interrupt_ &&
-                         static_cast<double>(st.dem_substeps) * per_substep >= kLongStepParticleSteps;
-  if (long_step) start_of_step_ = {dem_->export_state(), coupler_->export_state()};
+  auto is_long = [&](int substeps) {
+    return opt_.move_particles && interrupt_ &&
+           static_cast<double>(substeps) * per_substep >= kLongStepParticleSteps;
+  };
+  // The state an interrupted step restarts from is the one before prepare, whose drag may still
+  // shorten the step: keep it whenever the step before that shortening would be long.
+  if (is_long(st.dem_substeps)) start_of_step_ = {dem_->export_state(), coupler_->export_state()};
   coupler_->prepare(*dem_, *fluid_, dt_prev_);
+  limit_by_drag(st);
+  stop_at_end(st);
+  const bool long_step = is_long(st.dem_substeps);
   if (!advance_particles(st, long_step, per_substep)) return st;
   check_particles_finite(st.dt_s);
   coupler_->deposit(*dem_, *fluid_, st.dt_s);
@@ -139,6 +146,29 @@ double CoupledSystem::step_size(int& dem_substeps) const {
     dt = dem_substeps * dt_dem;
   }
   return dt;
+}
+
+void CoupledSystem::limit_by_drag(CoupledStep& st) const {
+  // Packed particles that relax past the fluid's lagged counter-flow within one step make it
+  // oscillate step by step (coupling/drag_stability.hpp): the step they allow, in whole DEM
+  // sub-steps, at least one.
+  // A held bed does not relax, so it has no such mode.
+  const double bound = coupler_->totals().drag_stable_dt_s;
+  if (!opt_.move_particles || !(bound < st.dt_s)) return;
+  st.dem_substeps = std::max(1, static_cast<int>(std::floor(bound / p_.time.dt_dem_s + 1e-9)));
+  st.dt_s = st.dem_substeps * p_.time.dt_dem_s;
+}
+
+void CoupledSystem::stop_at_end(CoupledStep& st) const {
+  // A step cut below time.dt_cfd (CFL, packed beds) need not divide the run: the last one ends
+  // at time.end instead of a DEM sub-step or more past it. Rounded to whole sub-steps, so a run
+  // whose steps divide it (time_ a sum of dt_cfd, off by round-off) keeps its last full step.
+  const double left = p_.time.end_s - time_;
+  if (!opt_.move_particles || !(left > 0.0)) return;
+  const auto substeps = static_cast<int>(std::llround(left / p_.time.dt_dem_s));
+  if (substeps < 1 || substeps >= st.dem_substeps) return;
+  st.dem_substeps = substeps;
+  st.dt_s = substeps * p_.time.dt_dem_s;
 }
 
 bool CoupledSystem::advance_particles(CoupledStep& st, bool long_step, double per_substep) {

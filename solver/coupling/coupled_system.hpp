@@ -129,6 +129,10 @@ class CoupledSystem {
   // The parts of step(), in order.
   /// The step (s): at most time.dt_cfd and CFL-limited, a whole number (set) of DEM sub-steps.
   double step_size(int& dem_substeps) const;
+  /// Shortens the step to what the exchange of packed particles allows (numerics.drag_dt_limit).
+  void limit_by_drag(CoupledStep& st) const;
+  /// Shortens the last step to end at time.end.
+  void stop_at_end(CoupledStep& st) const;
   /// The sub-steps (or, frozen bed, the drag impulse they would take); false when a stop request
   /// interrupted a long step.
   bool advance_particles(CoupledStep& st, bool long_step, double per_substep);

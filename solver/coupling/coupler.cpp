@@ -23,6 +23,7 @@ CouplingSettings CouplingSettings::from_case(const CaseParams& p) {
   s.kernel = kernel_from_name(p.numerics.void_fraction_kernel);
   s.sampling = sampling_from_name(p.numerics.sampling);
   s.edge_vorticity = edge_vorticity_from_name(p.numerics.vorticity);
+  s.drag_dt_limit = p.numerics.drag_dt_limit;
   s.rho_f_kg_m3 = p.fluid.density_kg_m3;
   s.mu_pa_s = p.fluid.viscosity_pa_s;
   s.top_slip = p.domain.top_wall == "slip";

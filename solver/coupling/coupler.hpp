@@ -20,6 +20,7 @@
 // steady state it vanishes, and over a run it sums to roughly the difference of its end values.
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -50,6 +51,7 @@ struct CouplingSettings {
   KernelKind kernel = KernelKind::trilinear_smoothed;
   Sampling sampling = Sampling::kernel;  ///< how the fluid is read at the particles (sampling.hpp)
   bool edge_vorticity = false;           ///< numerics.vorticity = "edges" (fluid_fields.hpp)
+  bool drag_dt_limit = false;            ///< numerics.drag_dt_limit: prepare finds drag_stable_dt_s
   double rho_f_kg_m3 = 1000.0, mu_pa_s = 1.0e-3;
   bool top_slip = false;
   /// The case's [forces], [fluid], numerics.void_fraction_kernel and numerics.sampling.
@@ -70,6 +72,9 @@ struct ExchangeTotals {
   /// viscous force F_pv read at the new level. Measured by prepare beside the lag (N s), not fed
   /// back; zero with "kernel". A momentum budget closes with lag + mismatch.
   std::array<double, 3> sampling_mismatch_ns{};
+  /// Largest CFD step the exchange of the last prepare's packed particles stays stable at
+  /// (drag_stability.hpp), s; infinity with none, or with numerics.drag_dt_limit off.
+  double drag_stable_dt_s = std::numeric_limits<double>::infinity();
   double min_alpha_f = 1.0;  ///< smallest and largest cell fluid fraction after the last deposit
   double max_alpha_f = 1.0;
 };

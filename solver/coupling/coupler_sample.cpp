@@ -2,14 +2,19 @@
 // particle side of the coupling hook set from it: implicit drag, added mass, and the explicit
 // pressure-gradient, viscous, lift and added-mass forces; the time-level lag and the sampling
 // mismatch measured on the way (coupler.hpp).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <vector>
+
+#include <mpi.h>
 
 #include "core/constants.hpp"
 #include "core/timers.hpp"
 #include "coupling/coupler.hpp"
 #include "coupling/drag_laws.hpp"
+#include "coupling/drag_stability.hpp"
 #include "coupling/stencil_sums.hpp"
 #include "fluid/fluid_solver.hpp"
 #include "particles/dem_system.hpp"
@@ -184,6 +189,7 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
   const bool linear = s_.sampling == Sampling::trilinear;
   std::vector<double> lag(3, 0.0);       // this rank's share of totals_.lag_impulse_ns
   std::vector<double> mismatch(3, 0.0);  // and of totals_.sampling_mismatch_ns
+  double stable_dt = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < p.n_local; ++i) {
     const double px = p.x[i] - lo[0], py = p.y[i] - lo[1], pz = p.z[i] - lo[2];
     const Stencil st = stencil(px, py, pz);
@@ -208,6 +214,8 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
     p.ufx[i] = f.uf[0], p.ufy[i] = f.uf[1], p.ufz[i] = f.uf[2];
     double fe[3] = {f.fe[0], f.fe[1], f.fe[2]}, react[3] = {0.0, 0.0, 0.0}, fl[3] = {0.0, 0.0, 0.0};
     add_explicit_forces(p, i, slip_v, w, d, vp, f, fe, react, fl);
+    if (s_.drag_dt_limit)
+      stable_dt = std::min(stable_dt, drag_stable_dt_s(alpha_f, (p.mass[i] + p.madd[i]) / p.beta[i]));
     if (budget_) add_to_budget(p.y[i], fl, f, p.madd[i], slip, w, d);
     p.v0x[i] = p.vx[i], p.v0y[i] = p.vy[i], p.v0z[i] = p.vz[i];
     p.react_x[i] = react[0], p.react_y[i] = react[1], p.react_z[i] = react[2];
@@ -216,6 +224,9 @@ void Coupler::prepare_impl(const Law& law, particles::DemSystem& dem, double dt_
   for (int c = 0; c < 3; ++c) totals_.lag_impulse_ns[c] = lag[c];
   if (linear && window_) mismatch = particles::ordered_sum(window_->comm(), mismatch);
   for (int c = 0; c < 3; ++c) totals_.sampling_mismatch_ns[c] = mismatch[c];
+  // A minimum is exact whatever the order, so every rank count gets the same step.
+  if (window_) MPI_Allreduce(MPI_IN_PLACE, &stable_dt, 1, MPI_DOUBLE, MPI_MIN, window_->comm());
+  totals_.drag_stable_dt_s = stable_dt;
 }
 
 void Coupler::prepare(particles::DemSystem& dem, fluid::FluidSolver& fs, double dt_prev_s) {

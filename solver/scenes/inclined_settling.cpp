@@ -359,28 +359,17 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
     run.start();
   }
   run.activate_models(timers);
-  // A stop request is honoured inside a long fluid step too (thousands of particle sub-steps).
-  run.set_interrupt([&ctx] { return ctx.should_stop(); });
-  CoupledSceneOutput out(
-      run, ctx, timers,
+  SummaryBase sb;
+  const int exit_code = run_recorded_steps(
+      run, ctx, timers, record,
       {"time_s", "mean_wp_m_s", "mean_wf_m_s", "slurry_velocity_m_s", "mean_up_m_s", "mean_vp_m_s",
        "driving_gradient_pa_m", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
-      resumed.has_value(), record.next_out_s());
-  const auto write_checkpoint = [&] {
-    ModelTimers::Scope sc(timers, "checkpoints");
-    record.checkpoint(run, ctx.out_dir, wall_before + clock.seconds(), out.next_out_s());
-  };
-  SummaryBase sb;
-  const int exit_code = run_coupled_steps(
-      run, out, [&] { record.before_step(run); },
+      resumed.has_value(), clock, wall_before, [&] { record.before_step(run); },
       [&](const coupling::CoupledStep& st, bool& end_early) { return record.measure(run, st, end_early); },
-      write_checkpoint, sb);
-  out.flush();
+      sb);
   run.report_timers(timers);
   record.write_distributions(run, ctx.out_dir);
-  sb.simulated_time_s = run.time_s();
-  sb.wall_time_s = wall_before + clock.seconds();
-  sb.particle_steps = static_cast<double>(run.dem().global_count()) * static_cast<double>(run.dem().steps());
+  set_run_totals(sb, run, wall_before + clock.seconds());
   const auto j = record.summary(run, sb, timers, vt, resumed.has_value());
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   return exit_code;

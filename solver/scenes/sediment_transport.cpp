@@ -322,27 +322,16 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   run.activate_models(timers);
   timers.activate("flux_controller",
                   fmt::format("G(t) holds mean alpha_f w = {} m/s", p.sediment.bulk_velocity_m_s));
-  // A stop request is honoured inside a long fluid step too (thousands of particle sub-steps).
-  run.set_interrupt([&ctx] { return ctx.should_stop(); });
-  CoupledSceneOutput out(
-      run, ctx, timers,
+  SummaryBase sb;
+  const int exit_code = run_recorded_steps(
+      run, ctx, timers, record,
       {"time_s", "q_m2_s", "q_star", "driving_gradient_pa_m", "mean_flux_z_m_s", "mean_up_z_m_s",
        "mean_vp_m_s", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
-      resumed.has_value(), record.next_out_s());
-  const auto write_checkpoint = [&] {
-    ModelTimers::Scope sc(timers, "checkpoints");
-    record.checkpoint(run, ctx.out_dir, wall_before + clock.seconds(), out.next_out_s());
-  };
-  SummaryBase sb;
-  const int exit_code = run_coupled_steps(
-      run, out, [] {}, [&](const coupling::CoupledStep& st, bool&) { return record.measure(run, st); },
-      write_checkpoint, sb);
-  out.flush();
+      resumed.has_value(), clock, wall_before, [] {},
+      [&](const coupling::CoupledStep& st, bool&) { return record.measure(run, st); }, sb);
   record.write_profiles(run, ctx.out_dir);
   run.report_timers(timers);
-  sb.simulated_time_s = run.time_s();
-  sb.wall_time_s = wall_before + clock.seconds();
-  sb.particle_steps = static_cast<double>(run.dem().global_count()) * static_cast<double>(run.dem().steps());
+  set_run_totals(sb, run, wall_before + clock.seconds());
   const auto j = record.summary(run, sb, timers, h_bed, resumed.has_value());
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   if (!ctx.quiet && output_rank())

@@ -144,12 +144,17 @@ TEST(CaseParams, IdentityVersion2LeavesOutTheRunLengthAndOutputOnly) {
   validate(c);
   EXPECT_NE(case_id(c), case_id(a));
   // The default case's id under version 2 (a change of the scheme must bump kCaseIdVersion and
-  // migrate stored ids, see driver/store/case_id_migration.cpp). Mei's lift and then two SIMPLE
-  // correctors became the default after it: a case with the defaults of earlier builds keeps its
-  // id (one corrector: the default case of the build before two; with Saffman's lift too: the
+  // migrate stored ids, see driver/store/case_id_migration.cpp). Mei's lift, then two SIMPLE
+  // correctors, then the packed-bed step limit became the default after it: a case with the
+  // defaults of earlier builds keeps its id (no limit: the default case of the build before it;
+  // one corrector too: the default case of the build before two; with Saffman's lift too: the
   // default case of the builds before Mei's).
-  EXPECT_EQ(case_id(a), "53efe1afd84e4584");
-  CaseParams one_corrector;
+  EXPECT_EQ(case_id(a), "40f6bb317af6f7d7");
+  CaseParams no_limit;
+  apply_override(no_limit, "numerics.drag_dt_limit=false");
+  validate(no_limit);
+  EXPECT_EQ(case_id(no_limit), "53efe1afd84e4584");
+  CaseParams one_corrector = no_limit;
   apply_override(one_corrector, "numerics.simple_correctors=1");
   validate(one_corrector);
   EXPECT_EQ(case_id(one_corrector), "98d95b7d3ced7ffb");

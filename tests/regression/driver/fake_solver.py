@@ -7,7 +7,8 @@ step), checkpoints its state to DIR/checkpoint.json every step, appends DIR/time
 writes DIR/summary.json at the end with the real solver's keys and statuses (core/run_status.hpp:
 "completed" at the end, "interrupted" when stopped; test_driver_faults checks them against the
 real solver). The result depends on the parameters only (never on how often it was interrupted):
-<<w_p>> = -0.01 (1 + 0.5 sin(theta)) * (viscosity/1e-3)^-0.1 m/s.
+<<w_p>> = -0.01 (1 + 0.5 sin(theta)) * (viscosity/1e-3)^-0.1 m/s; with FAKE_PEAK_DEG set,
+-0.01 (1 + 0.5 exp(-((theta - FAKE_PEAK_DEG)/15)^2/2)) * (viscosity/1e-3)^-0.1 m/s (a peak inside).
 Exit 75 on SIGTERM/SIGINT after a checkpoint; exit 3 once per run folder when seed == 13 and
 FAKE_FAIL_SEED13 is set (a retried failure); exit 3 always when seed == 14 (a failure for good).
 Exit 74 (a storage error: "No space left on device") on the first FAKE_STORAGE_FAILS runs in a
@@ -79,6 +80,10 @@ def main():
             return 4
     nsteps = int(round(end / 0.1))
     w_mean = -0.01 * (1 + 0.5 * math.sin(math.radians(angle))) * (visc / 1e-3) ** -0.1
+    if os.environ.get("FAKE_PEAK_DEG"):
+        # A curve with its peak inside the range, for [refine]: |w| largest at FAKE_PEAK_DEG.
+        peak = float(os.environ["FAKE_PEAK_DEG"])
+        w_mean = -0.01 * (1 + 0.5 * math.exp(-((angle - peak) / 15.0) ** 2 / 2)) * (visc / 1e-3) ** -0.1
     # The timeseries is rewritten from the checkpointed step, so a resumed run leaves the same file.
     ts = os.path.join(out, "timeseries.csv")
     lines = ["time_s,w_p_m_s\n"]

@@ -9,10 +9,10 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 cd "$work"
 tar xzf "$fixture"
-# The release that wrote the fixture ran Saffman's lift as printed and one SIMPLE corrector, the
-# defaults then: the study names both, so its cases are the stored ones (a study left on today's
-# defaults, Mei's lift and two correctors, has other cases and would run them).
-printf '[base.forces]\nlift = "saffman"\n[base.numerics]\nsimple_correctors = 1\n' >> migr.toml
+# The release that wrote the fixture ran Saffman's lift as printed, one SIMPLE corrector and no
+# packed-bed step limit, the defaults then: the study names them, so its cases are the stored
+# ones (a study left on today's defaults has other cases and would run them).
+printf '[base.forces]\nlift = "saffman"\n[base.numerics]\nsimple_correctors = 1\ndrag_dt_limit = false\n' >> migr.toml
 old_ids=$(sqlite3 migr.sqlite "select id from cases order by angle_deg" | tr '\n' ' ')
 "$bin" study run migr.toml --db migr.sqlite > out1.txt 2> err1.txt
 "$bin" study run migr.toml --db migr.sqlite > out2.txt 2> err2.txt

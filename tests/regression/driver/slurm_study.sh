@@ -7,7 +7,8 @@
 # bit, no duplicate rows; the signalled case has its two attempts (exit 75 on restart 0, exit 0 on
 # restart 1 of the same job), and collecting again changes nothing. Then one 2-rank case through
 # mpirun inside the job equals `study run --ranks 2` bit for bit, and, with the fake solver, a case that
-# fails once is retried in its task and one that keeps failing ends failed with its reason.
+# fails once is retried in its task and one that keeps failing ends failed with its reason, and a
+# study with [refine] adds, one submit/collect round at a time, the points a local study run adds.
 # Without a usable Slurm (packages missing, not root, daemons not starting) it skips (exit 77),
 # unless BOYCOTT_REQUIRE_SLURM=1 (.ci/run sets it): then it fails with the reason.
 set -euo pipefail
@@ -332,4 +333,37 @@ n() { sqlite3 fail.sqlite "$1"; }
   exit 1
 }
 "$bin" study submit fail.toml --db "$work/fail.sqlite" --scheduler slurm --retries 1 "${fake[@]}" | grep -q 'nothing to submit'
+
+# ---- [refine] through submit/collect rounds, with the fake solver's curve peaking at 64 deg: each
+# submit after a collect adds the next point of the curve; the points are those of a local study
+# run of the same study, and a last submit finds nothing to add ----
+cat > refine.toml << 'EOF2'
+name = "slurm_refine"
+refine = { key = "gravity.angle_deg", resolution = 2.5, max_points = 2 }
+matrix = { "gravity.angle_deg" = [30, 45, 60, 75, 90] }
+base = { scene = "inclined_settling", seed = 1, particles = { count = 1000 }, time = { end = 0.8, average_from = 0.4 } }
+EOF2
+export FAKE_PEAK_DEG=64 FAKE_STEP_WALL_S=0.01
+"$bin" study run refine.toml --db "$work/refine_local.sqlite" --jobs 2 "${fake[@]}" > refine_local.txt 2>&1
+for round in 0 1 2 3; do
+  "$bin" study submit refine.toml --db "$work/refine.sqlite" --scheduler slurm "${fake[@]}" > "submit_refine$round.txt" 2>&1
+  grep -q 'nothing to submit' "submit_refine$round.txt" && break
+  array=$(sed -n 's/.*submitted job \([0-9]*\),.*/\1/p' "submit_refine$round.txt")
+  for _ in $(seq 300); do
+    [ -z "$(squeue -h -j "$array" -o %i)" ] && break
+    sleep 0.2
+  done
+  "$bin" study collect refine.toml --db "$work/refine.sqlite" > /dev/null
+done
+unset FAKE_PEAK_DEG FAKE_STEP_WALL_S
+q="SELECT round, value, case_id FROM refined_points ORDER BY round"
+a=$(sqlite3 refine.sqlite "$q")
+b=$(sqlite3 refine_local.sqlite "$q")
+echo "[refine] under Slurm, rounds $round: $a; study run: $b"
+[ -n "$a" ] && [ "$a" = "$b" ] && grep -q 'nothing to submit' "submit_refine$round.txt" &&
+  [ "$(sqlite3 refine.sqlite 'SELECT COUNT(*) FROM results')" = "$(sqlite3 refine_local.sqlite 'SELECT COUNT(*) FROM results')" ] || {
+  cat submit_refine*.txt
+  echo "FAIL: submit/collect rounds did not add the points study run adds, or did not stop" >&2
+  exit 1
+}
 echo "total $(($(date +%s) - t0)) s"

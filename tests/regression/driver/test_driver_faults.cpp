@@ -26,6 +26,7 @@
 #include "core/error.hpp"
 #include "core/run_status.hpp"
 #include "driver/store/database.hpp"
+#include "study_process.hpp"
 
 namespace bd = boycott::driver;
 namespace fs = std::filesystem;
@@ -34,78 +35,20 @@ namespace {
 
 const std::string kFake = std::string("python3 ") + FAKE_SOLVER;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    char tmpl[] = "/tmp/boycott_faults_XXXXXX";
-    path = mkdtemp(tmpl);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
-
-void write(const fs::path& p, const std::string& text) {
-  std::ofstream(p) << text;
-}
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct Run {
-  int rc = -1;
-  std::string out, err;
-};
-
-/// Starts argv[0] (BOYCOTT_BIN unless given) with extra environment; output to files in dir.
-pid_t spawn(std::vector<std::string> args, const fs::path& dir, const std::map<std::string, std::string>& env,
-            const std::string& program = BOYCOTT_BIN) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-    setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-    for (const auto& [k, v] : env) setenv(k.c_str(), v.c_str(), 1);
-    freopen((dir / "stdout.txt").c_str(), "w", stdout);
-    freopen((dir / "stderr.txt").c_str(), "w", stderr);
-    args.insert(args.begin(), program);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execvp(argv[0], argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-Run wait_run(pid_t pid, const fs::path& dir) {
-  int st = 0;
-  waitpid(pid, &st, 0);
-  Run r;
-  r.rc = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-  r.out = read(dir / "stdout.txt");
-  r.err = read(dir / "stderr.txt");
-  return r;
-}
-
-Run run(const std::vector<std::string>& args, const fs::path& dir,
-        std::map<std::string, std::string> env = {}) {
-  env.try_emplace("FAKE_STEP_WALL_S", "0.01");
-  return wait_run(spawn(args, dir, env), dir);
-}
+using study_process::count;
+using study_process::read;
+using study_process::Run;
+using study_process::run;
+using study_process::spawn;
+using study_process::TempDir;
+using study_process::wait_run;
+using study_process::write;
 
 std::vector<std::string> study_run(const fs::path& study, const fs::path& db,
                                    const std::string& solver = kFake) {
   std::vector<std::string> a = {"study", "run", study.string(), "--db", db.string(), "--jobs", "1"};
   if (!solver.empty()) a.insert(a.end(), {"--solver-command", solver});
   return a;
-}
-
-std::int64_t count(const fs::path& db, const std::string& sql) {
-  bd::Database d(db.string(), bd::OpenMode::kExisting);
-  auto st = d.prepare(sql);
-  st.step();
-  return st.integer(0);
 }
 
 bool any_set_aside(const fs::path& db) {

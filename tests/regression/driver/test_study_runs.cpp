@@ -15,32 +15,14 @@
 #include <nlohmann/json.hpp>
 
 #include "driver/store/database.hpp"
+#include "study_process.hpp"
 
 namespace bd = boycott::driver;
 namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kSolver = std::string("python3 ") + FAKE_SOLVER;
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    char tmpl[] = "/tmp/boycott_runtest_XXXXXX";
-    path = mkdtemp(tmpl);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
-
-void write(const fs::path& p, const std::string& text) {
-  std::ofstream(p) << text;
-}
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using namespace study_process;
 
 // 2 groups x 3 angles; every fake case is 8 steps of FAKE_STEP_WALL_S.
 const char* kStudy = R"(
@@ -62,50 +44,6 @@ set = { "fluid.viscosity" = 1.0e-2 }
 "gravity.angle_deg" = [30, 60, 90]
 )";
 
-struct Run {
-  int rc = -1;
-  std::string out, err;
-};
-
-/// Starts `boycott args...` with extra environment; stdout and stderr go to files in dir.
-pid_t spawn(const std::vector<std::string>& args, const fs::path& dir,
-            const std::map<std::string, std::string>& env) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    for (const auto& [k, v] : env) setenv(k.c_str(), v.c_str(), 1);
-    freopen((dir / "stdout.txt").c_str(), "w", stdout);
-    freopen((dir / "stderr.txt").c_str(), "w", stderr);
-    std::vector<char*> argv{const_cast<char*>(BOYCOTT_BIN)};
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execv(BOYCOTT_BIN, argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-Run wait_run(pid_t pid, const fs::path& dir) {
-  int st = 0;
-  waitpid(pid, &st, 0);
-  Run r;
-  r.rc = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-  r.out = read(dir / "stdout.txt");
-  r.err = read(dir / "stderr.txt");
-  return r;
-}
-
-Run run(const std::vector<std::string>& args, const fs::path& dir,
-        std::map<std::string, std::string> env = {}) {
-  env.try_emplace("FAKE_STEP_WALL_S", "0.01");
-  return wait_run(spawn(args, dir, env), dir);
-}
-
-std::vector<std::string> study_run(const fs::path& study, const fs::path& db, int jobs = 2) {
-  return {"study",     "run",    study.string(),       "--db",
-          db.string(), "--jobs", std::to_string(jobs), "--solver-command",
-          kSolver};
-}
-
 /// Waits until some case of the study at db has written a checkpoint (so a stop lands mid-case).
 void wait_for_checkpoint(const fs::path& db) {
   const fs::path runs = db.string() + ".runs";
@@ -116,13 +54,6 @@ void wait_for_checkpoint(const fs::path& db) {
         if (fs::exists(e.path() / "checkpoint.json", ec)) return;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-}
-
-std::int64_t count(const fs::path& db, const std::string& sql) {
-  bd::Database d(db.string(), bd::OpenMode::kExisting);
-  auto st = d.prepare(sql);
-  st.step();
-  return st.integer(0);
 }
 
 /// case id -> (mean, stderr, particle_steps) as recorded.

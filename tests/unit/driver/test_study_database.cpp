@@ -17,6 +17,8 @@
 #include "driver/store/database.hpp"
 #include "driver/store/schema_files.hpp"
 #include "driver/store/store.hpp"
+#include "driver/store/store_refine.hpp"
+#include "driver/study/refine.hpp"
 #include "driver/study/study.hpp"
 
 namespace bd = boycott::driver;
@@ -123,6 +125,55 @@ TEST(StudyDatabase, Version1DatabaseMigratesToTheLatestKeepingItsRows) {
             1);
   EXPECT_EQ(count(v2, "SELECT COUNT(*) FROM cases"), 4);
   EXPECT_EQ(count(v2, "SELECT COUNT(*) FROM attempts WHERE run_dir IS NULL"), 1);
+}
+
+// Schema 5 (results_schema/005_refinement.sql) on a database of schema 4 with a finished case: its
+// rows kept, the table of added points there, a point recorded once however often it is offered.
+TEST(StudyDatabase, Version4DatabaseMigratesAndRecordsEachRefinedPointOnce) {
+  TempDir d;
+  const auto path = (d.path / "r.db").string();
+  auto study = bd::expand_study_string(std::string(kStudy) + R"(
+[refine]
+key = "gravity.angle_deg"
+resolution = 2.5
+)");
+  {
+    bd::Database v4(path, bd::OpenMode::kCreate, 4);
+    ASSERT_EQ(v4.version(), 4);
+    bd::register_study(v4, study);
+    const auto attempt = bd::begin_attempt(v4, study.cases[0].id, 1, "/runs/x");
+    bd::record_result(v4, attempt, study.cases[0].id,
+                      {{"mean_settling_velocity_m_s", -0.1}, {"settling_velocity_stderr_m_s", 0.001}});
+  }
+  {
+    bd::Database ro(path, bd::OpenMode::kReadOnly);
+    EXPECT_FALSE(bd::has_refined_points(ro));
+    EXPECT_TRUE(bd::refined_points(ro, "s").empty())
+        << "a query reads an older database as one without points";
+  }
+  bd::Database db(path, bd::OpenMode::kExisting);
+  EXPECT_EQ(db.version(), bd::Database::latest_version());
+  EXPECT_TRUE(bd::has_refined_points(db));
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM cases"), 4);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 1);
+  const auto curves = bd::refine_series(study);
+  const bd::StudyCase c = bd::refined_case(study, curves[0], 67.5, 0);
+  const bd::RefinedPoint p{"s", "a", "", 0, c.id, "gravity.angle_deg", 67.5, "the fit's vertex", ""};
+  const auto first = bd::record_refined_point(db, p, c);
+  EXPECT_FALSE(first.added_at.empty());
+  // Another driver offering a point for the same round gets the recorded one; nothing is added.
+  auto other = p;
+  other.value = 70.0;
+  other.case_id = bd::refined_case(study, curves[0], 70.0, 0).id;
+  const auto second = bd::record_refined_point(db, other, bd::refined_case(study, curves[0], 70.0, 0));
+  EXPECT_EQ(second.value, 67.5);
+  EXPECT_EQ(second.case_id, c.id);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM refined_points"), 1);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM study_cases WHERE study = 's'"), 5);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM case_values WHERE case_id = '" + c.id + "'"), 1);
+  const auto rows = bd::refined_points(db, "s");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].reason, "the fit's vertex");
 }
 
 TEST(StudyDatabase, NewerSchemaIsRefusedAndLeftUnchanged) {
