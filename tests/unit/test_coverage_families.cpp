@@ -126,7 +126,8 @@ double target_coverage(const std::string& name, double goal, std::uint64_t seed)
 // check on 1 000).
 TEST(EarlyStopCoverage, TheErrorAtTheStopCoversTwoThirdsOnAr1AtThreeTargets) {
   for (double target : {0.2, 0.15, 0.12}) {
-    const auto f = boycott::testing::ar1_early_stop_coverage(target, kSeries, 5000 + static_cast<int>(target * 1000));
+    const auto f =
+        boycott::testing::ar1_early_stop_coverage(target, kSeries, 5000 + static_cast<int>(target * 1000));
     std::printf("coverage, early stop at target %g: %.4f (stopped %d of %d, mean %.0f tau_int)\n", target,
                 f.coverage(), f.stopped, kSeries, f.mean_tau);
     EXPECT_EQ(f.stopped, kSeries);

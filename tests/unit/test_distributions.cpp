@@ -27,8 +27,10 @@ double simpson(const std::function<double(double)>& f, double a, double b, int n
 
 // P(T <= t) for Student's t: 1/2 plus the density's integral from 0 to t (smooth there).
 double t_cdf_by_quadrature(double t, double nu) {
-  const double c = std::exp(std::lgamma(0.5 * (nu + 1.0)) - std::lgamma(0.5 * nu)) / std::sqrt(nu * std::numbers::pi);
-  const double half = simpson([&](double s) { return c * std::pow(1.0 + s * s / nu, -0.5 * (nu + 1.0)); }, 0.0, std::abs(t));
+  const double c =
+      std::exp(std::lgamma(0.5 * (nu + 1.0)) - std::lgamma(0.5 * nu)) / std::sqrt(nu * std::numbers::pi);
+  const double half =
+      simpson([&](double s) { return c * std::pow(1.0 + s * s / nu, -0.5 * (nu + 1.0)); }, 0.0, std::abs(t));
   return t >= 0.0 ? 0.5 + half : 0.5 - half;
 }
 
@@ -94,7 +96,8 @@ TEST(Distributions, StudentTAtNonIntegerDegreesOfFreedomMatchesItsIntegratedDens
       EXPECT_NEAR(t_cdf_by_quadrature(t, nu), p, 1e-10) << "nu " << nu << ", p " << p;
       EXPECT_NEAR(student_t_cdf(t, nu), p, 1e-13) << "nu " << nu << ", p " << p;
     }
-    for (double t : {-3.0, 0.7, 1.0, 12.0}) EXPECT_NEAR(student_t_cdf(t, nu), t_cdf_by_quadrature(t, nu), 1e-10) << nu;
+    for (double t : {-3.0, 0.7, 1.0, 12.0})
+      EXPECT_NEAR(student_t_cdf(t, nu), t_cdf_by_quadrature(t, nu), 1e-10) << nu;
   }
 }
 
@@ -102,11 +105,13 @@ TEST(Distributions, StudentTFromOneToAMillionDegreesOfFreedomMatchesCornishFishe
   // The one-sigma factor and the 0.999 point against the expansion where it is exact to
   // round-off (nu >= 1000), and cdf(quantile(p)) = p at every decade from 1 to 10^6.
   for (double nu : {1e3, 1e4, 1e5, 1e6}) {
-    EXPECT_NEAR(one_sigma_t_factor(nu), t_quantile_cornish_fisher(0.5 * (1.0 + kOneSigmaCoverage), nu), 1e-12) << nu;
+    EXPECT_NEAR(one_sigma_t_factor(nu), t_quantile_cornish_fisher(0.5 * (1.0 + kOneSigmaCoverage), nu), 1e-12)
+        << nu;
     EXPECT_NEAR(student_t_quantile(0.999, nu), t_quantile_cornish_fisher(0.999, nu), 1e-11) << nu;
   }
   for (double nu = 1.0; nu <= 1e6; nu *= 10.0)
-    for (double p : {0.001, 0.8413, 0.999}) EXPECT_NEAR(student_t_cdf(student_t_quantile(p, nu), nu), p, 1e-13) << nu;
+    for (double p : {0.001, 0.8413, 0.999})
+      EXPECT_NEAR(student_t_cdf(student_t_quantile(p, nu), nu), p, 1e-13) << nu;
   // Degrees of freedom without end: the normal distribution.
   EXPECT_NEAR(student_t_quantile(0.999, INFINITY), normal_quantile(0.999), 1e-13);
   EXPECT_NEAR(student_t_cdf(1.0, INFINITY), 0.5 * std::erfc(-1.0 / std::sqrt(2.0)), 1e-15);
@@ -114,14 +119,17 @@ TEST(Distributions, StudentTFromOneToAMillionDegreesOfFreedomMatchesCornishFishe
 
 TEST(Distributions, ChiSquareAndFAtNonIntegerDegreesOfFreedomMatchTheirIntegratedDensities) {
   // Chi-square with 2 degrees of freedom is exponential: 1 - exp(-x / 2).
-  for (double x : {0.002, 1.0, 13.8155}) EXPECT_NEAR(chi_square_cdf(x, 2.0), -std::expm1(-0.5 * x), 1e-14) << x;
+  for (double x : {0.002, 1.0, 13.8155})
+    EXPECT_NEAR(chi_square_cdf(x, 2.0), -std::expm1(-0.5 * x), 1e-14) << x;
   for (double k : {1.3, 2.7})
-    for (double x : {0.001, 0.5, 3.0, 15.0}) EXPECT_NEAR(chi_square_cdf(x, k), chi_square_cdf_by_quadrature(x, k), 1e-10) << k;
+    for (double x : {0.001, 0.5, 3.0, 15.0})
+      EXPECT_NEAR(chi_square_cdf(x, k), chi_square_cdf_by_quadrature(x, k), 1e-10) << k;
   // F(d1, d2) <= x is a beta variable: I_z(d1/2, d2/2) at z = d1 x / (d1 x + d2).
   for (const auto& [d1, d2] : {std::pair{1.3, 2.7}, std::pair{2.7, 1.3}, std::pair{4.0, 30.5}})
     for (double x : {0.01, 1.0, 6.0}) {
       const double z = d1 * x / (d1 * x + d2);
-      EXPECT_NEAR(f_cdf(x, d1, d2), beta_cdf_by_quadrature(z, 0.5 * d1, 0.5 * d2), 1e-10) << d1 << " " << d2 << " " << x;
+      EXPECT_NEAR(f_cdf(x, d1, d2), beta_cdf_by_quadrature(z, 0.5 * d1, 0.5 * d2), 1e-10)
+          << d1 << " " << d2 << " " << x;
     }
 }
 

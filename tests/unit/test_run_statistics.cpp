@@ -14,9 +14,9 @@
 
 #include "scenes/summary_statistics.hpp"
 #include "stats/precision_target.hpp"
-#include "tests/unit/early_stop_coverage.hpp"
 #include "stats/transient.hpp"
 #include "stats/window_error.hpp"
+#include "tests/unit/early_stop_coverage.hpp"
 
 using namespace boycott;
 
@@ -24,9 +24,9 @@ TEST(ErrorCoverage, EarlyStopErrorCoverageOnAThousandSeries) {
   // A quick check of the rule whose 10 000-series figures at three targets are held within 0.66-0.705
   // in test_coverage_families.cpp (label long): 1 000 series at one target. Binomial standard error
   // of a coverage near 0.683 at 1 000 series: 0.0147; the band is 3.3 of them either side.
-  const auto f = testing::ar1_early_stop_coverage(0.15, 1000, 5150);
-  std::printf("coverage, early stop at target 0.15: %.4f (stopped %d of 1000, mean %.0f tau_int)\n", f.coverage(),
-              f.stopped, f.mean_tau);
+  const auto f = boycott::testing::ar1_early_stop_coverage(0.15, 1000, 5150);
+  std::printf("coverage, early stop at target 0.15: %.4f (stopped %d of 1000, mean %.0f tau_int)\n",
+              f.coverage(), f.stopped, f.mean_tau);
   EXPECT_EQ(f.stopped, 1000);
   EXPECT_GE(f.coverage(), 0.683 - 0.048);
   EXPECT_LE(f.coverage(), 0.683 + 0.048);
