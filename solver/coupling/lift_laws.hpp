@@ -15,7 +15,7 @@
 //                Re_w^1/2 / Re_p = (|w| nu)^1/2 / |u_f - u_p|. Saffman's analysis with the slip's
 //                inertia kept beside the shear's: Re_p << 1 and Re_w << 1, epsilon free (Saffman's
 //                law is epsilon -> inf). J falls from J(inf) as 0.66 / epsilon^2, is 0.75 of it at
-//                epsilon = 1, changes sign at epsilon = 0.223 and tends to -32 pi^2 epsilon^5
+//                epsilon = 1, changes sign at epsilon = 0.222 and tends to -32 pi^2 epsilon^5
 //                ln(epsilon^-2) (a lift toward the slower fluid, at most 0.0074 of Saffman's, at
 //                epsilon 0.18). J is the table below, interpolated (mclaughlin_j).
 //   none         no lift.
@@ -124,7 +124,7 @@ inline double mclaughlin_j(double epsilon) {
 }
 
 /// McLaughlin's (1991) ratio of the lift to Saffman's, J(epsilon) / J(inf) with epsilon =
-/// Re_w^1/2 / Re_p; re_p > 0, re_w >= 0. Negative for epsilon < 0.223.
+/// Re_w^1/2 / Re_p; re_p > 0, re_w >= 0. Negative for epsilon < 0.222.
 inline double mclaughlin_lift_factor(double re_p, double re_w) {
   return mclaughlin_j(std::sqrt(re_w) / re_p) / mclaughlin::kJInfinity;
 }
