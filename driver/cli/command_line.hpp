@@ -1,7 +1,8 @@
 #pragma once
 // The pieces every subcommand of the `boycott` command line shares: how a subcommand is set up
 // and run, the options that mean the same everywhere (counts, --retries, --format, --db), and how
-// errors become exit codes. Each group's subcommands: case_cli.cpp, study_cli.cpp, query_cli.cpp.
+// errors become exit codes. Each group's subcommands: case_cli.cpp, study_cli.cpp, query_cli.cpp,
+// stats_cli.cpp.
 #include <functional>
 #include <string>
 #include <vector>
@@ -49,5 +50,7 @@ std::vector<Command> setup_case_commands(CLI::App& app, int argc, char** argv,
 std::vector<Command> setup_study_commands(CLI::App& app);
 /// `boycott query curve|peak|validation|work-precision|cases`.
 std::vector<Command> setup_query_commands(CLI::App& app);
+/// `boycott stats mean`.
+std::vector<Command> setup_stats_commands(CLI::App& app);
 
 }  // namespace boycott::driver::cli

@@ -1,5 +1,6 @@
 // boycott: the command-line front end; its subcommands are set up and run by case_cli.cpp,
-// study_cli.cpp and query_cli.cpp (for users: README.md, "Running a case", "Studies", "Outputs").
+// study_cli.cpp, query_cli.cpp and stats_cli.cpp (for users: README.md, "Running a case", "Studies",
+// "Outputs").
 #include <cstdio>
 #include <string_view>
 
@@ -25,6 +26,7 @@ int main(int argc, char** argv) {
   std::vector<cli::Command> commands = cli::setup_case_commands(app, argc, argv, &petsc_options);
   for (auto& c : cli::setup_study_commands(app)) commands.push_back(std::move(c));
   for (auto& c : cli::setup_query_commands(app)) commands.push_back(std::move(c));
+  for (auto& c : cli::setup_stats_commands(app)) commands.push_back(std::move(c));
   const CLI::App* case_run = commands.front().app;
 
   // Everything after the first `--` is for PETSc; before it, a word the program does not know is

@@ -142,10 +142,20 @@ double CoupledSystem::step_size(int& dem_substeps) const {
   const double dt_dem = p_.time.dt_dem_s;
   double dt = std::min(p_.time.dt_cfd_s, fluid_->stable_dt());
   if (opt_.move_particles) {
-    dem_substeps = std::max(1, static_cast<int>(std::floor(dt / dt_dem + 1e-9)));
+    dem_substeps = whole_substeps_within(dt);
     dt = dem_substeps * dt_dem;
   }
   return dt;
+}
+
+int CoupledSystem::whole_substeps_within(double dt_s) const {
+  // The 1e-9 keeps a step that is a whole number of sub-steps up to round-off at that number.
+  return std::max(1, static_cast<int>(std::floor(dt_s / p_.time.dt_dem_s + 1e-9)));
+}
+
+void CoupledSystem::set_substeps(CoupledStep& st, int substeps) const {
+  st.dem_substeps = substeps;
+  st.dt_s = substeps * p_.time.dt_dem_s;
 }
 
 void CoupledSystem::limit_by_drag(CoupledStep& st) const {
@@ -155,8 +165,7 @@ void CoupledSystem::limit_by_drag(CoupledStep& st) const {
   // A held bed does not relax, so it has no such mode.
   const double bound = coupler_->totals().drag_stable_dt_s;
   if (!opt_.move_particles || !(bound < st.dt_s)) return;
-  st.dem_substeps = std::max(1, static_cast<int>(std::floor(bound / p_.time.dt_dem_s + 1e-9)));
-  st.dt_s = st.dem_substeps * p_.time.dt_dem_s;
+  set_substeps(st, whole_substeps_within(bound));
 }
 
 void CoupledSystem::stop_at_end(CoupledStep& st) const {
@@ -167,8 +176,7 @@ void CoupledSystem::stop_at_end(CoupledStep& st) const {
   if (!opt_.move_particles || !(left > 0.0)) return;
   const auto substeps = static_cast<int>(std::llround(left / p_.time.dt_dem_s));
   if (substeps < 1 || substeps >= st.dem_substeps) return;
-  st.dem_substeps = substeps;
-  st.dt_s = substeps * p_.time.dt_dem_s;
+  set_substeps(st, substeps);
 }
 
 bool CoupledSystem::advance_particles(CoupledStep& st, bool long_step, double per_substep) {

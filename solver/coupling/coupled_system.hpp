@@ -129,6 +129,9 @@ class CoupledSystem {
   // The parts of step(), in order.
   /// The step (s): at most time.dt_cfd and CFL-limited, a whole number (set) of DEM sub-steps.
   double step_size(int& dem_substeps) const;
+  /// The whole DEM sub-steps in dt_s (at least one), and a step set to a number of them.
+  int whole_substeps_within(double dt_s) const;
+  void set_substeps(CoupledStep& st, int substeps) const;
   /// Shortens the step to what the exchange of packed particles allows (numerics.drag_dt_limit).
   void limit_by_drag(CoupledStep& st) const;
   /// Shortens the last step to end at time.end.

@@ -158,8 +158,7 @@ void SettlingRecord::load(const io::CheckpointReader& r) {
   steps_ = read_step_series(r);
   if (r.has("stats.wp_series")) {
     wp_series_ = r.doubles("stats.wp_series");
-    const auto t = r.doubles("stats.target");
-    if (t.size() == 2) target_.next_check_ = static_cast<std::int64_t>(t[0]), target_.met_since_s_ = t[1];
+    target_.from_state(r.doubles("stats.target"));
   } else {
     wp_series_whole_ = wp_avg_.count() == 0;
   }
@@ -186,8 +185,7 @@ void SettlingRecord::checkpoint(const coupling::CoupledSystem& run, const std::f
     w.put("stats.ke_max_seen", ke_max_seen_);
     w.put("stats.wp_series", wp_series_);
     write_step_series(w, steps_);
-    w.put("stats.target",
-          std::vector<double>{static_cast<double>(target_.next_check_), target_.met_since_s_});
+    w.put("stats.target", target_.to_state());
   });
 }
 
@@ -256,9 +254,12 @@ void SettlingRecord::write_distributions(coupling::CoupledSystem& run, const std
 nlohmann::json SettlingRecord::summary(const coupling::CoupledSystem& run, SummaryBase& sb,
                                        const ModelTimers& timers, double terminal_speed_m_s,
                                        bool resumed) const {
-  const stats::ChosenWindow chosen = averaging_window(p_.time.average_from, steps_, wp_series_, run.time_s());
-  const stats::WindowError wp_err =
-      stats::window_error(chosen.window, chosen.from_s, run.time_s(), sb.status == kStatusConverged);
+  // A run its precision target stopped reports the target's two-stage error, over the window its
+  // first stage fixed.
+  const stats::TwoStagePlan* plan = sb.status == kStatusConverged ? &target_.plan() : nullptr;
+  const stats::ChosenWindow chosen =
+      averaging_window(p_.time.average_from, steps_, wp_series_, run.time_s(), plan);
+  const stats::WindowError wp_err = stats::window_error(chosen.window, chosen.from_s, run.time_s(), plan);
   nlohmann::json j = report_settling_velocity(sb, chosen, wp_err, timers);
   const bool chose = p_.time.average_from.automatic && wp_series_whole_;
   j["samples_averaged"] = chose ? static_cast<std::int64_t>(chosen.window.size()) : wp_avg_.count();
@@ -295,12 +296,10 @@ nlohmann::json SettlingRecord::report_settling_velocity(SummaryBase& sb, const s
     j["settling_velocity_rel_stderr"] = std::isfinite(rel) ? nlohmann::json(rel) : nlohmann::json(nullptr);
   if (target_.active()) {
     j["target_rel_error"] = p_.time.target_rel_error;
-    // Met: it stopped the run, or the whole window meets it at the end.
-    // Judged as the run judges it (PrecisionTarget): on Sokal's covering error.
-    const double covering_rel = std::abs(wp_err.e.covering_error / sb.mean_settling_velocity_m_s);
-    j["target_met"] = sb.status == kStatusConverged ||
-                      (wp_series_whole_ && covering_rel < p_.time.target_rel_error &&
-                       wp_err.e.correlation_times >= stats::PrecisionTarget::kMinCorrelationTimes);
+    // Met: it stopped the run, or the window's own error meets it at the end.
+    const double covering_rel = std::abs(wp_err.err.covering_error / sb.mean_settling_velocity_m_s);
+    j["target_met"] =
+        sb.status == kStatusConverged || (wp_series_whole_ && covering_rel < p_.time.target_rel_error);
   }
   return j;
 }

@@ -14,6 +14,7 @@
 #include "core/scene_specs.hpp"
 #include "core/version.hpp"
 #include "scenes/summary_statistics.hpp"
+#include "stats/precision_target.hpp"
 
 namespace boycott::scenes {
 
@@ -75,9 +76,13 @@ nlohmann::json resummarize_run(const std::filesystem::path& run_dir) {
       if (!w.is_string() || !is_settling_statistics_warning(w.get<std::string>())) kept.push_back(w);
     j["warnings"] = kept;
   }
-  const stats::ChosenWindow chosen = averaging_window(p.time.average_from, steps, window, now_s);
-  const stats::WindowError w =
-      stats::window_error(chosen.window, chosen.from_s, now_s, j.value("status", "") == kStatusConverged);
+  // A run its precision target stopped: the plan its first stage fixed (runs stopped by builds
+  // before the two-stage rule kept none and get the window's own error).
+  stats::PrecisionTarget target(p.time.target_rel_error);
+  if (r.has("stats.target")) target.from_state(r.doubles("stats.target"));
+  const stats::TwoStagePlan* plan = j.value("status", "") == kStatusConverged ? &target.plan() : nullptr;
+  const stats::ChosenWindow chosen = averaging_window(p.time.average_from, steps, window, now_s, plan);
+  const stats::WindowError w = stats::window_error(chosen.window, chosen.from_s, now_s, plan);
   report_settling_statistics(j, chosen.steps, chosen.window, w, true);
   if (p.time.average_from.automatic) {
     j["mean_settling_velocity_m_s"] = w.e.mean;

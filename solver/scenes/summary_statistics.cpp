@@ -35,53 +35,17 @@ void report_window_error(nlohmann::json& j, const std::string& prefix, const std
   j[prefix + "window_correlation_times"] = num(e.correlation_times);
   j[prefix + "error_method"] = stats::error_method_name(w.err.basis);
   j[prefix + "error_batches"] = w.err.batches > 0 ? nlohmann::json(w.err.batches) : nlohmann::json(nullptr);
-  if (e.samples == 0 || !warn) return;
-  std::string rests_on = "its error is not reported (fewer than 8 samples)";
-  if (w.err.basis == stats::MeanError::Basis::two_halves)
-    rests_on =
-        "its error comes from the difference of the window's two halves (1 degree of freedom; it "
-        "covers ~2/3 of the time from ~10 correlation times on, less in shorter windows)";
-  else if (w.err.basis == stats::MeanError::Basis::batch_means)
-    rests_on = fmt::format("its error comes from {} batch means ({} degrees of freedom)", w.err.batches,
-                           w.err.batches - 1);
-  else if (w.err.basis == stats::MeanError::Basis::autocorrelation)
-    rests_on = "its error is Sokal's, on which the run's target stopped it";
-  if (!std::isfinite(e.tau_int)) {
-    add_warning(
-        j, fmt::format("the averaging window ({:.4g} s, {} samples) gives no estimate of the correlation "
-                       "time of {}: {}",
-                       w.window_s, e.samples, what, rests_on));
-    return;
-  }
-  if (!e.doubtful()) return;
-  std::string advice = "run longer or average from earlier";
-  if (std::isfinite(transient_end_s))
-    advice =
-        transient_end_s < w.from_s - 0.5 * w.sample_s
-            ? fmt::format("run longer, or average from {:.3g} s, where the detected start-up transient ends",
-                          transient_end_s)
-            : fmt::format(
-                  "run longer (the detected start-up transient ends at {:.3g} s: averaging from "
-                  "earlier would take it in)",
-                  transient_end_s);
-  // Doubtful with enough correlation times: only the autocorrelation window failed to close.
-  const bool few = !(e.correlation_times >= stats::AutocorrelationError::kWarnCorrelationTimes);
-  add_warning(
-      j,
-      fmt::format(
-          "the averaging window ({:.4g} s) holds {}{:.1f} correlation times of {} (tau_int "
-          "{:.3g} s, at most {:.3g} s{}); {}: {}",
-          w.window_s, few ? "only " : "", e.correlation_times, what, w.correlation_time_s(),
-          w.correlation_time_upper_s(), e.window_closed ? "" : ", the autocorrelation window did not close",
-          few ? fmt::format("below {:g} {}", stats::AutocorrelationError::kWarnCorrelationTimes, rests_on)
-              : rests_on,
-          advice));
+  if (!warn) return;
+  const std::string text = stats::window_warning(w, what, transient_end_s);
+  if (!text.empty()) add_warning(j, text);
 }
 
 stats::ChosenWindow averaging_window(const WindowStart& start, const stats::StepSeries& s,
-                                     const std::vector<double>& collected, double now_s) {
-  return start.automatic ? stats::cut_at_transient(s, collected, start.collect_from_s(), now_s)
-                         : stats::ChosenWindow{s, collected, start.collect_from_s()};
+                                     const std::vector<double>& collected, double now_s,
+                                     const stats::TwoStagePlan* plan) {
+  if (!start.automatic) return stats::ChosenWindow{s, collected, start.collect_from_s()};
+  return plan && plan->set() ? stats::cut_window_at(s, collected, start.collect_from_s(), now_s, plan->cut)
+                             : stats::cut_at_transient(s, collected, start.collect_from_s(), now_s);
 }
 
 double report_transient(nlohmann::json& j, const std::string& what, const stats::StepSeries& s,
@@ -90,7 +54,7 @@ double report_transient(nlohmann::json& j, const std::string& what, const stats:
   std::vector<double> x(s.before);
   x.insert(x.end(), window.begin(), window.end());
   const stats::TransientEnd cut = stats::transient_end(x);
-  if (!std::isfinite(cut.effective_samples)) {
+  if (!cut.estimated) {
     j["transient_end_s"] = nullptr;
     return std::numeric_limits<double>::quiet_NaN();
   }
@@ -117,7 +81,7 @@ double report_transient(nlohmann::json& j, const std::string& what, const stats:
     for (double v : s.before_dt) d += v;
     return d;
   }();
-  if (warn && cut.start > n_before && stats::transient_biases_mean(x, n_before, cut.start))
+  if (warn && cut.start > n_before && stats::transient_biases_mean(x, n_before, cut.detected))
     add_warning(
         j, fmt::format("the start-up transient of {} ends at {:.3g} s, after time.average_from = {:g} s, "
                        "and the samples between shift the mean beyond their noise: average from {:.3g} s "

@@ -16,22 +16,24 @@
 namespace boycott::scenes {
 
 /// The summary keys of a time average's error, `prefix` + stderr_m_s, error_m_s (the covering
-/// half-width), error_dof (all three from WindowError::err), error_method ("batch_means"
-/// or "two_halves"), error_batches, correlation_time_s, correlation_time_upper_s, effective_samples,
-/// window_correlation_times (Sokal's diagnostics); null where not available. With `warn` (a
-/// finished run), a warning goes to j["warnings"] and stderr when the window holds fewer than ~20
-/// correlation times, saying what the error then rests on. `what` names the quantity.
-/// `transient_end_s` (NaN: not known) shapes the advice: average from where the detected transient
-/// ends when that is before the window, else run longer.
+/// half-width), error_dof (all three from WindowError::err), error_method ("gapped_batch_means",
+/// "two_halves", or "two_stage" where time.target_rel_error stopped the run), error_batches,
+/// correlation_time_s, correlation_time_upper_s, effective_samples, window_correlation_times (Sokal's
+/// diagnostics); null where not available. With `warn` (a finished run), a warning goes to j["warnings"] and
+/// stderr when the window holds fewer than ~20 correlation times, saying what the error then rests on. `what`
+/// names the quantity. `transient_end_s` (NaN: not known) shapes the advice: average from where the detected
+/// transient ends when that is before the window, else run longer.
 void report_window_error(nlohmann::json& j, const std::string& prefix, const std::string& what,
                          const stats::WindowError& w, bool warn,
                          double transient_end_s = std::numeric_limits<double>::quiet_NaN());
 
 /// The window a run averages over, from what it collected since start.collect_from_s(): cut at the
-/// transient where `start` is automatic (stats::cut_at_transient), as collected otherwise. One
+/// transient where `start` is automatic (stats::cut_at_transient; where the first stage of the
+/// precision target's `plan` cut it, when the plan stopped the run), as collected otherwise. One
 /// rule for the scene and for `case summarize`.
 stats::ChosenWindow averaging_window(const WindowStart& start, const stats::StepSeries& s,
-                                     const std::vector<double>& collected, double now_s);
+                                     const std::vector<double>& collected, double now_s,
+                                     const stats::TwoStagePlan* plan = nullptr);
 
 /// transient_end_s (stats/transient.hpp: transient_end over the whole series) and average_from_s
 /// in `j`; with `warn`, a warning when the transient ends after the window's start and the

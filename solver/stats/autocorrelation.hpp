@@ -1,5 +1,7 @@
 #pragma once
 // The error of the mean of a correlated series from its integrated autocorrelation time (Sokal).
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -31,6 +33,14 @@ namespace boycott::stats {
 /// that covers 68 % is the standard error times Student's t at that dof (covering_error). On AR(1)
 /// series it covers 0.69-0.70 at 20 correlation times, 0.71-0.73 at 50-100 and 0.70 at 300, where
 /// the plain standard error covers 0.59-0.61 at 20 (docs/validation.md, "Error bars").
+///
+/// The correlation span, 1/2 + sum_{t=1}^{M'} |rho(t)| with its own window M' >= c span(M') (at
+/// most N/4), is how long the series remembers itself whichever the sign: tau_int for a series
+/// whose correlation is positive (AR(1), sums of them), but for a damped oscillation, whose lobes
+/// cancel in tau_int (which can be far below the envelope's decay time, or no estimate at all), a
+/// good part of the envelope's decay time (2/pi of it for a damped cosine). Batch means need
+/// batches long against it (stats/window_error.hpp); span_times counts the spans in the series as
+/// correlation_times counts tau_int, at the upper end of the one-sigma range of M' lags.
 struct AutocorrelationError {
   std::int64_t samples = 0;
   double mean = 0.0;
@@ -43,8 +53,17 @@ struct AutocorrelationError {
   double correlation_times = 0.0;  ///< N / tau_int_upper (the conservative count above)
   double dof = 0.0;                ///< N / (2M + 1), the degrees of freedom of stderr_of_mean
   double covering_error = 0.0;     ///< stderr_of_mean * t_dof, covering ~68 %; NaN with it
+  double span = 0.0;               ///< correlation span, in samples (below)
+  double span_times = 0.0;         ///< N / span_upper, the conservative count of spans
   /// Whether the error is to be doubted: fewer than kWarnCorrelationTimes, or no closed window.
   bool doubtful() const { return !window_closed || !(correlation_times >= kWarnCorrelationTimes); }
+  /// The count that decides how long batches must be: the smaller of correlation_times and
+  /// span_times, whichever has an estimate (NaN where neither has).
+  double batch_count() const {
+    if (std::isnan(span_times)) return correlation_times;
+    if (std::isnan(correlation_times)) return span_times;
+    return std::min(correlation_times, span_times);
+  }
   static constexpr double kWarnCorrelationTimes = 20.0;
   static constexpr double kMinCorrelationTimes = 5.0;
   static constexpr double kWindowFactor = 6.0;  ///< c

@@ -1,10 +1,9 @@
 #pragma once
 // The sampling distributions an error bar needs: Student's t (the mean of a few numbers over
 // their own scatter), chi-square (a scatter against known errors) and F (a scatter against
-// errors that are themselves estimated). Regularised incomplete beta
-// and gamma functions by their continued fractions and series (Abramowitz & Stegun 26.5.8,
-// 6.5.29, 6.5.31), evaluated with the modified Lentz method (Thompson & Barnett, J. Comput. Phys.
-// 64, 490 (1986)).
+// errors that are themselves estimated), from Boost.Math (Debian's libboost-math-dev, header
+// only): its documented accuracy, tails and non-integer degrees of freedom, tested far beyond what
+// a project of our own could. Arguments outside a function's domain give NaN.
 
 namespace boycott::stats {
 

@@ -126,10 +126,18 @@ std::optional<double> ratio_error(double w, const PointError& e, double w90, con
   const double a = *e.plain_m_s / w90, b = r * *e90.plain_m_s / w90;
   const double var = a * a + b * b;
   if (var == 0.0) return 0.0;
-  const auto term = [](double x, double nu) { return std::isinf(nu) ? 0.0 : x * x * x * x / nu; };
-  const double denom = term(a, e.dof) + term(b, e90.dof);
-  const double nu = denom > 0.0 ? var * var / denom : std::numeric_limits<double>::infinity();
-  return std::sqrt(var) * one_sigma_t_factor(nu);
+  return std::sqrt(var) * one_sigma_t_factor(welch_dof(a * a, e.dof, b * b, e90.dof));
+}
+
+double welch_dof(double var_a, double dof_a, double var_b, double dof_b) {
+  // Each part's share of var^2 over its dof + 2: s^4 nu / (nu + 2) is the unbiased estimate of
+  // sigma^4 (E s^4 = sigma^4 (nu + 2) / nu), where Satterthwaite's s^4 / nu is biased high.
+  const auto term = [](double v, double nu) { return std::isinf(nu) ? 0.0 : v * v / (nu + 2.0); };
+  const double denom = term(var_a, dof_a) + term(var_b, dof_b);
+  if (!(denom > 0.0)) return std::numeric_limits<double>::infinity();
+  const double nu = (var_a + var_b) * (var_a + var_b) / denom - 2.0;
+  // At least the smaller part's own dof (reached where that part is all of the variance).
+  return std::max(nu, std::min(dof_a, dof_b));
 }
 
 int stein_replicas_needed(const std::vector<double>& stage_one_w, double target_rel_error, int max) {

@@ -15,8 +15,8 @@
 //   and the error is t_{n0-1} s0 / sqrt(n), which covers exactly whatever n s0 led to; the plain
 //   t_{n-1} s / sqrt(n) after a stop that s itself decided covers less (0.63 at a target that needs
 //   8 replicas).
-// - r_acc = w / w90: first-order propagation of the two points' variances with the
-//   Welch-Satterthwaite degrees of freedom, then Student's t at those.
+// - r_acc = w / w90: first-order propagation of the two points' variances with Welch's (1947)
+//   degrees of freedom, then Student's t at those (welch_dof below).
 #include <optional>
 #include <string>
 #include <vector>
@@ -57,8 +57,17 @@ ReplicaMean replica_mean(const std::vector<double>& w);
 PointError point_error(const std::vector<RunEstimate>& runs, int stage_one = 0);
 
 /// The covering error of r = w / w90 from the two points' plain errors and degrees of freedom
-/// (independent points). Unset when either has none.
+/// (independent points; welch_dof). Unset when either has none.
 std::optional<double> ratio_error(double w, const PointError& e, double w90, const PointError& e90);
+
+/// The degrees of freedom of a sum of two independent variance estimates var_a + var_b with dof_a
+/// and dof_b (infinite: known): B. L. Welch, Biometrika 34, 28 (1947),
+/// (var_a + var_b)^2 / (var_a^2 / (dof_a + 2) + var_b^2 / (dof_b + 2)) - 2, at least
+/// min(dof_a, dof_b). Satterthwaite's form (dof_i in place of dof_i + 2, no - 2) estimates each
+/// sigma^4 by s^4, which is biased high by (nu + 2) / nu: 3x at one degree of freedom, so its
+/// count is low where the parts rest on 1-2 each, and t at it covers 0.70-0.74 at 2 replicas per
+/// point. Welch's covers 0.665-0.70 there, 0.67-0.69 at 3 and 4 (docs/validation.md, "r_acc").
+double welch_dof(double var_a, double dof_a, double var_b, double dof_b);
 
 /// The replicas an adaptive point needs under Stein's rule: the smallest n >= stage-one count
 /// with t_{n0-1} s0 / sqrt(n) <= target |mean0|, at most `max` (from its first replicas).

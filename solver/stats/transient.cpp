@@ -3,86 +3,81 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
 
 #include "stats/autocorrelation.hpp"
+#include "stats/distributions.hpp"
 
 namespace boycott::stats {
 
 namespace {
 
-// Batch means of x: `block` samples each, the incomplete last one left out.
-std::vector<double> batch_means(const std::vector<double>& x, std::int64_t block) {
-  std::vector<double> b(x.size() / static_cast<std::size_t>(block));
-  for (std::size_t i = 0; i < b.size(); ++i) {
-    double s = 0.0;
-    for (std::int64_t k = 0; k < block; ++k) s += x[i * block + k];
-    b[i] = s / static_cast<double>(block);
-  }
-  return b;
+// The mean of x[from, from + len).
+double segment_mean(const std::vector<double>& x, std::int64_t from, std::int64_t len) {
+  double m = 0.0;
+  for (std::int64_t i = from; i < from + len; ++i) m += x[static_cast<std::size_t>(i)];
+  return m / static_cast<double>(len);
 }
 
-// The start in [0, b.size() / 2] with the most effective samples, (n - t0) / (2 tau_int), on a
-// grid of kCandidates starts, and that count; none where no start gives an estimate.
-struct EffectiveStart {
-  std::int64_t start = 0;
-  double effective_samples = 0.0;
+// The reference: the last `count` segments of `len` samples (the last one ending at the series'
+// end), their mean, the scatter of their means (the variance of one segment's mean, estimated
+// without a model of the correlation) and the variance of the samples.
+struct Reference {
+  std::int64_t count = 0;
+  double mean = 0.0, segment_var = 0.0, var = 0.0;
 };
-std::optional<EffectiveStart> most_effective_samples_start(const std::vector<double>& b) {
-  const auto nb = static_cast<std::int64_t>(b.size());
-  std::optional<EffectiveStart> best;
-  for (int c = 0; c <= TransientEnd::kCandidates; ++c) {
-    const std::int64_t t0 = nb / 2 * c / TransientEnd::kCandidates;
-    const double neff = autocorrelation_error(std::vector<double>(b.begin() + t0, b.end())).effective_samples;
-    if (std::isfinite(neff) && !(best && neff <= best->effective_samples)) best = EffectiveStart{t0, neff};
+Reference reference(const std::vector<double>& x, std::int64_t len, std::int64_t count) {
+  Reference r{count};
+  const auto n = static_cast<std::int64_t>(x.size());
+  std::vector<double> means(static_cast<std::size_t>(count));
+  for (std::int64_t j = 0; j < count; ++j) {
+    means[static_cast<std::size_t>(j)] = segment_mean(x, n - (j + 1) * len, len);
+    r.mean += means[static_cast<std::size_t>(j)] / static_cast<double>(count);
   }
-  return best;
-}
-
-// MSER: the start in [0, b.size() / 2] with the least marginal standard error,
-// sum over i >= t0 of (b_i - mean)^2 / (n - t0)^2, from suffix sums in O(n).
-std::int64_t mser_start(const std::vector<double>& b) {
-  const auto nb = static_cast<std::int64_t>(b.size());
-  std::vector<double> s1(b.size() + 1, 0.0), s2(b.size() + 1, 0.0);
-  for (std::int64_t i = nb - 1; i >= 0; --i) {
-    s1[i] = s1[i + 1] + b[i];
-    s2[i] = s2[i + 1] + b[i] * b[i];
-  }
-  double best = std::numeric_limits<double>::infinity();
-  std::int64_t start = 0;
-  for (std::int64_t t0 = 0; t0 <= nb / 2; ++t0) {
-    const double m = static_cast<double>(nb - t0), mean = s1[t0] / m;
-    const double mser = std::max(0.0, s2[t0] / m - mean * mean) / m;
-    if (mser < best) {
-      best = mser;
-      start = t0;
-    }
-  }
-  return start;
+  for (double m : means) r.segment_var += (m - r.mean) * (m - r.mean) / static_cast<double>(count - 1);
+  for (std::int64_t i = n - count * len; i < n; ++i)
+    r.var += (x[static_cast<std::size_t>(i)] - r.mean) * (x[static_cast<std::size_t>(i)] - r.mean) /
+             static_cast<double>(count * len);
+  return r;
 }
 
 }  // namespace
 
 TransientEnd transient_end(const std::vector<double>& x) {
   TransientEnd cut;
-  cut.effective_samples = std::numeric_limits<double>::quiet_NaN();
   const auto n = static_cast<std::int64_t>(x.size());
   if (n < 16) return cut;
-  // The correlation time survives blocking to kMaxBlocks; MSER-5 batches at least 5 samples.
-  const std::int64_t block = (n + TransientEnd::kMaxBlocks - 1) / TransientEnd::kMaxBlocks;
-  const std::int64_t batch = std::max(TransientEnd::kBatch, block);
-  const std::vector<double> b = batch_means(x, block);
-  const auto effective_start = most_effective_samples_start(b);
-  if (!effective_start) return cut;
-  const std::int64_t mser =
-      batch == block ? mser_start(b) : mser_start(batch_means(x, batch)) * batch / block;
-  const std::int64_t start_block = std::max(effective_start->start, mser);
-  cut.start = start_block * block;
-  // Counted on the blocks (blocking keeps the count); MSER's later cut is counted anew.
-  cut.effective_samples =
-      start_block == effective_start->start
-          ? effective_start->effective_samples
-          : autocorrelation_error(std::vector<double>(b.begin() + start_block, b.end())).effective_samples;
+  const std::int64_t len = std::max<std::int64_t>(1, n / (2 * TransientEnd::kSegments));
+  const std::int64_t refs = (n - n / 2) / len;
+  if (refs < 4) return cut;
+  const Reference ref = reference(x, len, refs);
+  if (!(ref.segment_var > 0.0)) return cut;
+  cut.estimated = true;
+  // A segment's mean less the reference's: the segment's variance and the reference's, as if
+  // independent; Student's t at the reference's refs - 1 degrees of freedom.
+  const double q = student_t_quantile(1.0 - TransientEnd::kFalseAlarm / 2.0, static_cast<double>(refs - 1));
+  const double diff_var = ref.segment_var * (1.0 + 1.0 / static_cast<double>(refs));
+  const std::int64_t segments = std::min<std::int64_t>(TransientEnd::kSegments, (n - refs * len) / len);
+  std::int64_t end = 0;
+  for (std::int64_t j = 0, clean = 0; j < segments && clean < 2; ++j) {
+    const double m = segment_mean(x, j * len, len);
+    double spread = 0.0;
+    for (std::int64_t i = j * len; i < (j + 1) * len; ++i)
+      spread += (x[static_cast<std::size_t>(i)] - m) * (x[static_cast<std::size_t>(i)] - m) /
+                static_cast<double>(len);
+    const bool differs =
+        (m - ref.mean) * (m - ref.mean) > q * q * diff_var || spread > TransientEnd::kSpreadFactor * ref.var;
+    clean = differs ? 0 : clean + 1;
+    if (differs) end = j + 1;
+  }
+  cut.detected = end * len;
+  if (end > 0) {
+    // The reference's correlation span, its upper end (samples): how long the series remembers.
+    const AutocorrelationError e = autocorrelation_error(std::vector<double>(x.end() - refs * len, x.end()));
+    const double span = std::isfinite(e.span_times) && e.span_times > 0.0
+                            ? static_cast<double>(refs * len) / e.span_times
+                            : 0.0;
+    cut.start = std::min<std::int64_t>(n / 2, cut.detected + std::llround(TransientEnd::kGuardSpans * span));
+  }
   return cut;
 }
 
@@ -104,10 +99,15 @@ bool transient_biases_mean(const std::vector<double>& x, std::int64_t from, std:
 
 ChosenWindow cut_at_transient(const StepSeries& s, const std::vector<double>& window, double collected_from_s,
                               double now_s) {
-  ChosenWindow c{s, window, collected_from_s};
   const TransientEnd cut = transient_end(window);
-  if (!std::isfinite(cut.effective_samples) || cut.start <= 0) return c;
-  const auto k = static_cast<std::size_t>(cut.start);
+  return cut_window_at(s, window, collected_from_s, now_s, cut.estimated ? cut.start : 0);
+}
+
+ChosenWindow cut_window_at(const StepSeries& s, const std::vector<double>& window, double collected_from_s,
+                           double now_s, std::int64_t cut) {
+  ChosenWindow c{s, window, collected_from_s};
+  if (cut <= 0) return c;
+  const auto k = std::min(static_cast<std::size_t>(cut), window.size());
   c.steps.before.insert(c.steps.before.end(), window.begin(),
                         window.begin() + static_cast<std::ptrdiff_t>(k));
   c.window.erase(c.window.begin(), c.window.begin() + static_cast<std::ptrdiff_t>(k));

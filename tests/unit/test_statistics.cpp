@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "stats/autocorrelation.hpp"
+#include "stats/precision_target.hpp"
 #include "stats/running.hpp"
 
 using namespace boycott::stats;
@@ -147,4 +148,29 @@ TEST(AutocorrelationError, WhiteNoiseGivesThePlainStandardError) {
   const auto c = autocorrelation_error(std::vector<double>(100, 3.0));
   EXPECT_EQ(c.stderr_of_mean, 0.0);
   EXPECT_EQ(c.mean, 3.0);
+}
+
+TEST(PrecisionTarget, AResumedRunPlansItsLengthForItsOwnTargetFromTheSameFirstStage) {
+  // A loose target (5 %) stops an AR(1) series (tau_int 10 steps, mean 1); its checkpointed state,
+  // restored under the same target, stops at the same sample, and under a strict one (0.01 %)
+  // plans a run 500^2 times as long in relative error terms and does not stop.
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const double phi = 19.0 / 21.0, sd = std::sqrt(1.0 - phi * phi);
+  boycott::stats::PrecisionTarget loose(0.05);
+  std::vector<double> x;
+  double v = g(rng);
+  while (x.size() < 200000) {
+    x.push_back(1.0 + (v = phi * v + sd * g(rng)));
+    if (loose.reached(x, 0.0, static_cast<double>(x.size()))) break;
+  }
+  ASSERT_LT(x.size(), 200000u);
+  ASSERT_TRUE(loose.plan().set());
+  boycott::stats::PrecisionTarget same(0.05), strict(1e-4);
+  same.from_state(loose.to_state());
+  strict.from_state(loose.to_state());
+  EXPECT_EQ(same.plan().planned, loose.plan().planned);
+  EXPECT_TRUE(same.reached(x, 0.0, static_cast<double>(x.size())));
+  EXPECT_FALSE(strict.reached(x, 0.0, static_cast<double>(x.size())));
+  EXPECT_GT(strict.plan().planned, 1000 * loose.plan().planned);
 }

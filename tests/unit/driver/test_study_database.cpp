@@ -1,6 +1,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -360,10 +361,12 @@ average_from = 1.0
   EXPECT_EQ(pts[1].error_method, "batch_means");
   EXPECT_NEAR(*pts[0].r_acc, m45 / m90, 1e-12);
   // The covering errors: t at 2 degrees of freedom (the replicas' own errors of 1 % agree with
-  // their scatter: no chi-square note), and r_acc's from Welch-Satterthwaite, written out.
+  // their scatter: no chi-square note), and r_acc's at Welch's (1947) degrees of freedom, written
+  // out: each part's s^4 over its dof + 2, less 2, and at least the smaller part's dof (2).
   EXPECT_NEAR(*pts[0].error.error_m_s, boycott::stats::one_sigma_t_factor(2.0) * e45, 1e-15);
   const double a = e45 / m90, b = m45 / m90 * e90 / m90;
-  const double nu = (a * a + b * b) * (a * a + b * b) / (a * a * a * a / 2.0 + b * b * b * b / 2.0);
+  const double nu =
+      std::max(2.0, (a * a + b * b) * (a * a + b * b) / (a * a * a * a / 4.0 + b * b * b * b / 4.0) - 2.0);
   EXPECT_NEAR(*pts[0].r_acc_err, std::hypot(a, b) * boycott::stats::one_sigma_t_factor(nu), 1e-12);
   EXPECT_EQ(*pts[1].r_acc_err, 0.0);
   // The error keys of <<w_p>> are not validation errors.

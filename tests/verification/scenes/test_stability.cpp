@@ -79,6 +79,16 @@ double terminal_speed(const CaseParams& p) {
 // Runs the case to its end and checks what "stable" means here: exit 0, alpha_f within (0, 1] in
 // every cell at every step, the kinetic energy below that of every particle moving at ten
 // isolated terminal speeds, and a finite <<w_p>>.
+// The message of the PhysicsError a run ends with ("" when it ends without one).
+std::string physics_error_of(const CaseParams& p, RunContext& ctx) {
+  try {
+    run_case(p, ctx);
+  } catch (const PhysicsError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 void expect_stable(const std::string& tag, const std::vector<std::string>& sets) {
   const CaseParams p = small_case(sets);
   RunContext ctx;
@@ -170,12 +180,7 @@ TEST(StiffAndExtremeCases, WithoutTheStepLimitAViscousPackedBedOscillatesUntilAl
   RunContext ctx;
   ctx.quiet = true;
   ctx.out_dir = fresh_dir("viscous_bed_unlimited");
-  std::string message;
-  try {
-    run_case(p, ctx);
-  } catch (const PhysicsError& e) {
-    message = e.what();
-  }
+  const std::string message = physics_error_of(p, ctx);
   std::printf("[ report ] viscous bed without the limit: %s\n", message.c_str());
   EXPECT_NE(message.find("fluid fraction outside (0, 1]"), std::string::npos) << message;
 }
@@ -328,12 +333,7 @@ TEST(StiffAndExtremeCases, NanStopsTheRunBeforeItIsCheckpointed) {
 
   stop = false;
   ctx.progress = nullptr;
-  std::string message;
-  try {
-    run_case(p, ctx);
-  } catch (const PhysicsError& e) {
-    message = e.what();
-  }
+  const std::string message = physics_error_of(p, ctx);
   std::printf("[ report ] NaN run stopped: %s\n", message.c_str());
   EXPECT_NE(message.find("NaN"), std::string::npos) << message;
   EXPECT_EQ(files_in(dir / "checkpoints"), before) << "no checkpoint may be written after the NaN";

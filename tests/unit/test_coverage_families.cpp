@@ -1,0 +1,281 @@
+// Whether one run's error bar keeps its promise on series that are not AR(1) (issue 61): over
+// 10 000 series per figure with fixed seeds, the share whose stated interval holds the true mean
+// (0, or 1 for a relative target). Families (tests/unit/series_families.hpp): AR(1) of tau_int 10
+// steps; sums of two AR(1) processes 3-30 times apart in time, the slow one carrying 0.1-0.5 of
+// the variance; a damped oscillation (period 8-40 steps, envelope 1-4 periods) plus white noise.
+// Windows are counted in the slowest time scale (the slow AR(1)'s tau_int, the envelope's decay
+// time). Each figure is held within kBand of the value measured when the rule was settled (so a
+// change of the rules worth 0.02 shows), and within 0.65-0.71 (the promise). Binomial standard
+// error of a coverage near 0.68 at 10 000 series: 0.0047. Label `long` (minutes).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "stats/autocorrelation.hpp"
+#include "stats/distributions.hpp"
+#include "stats/precision_target.hpp"
+#include "stats/transient.hpp"
+#include "stats/window_error.hpp"
+#include "tests/unit/early_stop_coverage.hpp"
+#include "tests/unit/series_families.hpp"
+
+using namespace boycott::stats;
+using boycott::testing::FamilySeries;
+
+namespace {
+
+constexpr int kSeries = 10000;
+constexpr double kBand = 0.015;  // about 3 binomial standard errors
+
+using Family = std::function<FamilySeries(double window, std::mt19937_64&)>;
+Family family(const std::string& name) {
+  if (name == "ar1")
+    return [](double w, std::mt19937_64& r) { return boycott::testing::ar1_series(10.0, w, r); };
+  if (name == "two_scales") return boycott::testing::two_scale_series;
+  return boycott::testing::oscillation_series;
+}
+
+// One run's error as a run with a fixed window reports it (window_error), `narrow` times its
+// half-width (1: as reported; below 1: a planted defect).
+double one_run_coverage(const std::string& name, double window, std::uint64_t seed, double narrow = 1.0) {
+  std::mt19937_64 rng(seed);
+  const Family make = family(name);
+  int covered = 0;
+  for (int s = 0; s < kSeries; ++s) {
+    const FamilySeries f = make(window, rng);
+    const WindowError w = window_error(f.x, 0.0, static_cast<double>(f.x.size()));
+    covered += std::abs(w.e.mean) <= narrow * w.err.covering_error;
+  }
+  const double c = static_cast<double>(covered) / kSeries;
+  std::printf("coverage, one run, %s, %g slowest times: %.4f\n", name.c_str(), window, c);
+  return c;
+}
+
+void expect_figure(double measured, double settled, const std::string& what) {
+  EXPECT_NEAR(measured, settled, kBand) << what;
+  EXPECT_GE(measured, 0.65) << what;
+  EXPECT_LE(measured, 0.71) << what;
+}
+
+}  // namespace
+
+TEST(FamilyCoverage, OneRunErrorCoversTwoThirdsFrom10SlowestTimesOnEveryFamily) {
+  struct Figure {
+    const char* family;
+    double window, settled;
+  };
+  const Figure figures[] = {{"ar1", 10, 0.6661},         {"ar1", 50, 0.6847},
+                            {"ar1", 200, 0.6800},        {"two_scales", 10, 0.6713},
+                            {"two_scales", 20, 0.6732},  {"two_scales", 50, 0.6578},
+                            {"two_scales", 200, 0.6764}, {"oscillation", 10, 0.6922},
+                            {"oscillation", 50, 0.6913}, {"oscillation", 200, 0.6861}};
+  std::uint64_t seed = 61000;
+  for (const auto& f : figures)
+    expect_figure(one_run_coverage(f.family, f.window, ++seed), f.settled,
+                  std::string(f.family) + " " + std::to_string(f.window));
+}
+
+TEST(FamilyCoverage, AnErrorFivePerCentTooNarrowFallsOutsideTheBand) {
+  // The planted defect: the same figure with every half-width 5 % narrower, which moves a
+  // coverage near 0.68 by up to 2 phi(1) 0.05 ~ 0.024 (less where few degrees of freedom flatten
+  // the distribution at the bar's end); the band must not let it through.
+  const double settled = 0.6800;  // ar1, 200 correlation times, seed as above
+  const double defective = one_run_coverage("ar1", 200, 61003, 0.95);
+  EXPECT_GT(std::abs(defective - settled), kBand);
+}
+
+namespace {
+
+// A run that time.target_rel_error stops (PrecisionTarget, two-stage), on 1 + a family's series,
+// the target set to need ~`goal` slowest times; its reported error at the stop.
+double target_coverage(const std::string& name, double goal, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  const Family make = family(name);
+  int covered = 0, stopped = 0;
+  for (int s = 0; s < kSeries; ++s) {
+    const FamilySeries f = make(12.0 * goal, rng);
+    const double rel = one_sigma_t_factor(7.0) * std::sqrt(2.0 * f.tau_int / (goal * f.slowest));
+    PrecisionTarget target(rel);
+    std::vector<double> w;
+    w.reserve(f.x.size());
+    bool done = false;
+    for (double v : f.x) {
+      w.push_back(1.0 + v);
+      if ((done = target.reached(w, 0.0, static_cast<double>(w.size())))) break;
+    }
+    if (!done) continue;
+    ++stopped;
+    const WindowError e = window_error(w, 0.0, static_cast<double>(w.size()), &target.plan());
+    covered += std::abs(e.e.mean - 1.0) <= e.err.covering_error;
+  }
+  const double c = static_cast<double>(covered) / stopped;
+  std::printf("coverage, target stop, %s, goal %g slowest times: %.4f (%d of %d stopped)\n", name.c_str(),
+              goal, c, stopped, kSeries);
+  return c;
+}
+
+}  // namespace
+
+// time.target_rel_error on AR(1) series (tau_int 10 steps): the error a run reports where the target
+// stopped it, at three target levels, 10 000 series each (test_run_statistics.cpp holds a quick
+// check on 1 000).
+TEST(EarlyStopCoverage, TheErrorAtTheStopCoversTwoThirdsOnAr1AtThreeTargets) {
+  for (double target : {0.2, 0.15, 0.12}) {
+    const auto f =
+        boycott::testing::ar1_early_stop_coverage(target, kSeries, 5000 + static_cast<int>(target * 1000));
+    std::printf("coverage, early stop at target %g: %.4f (stopped %d of %d, mean %.0f tau_int)\n", target,
+                f.coverage(), f.stopped, kSeries, f.mean_tau);
+    EXPECT_EQ(f.stopped, kSeries);
+    EXPECT_GE(f.coverage(), 0.66) << "target " << target;
+    EXPECT_LE(f.coverage(), 0.705) << "target " << target;
+  }
+}
+
+// Settled on 10 000 series per family under the tau_int trigger and 4 batches at the first stage
+// (the test was disabled after 2 000 series gave 0.653 / 0.646 on two scales / oscillation at an
+// earlier state of the rules; on the merged rules 2 000 series give 0.653 / 0.679). The series
+// that never stop within 12x the goal (0.8 / 2.0 / 6.4 %) are left out of the figure. Two scales
+// sits 1 binomial error above the promise's 0.65.
+TEST(FamilyCoverage, ARunTheTargetStopsCoversTwoThirdsOnEveryFamily) {
+  struct Figure {
+    const char* family;
+    double goal, settled;
+  };
+  const Figure figures[] = {{"ar1", 300, 0.6761}, {"two_scales", 300, 0.6547}, {"oscillation", 300, 0.6834}};
+  std::uint64_t seed = 62000;
+  for (const auto& f : figures) expect_figure(target_coverage(f.family, f.goal, ++seed), f.settled, f.family);
+}
+
+namespace {
+
+struct AutoFigures {
+  double coverage = 0.0, cut = 0.0, unbiased = 0.0;
+};
+// average_from = "auto" (cut_at_transient) on a family's series of `window` slowest times plus a
+// start-up decay A exp(-t / (5 slowest)) that biases the whole series' mean by `bias_se` true
+// standard errors: the reported error's coverage, the share of series cut, and the share whose
+// remaining bias is below half a standard error of what is kept.
+AutoFigures auto_window_figures(const std::string& name, double window, double bias_se, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  const Family make = family(name);
+  AutoFigures a;
+  for (int s = 0; s < kSeries; ++s) {
+    FamilySeries f = make(window, rng);
+    const double n = static_cast<double>(f.x.size()), decay = 5.0 * f.slowest;
+    const double amplitude = bias_se * f.true_se() * n / decay;
+    auto transient = [&](std::size_t i) { return amplitude * std::exp(-static_cast<double>(i) / decay); };
+    for (std::size_t i = 0; i < f.x.size(); ++i) f.x[i] += transient(i);
+    const ChosenWindow c = cut_at_transient(StepSeries{}, f.x, 0.0, n);
+    const std::size_t k = f.x.size() - c.window.size();
+    double residual = 0.0;
+    for (std::size_t i = k; i < f.x.size(); ++i)
+      residual += transient(i) / static_cast<double>(c.window.size());
+    const WindowError w = window_error(c.window, 0.0, n);
+    a.coverage += (std::abs(w.e.mean) <= w.err.covering_error) / static_cast<double>(kSeries);
+    a.cut += (k > 0) / static_cast<double>(kSeries);
+    a.unbiased += (residual < 0.5 * std::sqrt(2.0 * f.tau_int / static_cast<double>(c.window.size()))) /
+                  static_cast<double>(kSeries);
+  }
+  std::printf(
+      "auto window, %s, %g slowest times, transient of %g standard errors: coverage %.4f, cut %.4f, "
+      "unbiased after the cut %.4f\n",
+      name.c_str(), window, bias_se, a.coverage, a.cut, a.unbiased);
+  return a;
+}
+
+}  // namespace
+
+TEST(FamilyCoverage, AnAutomaticWindowCutsFewStationarySeriesAndItsErrorCovers) {
+  struct Figure {
+    const char* family;
+    double settled;
+  };
+  const Figure figures[] = {{"ar1", 0.6836}, {"two_scales", 0.6576}, {"oscillation", 0.6929}};
+  std::uint64_t seed = 63000;
+  for (const auto& f : figures) {
+    const AutoFigures a = auto_window_figures(f.family, 50.0, 0.0, ++seed);
+    expect_figure(a.coverage, f.settled, f.family);
+    EXPECT_LE(a.cut, 0.1) << f.family;
+  }
+}
+
+TEST(FamilyCoverage, AnAutomaticWindowCutsAStrongTransientOfAr1ToBelowHalfAStandardErrorAndKeepsItsFigures) {
+  struct Figure {
+    const char* family;
+    double coverage, unbiased;
+  };
+  // Settled, not the promise: on the two-scale and oscillating families a slow decay under the
+  // fast noise is cut too early (unbiased 0.33 and 0.17, coverage 0.63 and 0.62; issue 61 asks 0.9 and
+  // 0.65-0.71; docs/validation.md, "Series that are not AR(1)").
+  const Figure figures[] = {
+      {"ar1", 0.6838, 0.9938}, {"two_scales", 0.6267, 0.3297}, {"oscillation", 0.6217, 0.1683}};
+  std::uint64_t seed = 64000;
+  for (const auto& f : figures) {
+    const AutoFigures a = auto_window_figures(f.family, 50.0, 3.0, ++seed);
+    EXPECT_NEAR(a.coverage, f.coverage, kBand) << f.family;
+    EXPECT_NEAR(a.unbiased, f.unbiased, kBand) << f.family;
+    if (std::string(f.family) == "ar1") {
+      EXPECT_GE(a.unbiased, 0.9);
+    }
+  }
+}
+
+namespace {
+
+// The committed full-size 75 deg run's <w_p> rows (every 0.01 s; docs/results.md), from where the
+// product's own cut puts the end of its start-up transient.
+std::vector<double> plateau_75_degrees() {
+  std::ifstream in(BOYCOTT_SOURCE_DIR "/docs/results/timeseries/9592e8d74a5a4760.csv");
+  std::string line;
+  std::getline(in, line);  // time_s,mean_wp_m_s,...
+  std::vector<double> w;
+  while (std::getline(in, line)) w.push_back(std::stod(line.substr(line.find(',') + 1)));
+  const auto cut = transient_end(w).start;
+  return std::vector<double>(w.begin() + cut, w.end());
+}
+
+}  // namespace
+
+TEST(FamilyCoverage, BlockBootstrapOfThe75DegreeRunsFluctuationsIsCovered) {
+  // A real series' own correlation, whatever it is: the 75 deg plateau's fluctuations about their
+  // mean, resampled as a circular block bootstrap (blocks of 5 tau_upper, random starts) into
+  // series of `window` tau_int whose true mean is 0 (each block start equally likely, so the
+  // resampled mean's expectation is the plateau's mean, subtracted). Correlation across a block's
+  // end is lost, so blocks must be long against tau. Windows of at least 5 blocks: the plateau
+  // holds only ~12 tau_upper, so its block means are few and far from normal (it drifts: halves
+  // 192.1 and 187.4 mm/s), and a series of two blocks inherits that (0.61 at 20 tau_int, whose
+  // two halves are the two blocks: when both come from the same part they agree by construction).
+  auto x = plateau_75_degrees();
+  ASSERT_GE(x.size(), 400u);
+  const auto e = autocorrelation_error(x);
+  for (double& v : x) v -= e.mean;
+  const auto block = static_cast<std::size_t>(std::ceil(5.0 * e.tau_int_upper));
+  std::printf("75 deg plateau: %zu rows, tau_int %.1f rows (upper %.1f), blocks of %zu rows\n", x.size(),
+              e.tau_int, e.tau_int_upper, block);
+  struct Figure {
+    double window, settled;
+  };
+  for (const Figure f : {Figure{50.0, 0.6870}, Figure{100.0, 0.6829}}) {
+    std::mt19937_64 rng(65000 + static_cast<int>(f.window));
+    std::uniform_int_distribution<std::size_t> start(0, x.size() - 1);
+    const auto n = static_cast<std::size_t>(f.window * e.tau_int);
+    int covered = 0;
+    for (int s = 0; s < kSeries; ++s) {
+      std::vector<double> y;
+      y.reserve(n + block);
+      while (y.size() < n)
+        for (std::size_t i = 0, a = start(rng); i < block && y.size() < n; ++i)
+          y.push_back(x[(a + i) % x.size()]);
+      const WindowError w = window_error(y, 0.0, static_cast<double>(n));
+      covered += std::abs(w.e.mean) <= w.err.covering_error;
+    }
+    const double c = static_cast<double>(covered) / kSeries;
+    std::printf("coverage, block bootstrap of the 75 deg plateau, %g tau_int: %.4f\n", f.window, c);
+    expect_figure(c, f.settled, "75 deg bootstrap " + std::to_string(f.window));
+  }
+}
