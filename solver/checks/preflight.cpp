@@ -113,6 +113,36 @@ void check_kernel_resolution(const CaseParams& p, Preflight& r) {
         peak));
 }
 
+/// The lift law against the settling Reynolds number Re_p (the isolated terminal slip's) of
+/// the published range it rests on (coupling/lift_laws.hpp). Each law also needs a shear
+/// Reynolds number Re_w = |w| d^2 / nu, a property of the flow that is not known before the run
+/// (output.force_budget_y reports it per band), so only Re_p is judged here, and the message
+/// names the Re_w condition too.
+void check_lift_range(const CaseParams& p, double re_p, Preflight& r) {
+  const std::string law = p.forces.saffman_lift ? p.forces.lift : "none";
+  const std::string instead =
+      re_p <= 100.0 ? "; saffman_mei is fitted up to Re_p = 100" : "; no lift law here covers Re_p > 100";
+  // The asymptotic theories assume Re_p << 1; from Re_p = 1 a case is outside them.
+  if (law == "saffman" && re_p >= 1.0)
+    r.warnings.push_back(fmt::format(
+        "forces.lift = \"saffman\" at Re_p = {:.3g}: Saffman's (1965, 1968) lift holds for Re_p << "
+        "Re_w^1/2 << 1 (slip and shear Reynolds numbers both small, the shear's dominating){}",
+        re_p, instead));
+  if (law == "mclaughlin" && re_p >= 1.0)
+    r.warnings.push_back(fmt::format(
+        "forces.lift = \"mclaughlin\" at Re_p = {:.3g}: McLaughlin's (1991) J(epsilon) holds for Re_p << 1 "
+        "and Re_w << 1 (epsilon = Re_w^1/2 / Re_p free){}",
+        re_p, instead));
+  // Mei (1992) fitted Dandy & Dwyer's (1990) computations over 0.1 <= Re_p <= 100 and
+  // 0.005 <= Re_w / (2 Re_p) <= 0.4.
+  if (law == "saffman_mei" && (re_p < 0.1 || re_p > 100.0))
+    r.warnings.push_back(
+        fmt::format("forces.lift = \"saffman_mei\" at Re_p = {:.3g}: Mei's (1992) factor is a fit over 0.1 "
+                    "<= Re_p <= 100 "
+                    "and 0.005 <= Re_w / (2 Re_p) <= 0.4 (Dandy & Dwyer's 1990 computations){}",
+                    re_p, re_p < 0.1 ? "; below it mclaughlin (Re_p << 1, Re_w << 1) is the theory" : ""));
+}
+
 /// The settling scales from the case's own drag law, and the steps and cells measured against
 /// them. Returns the isolated terminal speed w_t, m/s.
 double check_settling_scales(const CaseParams& p, Preflight& r) {
@@ -129,6 +159,7 @@ double check_settling_scales(const CaseParams& p, Preflight& r) {
   add_item(r, "terminal_velocity", wt, "m/s",
            fmt::format("isolated terminal speed, drag law {}", p.forces.drag));
   add_item(r, "Re_p", re, "", "particle Reynolds number rho_f w_t d / mu");
+  if (scene_reads(scene_spec(p.scene), "forces.lift")) check_lift_range(p, re, r);
   add_item(r, "St", rho_p / rho_f * re / 9.0, "", "collision Stokes number (rho_p/rho_f) Re_p / 9");
   // Response time: how long the particle takes to reach w_t (weight against drag, added mass
   // included), the time scale a time step has to be compared with.

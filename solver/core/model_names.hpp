@@ -17,7 +17,7 @@ inline const std::vector<std::string>& drag_law_names() {
 }
 /// forces.lift (coupling/lift_laws.hpp)
 inline const std::vector<std::string>& lift_law_names() {
-  static const std::vector<std::string> n = {"saffman", "saffman_mei", "none"};
+  static const std::vector<std::string> n = {"saffman", "saffman_mei", "mclaughlin", "none"};
   return n;
 }
 /// numerics.void_fraction_kernel

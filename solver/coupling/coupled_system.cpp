@@ -306,6 +306,9 @@ void CoupledSystem::activate_models(ModelTimers& t) const {
     t.activate("saffman_lift", "Eq. 16 (timed with coupling_sample)");
   if (coupler_->settings().lift == LiftLaw::saffman_mei)
     t.activate("saffman_mei_lift", "Eq. 16 times Mei's (1992) finite-Re factor (timed with coupling_sample)");
+  if (coupler_->settings().lift == LiftLaw::mclaughlin)
+    t.activate("mclaughlin_lift",
+               "Eq. 16 times McLaughlin's (1991) J(epsilon) / J(inf) (timed with coupling_sample)");
   if (f.added_mass)
     t.activate("added_mass", "Eq. 17, particle side in the mass matrix (timed with coupling_sample)");
   if (opt_.zero_slurry_flux) t.activate("slurry_flux_control", "Eq. 25 through the mean gradient G");

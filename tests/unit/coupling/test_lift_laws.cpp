@@ -1,6 +1,7 @@
 // The lift laws (coupling/lift_laws.hpp) against their published formulas, evaluated here from
-// the exact shear and slip: Saffman (1965/1968) as the paper's Eq. 16, and Mei's (1992, eq. 8)
-// finite-Re ratio with its limits.
+// the exact shear and slip: Saffman (1965/1968) as the paper's Eq. 16, Mei's (1992, eq. 8)
+// finite-Re ratio with its limits, and McLaughlin's (1991) J(epsilon) / J(inf) as a force (J
+// itself: test_mclaughlin_lift.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -90,4 +91,29 @@ TEST(LiftLaws, SaffmanMeiIsSaffmanTimesTheFactorAndNoneIsZero) {
   for (double v : fm) EXPECT_EQ(v, 0.0);
   bc::lift_force(bc::LiftLaw::saffman_mei, zero, w, kD, kRho, kNu, fm);
   for (double v : fm) EXPECT_EQ(v, 0.0);
+}
+
+TEST(LiftLaws, McLaughlinIsSaffmanTimesJOverJInfinityAndReversesWhereJIsNegative) {
+  // The channel's case (slip along z, vorticity along x) at three epsilon = (|w| nu)^1/2 / |s|:
+  // 2 (J/J(inf) = 0.929), 0.5 (0.326) and 0.1 (J < 0: the lift points the other way).
+  const double w_x = 100.0;
+  for (double eps : {2.0, 0.5, 0.1}) {
+    const double s_z = std::sqrt(w_x * kNu) / eps;
+    const double s[3] = {0.0, 0.0, s_z}, w[3] = {w_x, 0.0, 0.0};
+    double fs[3], fm[3];
+    bc::lift_force(bc::LiftLaw::saffman, s, w, kD, kRho, kNu, fs);
+    bc::lift_force(bc::LiftLaw::mclaughlin, s, w, kD, kRho, kNu, fm);
+    const double ratio = bc::mclaughlin_j(eps) / bc::mclaughlin::kJInfinity;
+    EXPECT_NEAR(fm[1], ratio * fs[1], 1e-12 * std::abs(fs[1])) << eps;
+    EXPECT_EQ(fm[0], 0.0);
+    EXPECT_EQ(fm[2], 0.0);
+    EXPECT_EQ(fm[1] * fs[1] < 0.0, eps < 0.2) << eps;
+  }
+  // No vorticity or no slip: no lift (and no division by zero).
+  const double s[3] = {0.0, 0.0, 0.01}, w[3] = {w_x, 0.0, 0.0}, zero[3] = {0.0, 0.0, 0.0};
+  double f[3];
+  bc::lift_force(bc::LiftLaw::mclaughlin, s, zero, kD, kRho, kNu, f);
+  for (double v : f) EXPECT_EQ(v, 0.0);
+  bc::lift_force(bc::LiftLaw::mclaughlin, zero, w, kD, kRho, kNu, f);
+  for (double v : f) EXPECT_EQ(v, 0.0);
 }
