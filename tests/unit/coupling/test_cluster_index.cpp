@@ -4,6 +4,7 @@
 // column gives 0, clumps of m particles placed at random give m.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
