@@ -44,7 +44,7 @@ std::string VelocityProfile::csv() const {
     text += fmt::format("{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", n.bin_center(b),
                         all_samples > 0 ? count / all_samples : 0.0, mean[wp], mean[vp], mean[wf], mean[vf],
                         mean[wp] - mean[wf], mean[vp] - mean[vf],
-                        all_flux != 0 ? sums_[wp].counts_[b] / all_flux : 0.0);
+                        count > 0 && all_flux != 0 ? sums_[wp].counts_[b] / all_flux : 0.0);
   }
   return text;
 }

@@ -465,7 +465,8 @@ std::vector<std::string> inclined_settling_keys() {
 
 const SceneRegistration kRegistered{
     {.name = "inclined_settling",
-     .measures = "<<w_p>> over [average_from, end] with its error, <w_p>(t), PDFs of y and w_p, cluster index, images",
+     .measures = "<<w_p>> over [average_from, end] with its error, <w_p>(t), PDFs of y and w_p, cluster "
+                 "index, images",
      .reads = inclined_settling_keys(),
      .default_solid_fraction = table3_solid_fraction(),
      .tolerances = {{"hindered_settling_rel_error", 0.15, "Richardson-Zaki, periodic suspension"}},
