@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Where the particles sit across the gap, and which forces hold them there.
 
-  scripts/gap_profile.py [--budget] RUN_DIR [RUN_DIR ...]
+  scripts/gap_profile.py [--budget] [--profile] RUN_DIR [RUN_DIR ...]
 
-Averages pdf_y.csv (and, with --budget, force_budget_y.csv) of the runs given (replicas of one
+Averages pdf_y.csv (with --budget force_budget_y.csv, with --profile velocity_profile_y.csv) of the
+runs given (replicas of one
 case), prints the profile as density over its mean from wall to wall, and two numbers:
   interior_cv   the coefficient of variation (rms / mean) of the density over the bands whose
                 centre lies at least 0.75 mm from both walls: 0 for a flat interior; sheets that
@@ -11,7 +12,8 @@ case), prints the profile as density over its mean from wall to wall, and two nu
   wall_layer    the mean density of the bands from the contact distance d/2 out to d/2 + 0.45 mm,
                 both walls, over the mean density (the paper's Fig. 12(a): a rise at both walls).
 With --budget, the mean y-force per particle of every term by band, over the buoyant weight,
-and the band's mean particle and shear Reynolds numbers (the lift law's inputs).
+and the band's mean particle and shear Reynolds numbers (the lift law's inputs). With --profile,
+the band's mean w_p, the w_f its particles see and their slip (mm/s), and its share of the flux (%).
 """
 import csv
 import statistics
@@ -35,7 +37,8 @@ def mean_columns(dirs, name):
 
 def main(argv):
     budget = "--budget" in argv
-    dirs = [a for a in argv if a != "--budget"]
+    profile = "--profile" in argv
+    dirs = [a for a in argv if a not in ("--budget", "--profile")]
     if not dirs:
         sys.exit(__doc__)
     pdf = mean_columns(dirs, "pdf_y.csv")
@@ -59,6 +62,12 @@ def main(argv):
         if "re_p" in b[0]:
             for t in ("re_p", "re_w"):
                 print(f"{t:8s}" + " ".join(f"{r[t]:5.1f}" for r in b))
+    if profile:
+        v = mean_columns(dirs, "velocity_profile_y.csv")
+        for t, name in (("wp_m_s", "w_p"), ("wf_seen_m_s", "w_f seen"), ("slip_w_m_s", "slip")):
+            print(f"{name[:8]:8s}" + " ".join(f"{r[t] * 1e3:5.0f}" for r in v))
+        print("flux %  " + " ".join(f"{r['flux_share'] * 100:5.1f}" for r in v))
+        print("(velocities in mm/s along the channel; the flux shares add up to 100)")
 
 
 if __name__ == "__main__":

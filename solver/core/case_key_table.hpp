@@ -175,6 +175,8 @@ void visit_keys(P& p, V&& visitor) {
   v("output.pdf_bins", p.output.pdf_bins, range(2, 100000), "bins of the PDFs of y and w_p");
   v("output.force_budget_y", p.output.force_budget_y, any(),
     "write force_budget_y.csv: each force on the particles per band of y");
+  v("output.velocity_profile_y", p.output.velocity_profile_y, any(),
+    "write velocity_profile_y.csv: particle and seen fluid velocities, slip and flux share per band of y");
 
   v("ergun.pressure_gradients", p.ergun.pressure_gradients_pa_m, positive("Pa/m"),
     "driving pressure gradients swept over the frozen bed");

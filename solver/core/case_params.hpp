@@ -151,6 +151,10 @@ struct OutputParams {
   /// Write force_budget_y.csv: every force on the particles per band of y over the averaging
   /// window (coupling/force_budget.hpp), in pdf_bins bands.
   bool force_budget_y = false;
+  /// Write velocity_profile_y.csv: the particles' mean velocities, the fluid velocity they see,
+  /// their slip and their share of the flux per band of y over the averaging window
+  /// (coupling/velocity_profile.hpp), in pdf_bins bands.
+  bool velocity_profile_y = false;
 };
 
 struct ErgunParams {

@@ -3,7 +3,8 @@
 // at zero by the driving gradient G (Eq. 25). Measures <w_p>(t) and <w_f>(t) (Eq. 28), the
 // ensemble average <<w_p>> over [average_from, end] with its error from the autocorrelation of the
 // whole <w_p> series over the window (stats/window_error.hpp, scenes/summary_statistics.hpp;
-// Eq. 29), and the PDFs of particle y and w_p over the same window (Fig. 12). With
+// Eq. 29), the PDFs of particle y and w_p over the same window (Fig. 12), and the particles'
+// clustering in the x-z plane (Figs. 7, 13: coupling/cluster_index.hpp) every step. With
 // time.target_rel_error it stops once <<w_p>> is that precise (status converged).
 #include <algorithm>
 #include <cmath>
@@ -17,7 +18,9 @@
 #include "core/constants.hpp"
 #include "core/error.hpp"
 #include "core/version.hpp"
+#include "coupling/cluster_index.hpp"
 #include "coupling/drag_laws.hpp"
+#include "coupling/velocity_profile.hpp"
 #include "io/checkpoint_file.hpp"
 #include "io/state_io.hpp"
 #include "scenes/coupled_checkpoint.hpp"
@@ -27,6 +30,7 @@
 #include "scenes/scene.hpp"
 #include "scenes/summarize.hpp"
 #include "scenes/summary_statistics.hpp"
+#include "stats/dispersion.hpp"
 #include "stats/precision_target.hpp"
 #include "stats/running.hpp"
 #include "stats/transient.hpp"
@@ -69,8 +73,9 @@ void write_pdf(const std::filesystem::path& path, const std::string& column, con
 }
 
 /// What the scene records over a run and carries across its checkpoints: <w_p>'s series (the
-/// window's and the samples before it), the fluid and slurry means, the PDFs of y and w_p, the
-/// transverse force budget, and the stability record (alpha_f range, largest kinetic energy).
+/// window's and the samples before it), the fluid and slurry means, the cluster index's mean, the
+/// PDFs of y and w_p, the transverse force budget, the velocity profile across the gap, and the
+/// stability record (alpha_f range, largest kinetic energy).
 class SettlingRecord {
  public:
   SettlingRecord(const CaseParams& p, const coupling::CoupledSystem& run, double terminal_speed_m_s)
@@ -86,6 +91,9 @@ class SettlingRecord {
     // The transverse force budget over the same window and bands as pdf_y (output.force_budget_y).
     if (p.output.force_budget_y)
       budget_.emplace(run.dem().config().box.lo[1], p.domain.width_y_m, static_cast<int>(p.output.pdf_bins));
+    // The velocities per band, over the samples pdf_y takes (output.velocity_profile_y).
+    if (p.output.velocity_profile_y)
+      profile_.emplace(run.dem().config().box.lo[1], p.domain.width_y_m, static_cast<int>(p.output.pdf_bins));
   }
 
   /// The record of a checkpoint (the histograms on the output rank, which carries the sums of all).
@@ -102,8 +110,12 @@ class SettlingRecord {
   /// step's time-series row, made when the output asks for it.
   std::function<std::vector<double>()> measure(const coupling::CoupledSystem& run,
                                                const coupling::CoupledStep& st, bool& end_early);
-  /// pdf_y.csv, pdf_wp.csv and force_budget_y.csv, the histograms summed over ranks.
-  void write_distributions(coupling::CoupledSystem& run, const std::filesystem::path& dir);
+  /// pdf_y.csv, pdf_wp.csv, force_budget_y.csv and velocity_profile_y.csv, the histograms summed
+  /// over ranks.
+  void write_distributions(coupling::CoupledSystem& run, const std::filesystem::path& dir) {
+    write_pdfs_and_budget(run, dir);
+    write_profile(run, dir);
+  }
   /// summary.json: the common keys, <<w_p>> with its error, and the run's record.
   nlohmann::json summary(const coupling::CoupledSystem& run, SummaryBase& sb, const ModelTimers& timers,
                          double terminal_speed_m_s, bool resumed) const;
@@ -111,17 +123,27 @@ class SettlingRecord {
   double next_out_s() const { return next_out_; }
 
  private:
+  void write_pdfs_and_budget(coupling::CoupledSystem& run, const std::filesystem::path& dir);
+  void write_profile(coupling::CoupledSystem& run, const std::filesystem::path& dir);
   /// <<w_p>> over the chosen window with its error `wp_err`: into sb, then the summary's keys.
   nlohmann::json report_settling_velocity(SummaryBase& sb, const stats::ChosenWindow& chosen,
                                           const stats::WindowError& wp_err, const ModelTimers& timers) const;
-  /// The run's own record: means, counts, stability, the vertical suspension's reference.
+  /// The run's own record: means, counts, stability, clustering, the vertical suspension's
+  /// reference.
   void report_run_record(nlohmann::json& j, const coupling::CoupledSystem& run, double terminal_speed_m_s,
                          bool resumed) const;
+  /// The cluster index's mean over the steps of the fluid means, with the scatter that one
+  /// sample of these particles placed at random in these columns has (1 +- that is random).
+  void report_clustering(nlohmann::json& j, const coupling::CoupledSystem& run) const;
 
   const CaseParams& p_;
   stats::Histogram pdf_y_, pdf_w_;
   std::optional<coupling::ForceBudget> budget_;
+  std::optional<coupling::VelocityProfile> profile_;
   stats::BatchMeans wp_avg_, wf_avg_, slurry_avg_;
+  /// The cluster index over the steps the fluid means take (none before a resume of a build
+  /// that kept none: then from the resume on, cluster_index_samples says how many).
+  stats::BatchMeans cluster_avg_;
   /// Every <w_p> sample of the window, for its error (20 s of 1 ms steps: 15 000 doubles).
   std::vector<double> wp_series_;
   bool wp_series_whole_ = true;  ///< false after resuming a checkpoint of a build that kept none
@@ -138,6 +160,7 @@ void SettlingRecord::load(const io::CheckpointReader& r) {
   io::load(r, "stats.wp.", wp_avg_);
   io::load(r, "stats.wf.", wf_avg_);
   io::load(r, "stats.slurry.", slurry_avg_);
+  if (r.has("stats.cluster.ints")) io::load(r, "stats.cluster.", cluster_avg_);
   // The histograms are counts over all ranks: rank 0 carries them on, the others add theirs.
   if (output_rank()) {
     io::load(r, "stats.pdf_y.", pdf_y_);
@@ -146,6 +169,10 @@ void SettlingRecord::load(const io::CheckpointReader& r) {
     if (budget_ && r.has("stats.budget.0.counts")) {
       const auto h = budget_->all();
       for (std::size_t k = 0; k < h.size(); ++k) io::load(r, fmt::format("stats.budget.{}.", k), *h[k]);
+    }
+    if (profile_ && r.has("stats.profile.0.counts")) {
+      const auto h = profile_->all();
+      for (std::size_t k = 0; k < h.size(); ++k) io::load(r, fmt::format("stats.profile.{}.", k), *h[k]);
     }
   }
   slurry_max_ = r.scalar("stats.slurry_max");
@@ -170,6 +197,9 @@ void SettlingRecord::checkpoint(const coupling::CoupledSystem& run, const std::f
   std::vector<stats::Histogram> all_budget;
   if (budget_)
     for (const stats::Histogram* h : budget_->all()) all_budget.push_back(over_ranks(run, *h));
+  std::vector<stats::Histogram> all_profile;
+  if (profile_)
+    for (const stats::Histogram* h : profile_->all()) all_profile.push_back(over_ranks(run, *h));
   checkpoint_coupled(run, dir, wall_s, [&](io::CheckpointWriter& w) {
     io::save(w, "stats.wp.", wp_avg_);
     io::save(w, "stats.wf.", wf_avg_);
@@ -178,6 +208,9 @@ void SettlingRecord::checkpoint(const coupling::CoupledSystem& run, const std::f
     io::save(w, "stats.pdf_w.", all_w);
     for (std::size_t k = 0; k < all_budget.size(); ++k)
       io::save(w, fmt::format("stats.budget.{}.", k), all_budget[k]);
+    for (std::size_t k = 0; k < all_profile.size(); ++k)
+      io::save(w, fmt::format("stats.profile.{}.", k), all_profile[k]);
+    io::save(w, "stats.cluster.", cluster_avg_);
     w.put("stats.slurry_max", slurry_max_);
     w.put("stats.next_out", next_out_s);
     w.put("stats.alpha_min_seen", alpha_min_seen_);
@@ -197,6 +230,7 @@ std::function<std::vector<double>()> SettlingRecord::measure(const coupling::Cou
   const double wp = run.mean_particle_velocity(2);
   const double wf = run.mean_fluid_velocity_z();
   const double slurry = run.slurry_velocity_z();
+  const double cluster = coupling::xz_cluster_index(run);
   alpha_min_seen_ = std::min(alpha_min_seen_, run.coupler().totals().min_alpha_f);
   alpha_max_seen_ = std::max(alpha_max_seen_, run.coupler().totals().max_alpha_f);
   ke_max_seen_ = std::max(ke_max_seen_, run.dem().kinetic_energy_j());
@@ -206,11 +240,13 @@ std::function<std::vector<double>()> SettlingRecord::measure(const coupling::Cou
     steps_.window_dt.push_back(st.dt_s);
     wf_avg_.add(wf);
     slurry_avg_.add(slurry);
+    if (std::isfinite(cluster)) cluster_avg_.add(cluster);
     slurry_max_ = std::max(slurry_max_, std::abs(slurry));
     for (std::size_t i = 0; i < s.n_local; ++i) {
       pdf_y_.add(s.y[i]);
       pdf_w_.add(s.vz[i]);
     }
+    if (profile_) profile_->add(s);
   } else {
     steps_.before.push_back(wp);
     steps_.before_dt.push_back(st.dt_s);
@@ -218,7 +254,7 @@ std::function<std::vector<double>()> SettlingRecord::measure(const coupling::Cou
   // time.target_rel_error met before time.end: the last row, a checkpoint, status converged.
   end_early =
       wp_series_whole_ && target_.reached(wp_series_, collect_from_s_, t) && !reached_end(t, p_.time.end_s);
-  return [&run, t, wp, wf, slurry, dt_s = st.dt_s,
+  return [&run, t, wp, wf, slurry, cluster, dt_s = st.dt_s,
           iterations = st.fluid.simple_iterations]() -> std::vector<double> {
     return {t,
             wp,
@@ -230,11 +266,12 @@ std::function<std::vector<double>()> SettlingRecord::measure(const coupling::Cou
             dt_s,
             static_cast<double>(iterations),
             run.coupler().totals().min_alpha_f,
-            run.dem().kinetic_energy_j()};
+            run.dem().kinetic_energy_j(),
+            cluster};
   };
 }
 
-void SettlingRecord::write_distributions(coupling::CoupledSystem& run, const std::filesystem::path& dir) {
+void SettlingRecord::write_pdfs_and_budget(coupling::CoupledSystem& run, const std::filesystem::path& dir) {
   pdf_y_ = over_ranks(run, pdf_y_);
   pdf_w_ = over_ranks(run, pdf_w_);
   if (wp_avg_.count()) {
@@ -249,6 +286,13 @@ void SettlingRecord::write_distributions(coupling::CoupledSystem& run, const std
       std::abs(p_.particles.density_kg_m3 - p_.fluid.density_kg_m3) * vp * p_.gravity.magnitude_m_s2;
   if (output_rank() && budget_->exposure().total_ > 0)
     write_file_atomic(dir / "force_budget_y.csv", budget_->csv(weight > 0 ? weight : 1.0));
+}
+
+void SettlingRecord::write_profile(coupling::CoupledSystem& run, const std::filesystem::path& dir) {
+  if (!profile_) return;
+  for (stats::Histogram* h : profile_->all()) *h = over_ranks(run, *h);
+  if (output_rank() && profile_->sums(coupling::VelocityProfile::samples).total_ > 0)
+    write_file_atomic(dir / "velocity_profile_y.csv", profile_->csv());
 }
 
 nlohmann::json SettlingRecord::summary(const coupling::CoupledSystem& run, SummaryBase& sb,
@@ -325,6 +369,7 @@ void SettlingRecord::report_run_record(nlohmann::json& j, const coupling::Couple
   // attempt it gives how often the neighbour list is rebuilt, which the cost depends on.
   j["neighbor_rebuilds_this_attempt"] = run.dem().rebuilds();
   j["resumed_from_checkpoint"] = resumed;
+  report_clustering(j, run);
   j["pdf_outside_fraction"] = {{"y", pdf_y_.total_ > 0 ? pdf_y_.outside_ / pdf_y_.total_ : 0.0},
                                {"wp", pdf_w_.total_ > 0 ? pdf_w_.outside_ / pdf_w_.total_ : 0.0}};
   // A vertical suspension beside Richardson-Zaki: <<w_p>> is relative to zero volume flux, which
@@ -338,6 +383,17 @@ void SettlingRecord::report_run_record(nlohmann::json& j, const coupling::Couple
     if (p_.domain.periodic_y)
       j["hindered_settling_rel_error"] = wp_avg_.count() ? (wp_avg_.mean() - ref) / ref : kUnset;
   }
+}
+
+void SettlingRecord::report_clustering(nlohmann::json& j, const coupling::CoupledSystem& run) const {
+  const std::int64_t columns = p_.domain.cells[0] * p_.domain.cells[2];
+  j["cluster_index_mean"] = cluster_avg_.count() ? cluster_avg_.mean() : kUnset;
+  const double se = cluster_avg_.stderr_of_mean();
+  j["cluster_index_stderr_batch_means"] = std::isfinite(se) ? nlohmann::json(se) : nlohmann::json(nullptr);
+  j["cluster_index_samples"] = cluster_avg_.count();
+  j["cluster_index_columns"] = columns;
+  const double sd = stats::dispersion_index_random_sd(run.dem().global_count(), columns);
+  j["cluster_index_random_sd"] = std::isfinite(sd) ? nlohmann::json(sd) : nlohmann::json(nullptr);
 }
 
 }  // namespace
@@ -363,7 +419,8 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
   const int exit_code = run_recorded_steps(
       run, ctx, timers, record,
       {"time_s", "mean_wp_m_s", "mean_wf_m_s", "slurry_velocity_m_s", "mean_up_m_s", "mean_vp_m_s",
-       "driving_gradient_pa_m", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
+       "driving_gradient_pa_m", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j",
+       "cluster_index"},
       resumed.has_value(), clock, wall_before, [&] { record.before_step(run); },
       [&](const coupling::CoupledStep& st, bool& end_early) { return record.measure(run, st, end_early); },
       sb);
@@ -408,7 +465,8 @@ std::vector<std::string> inclined_settling_keys() {
 
 const SceneRegistration kRegistered{
     {.name = "inclined_settling",
-     .measures = "<<w_p>> over [average_from, end] with its error, <w_p>(t), PDFs of y and w_p, images",
+     .measures = "<<w_p>> over [average_from, end] with its error, <w_p>(t), PDFs of y and w_p, cluster "
+                 "index, images",
      .reads = inclined_settling_keys(),
      .default_solid_fraction = table3_solid_fraction(),
      .tolerances = {{"hindered_settling_rel_error", 0.15, "Richardson-Zaki, periodic suspension"}},

@@ -112,7 +112,14 @@ CsvWriter::CsvWriter(const std::filesystem::path& path, std::vector<std::string>
   if (!(append && exists)) {
     for (std::size_t i = 0; i < columns.size(); ++i) std::fprintf(f_, i ? ",%s" : "%s", columns[i].c_str());
     std::fputc('\n', f_);
+    return;
   }
+  // A file begun by a build with fewer columns (a column added at the end since) keeps its own:
+  // a longer row would read as torn to the next resume (truncate_csv_after) and end the file there.
+  std::ifstream in(path);
+  std::string header;
+  std::getline(in, header);
+  ncol_ = std::min(ncol_, static_cast<std::size_t>(std::count(header.begin(), header.end(), ',')) + 1);
 }
 
 CsvWriter::~CsvWriter() {

@@ -42,6 +42,7 @@ struct SummaryBase {
 nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const ModelTimers& timers);
 
 /// Appends rows to a CSV file with a fixed header; creates it (with the header) when absent.
+/// Appending to a file with fewer columns (of an earlier build), it writes only those.
 /// Only the output rank writes. A row that could not be written (disk full, I/O error) is a
 /// StorageError at the next flush(), naming the file and the cause.
 class CsvWriter {

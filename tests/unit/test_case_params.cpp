@@ -353,11 +353,15 @@ TEST(CaseParams, LiftLawIsALateKeyWithOneIdPerPhysics) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("forces.saffman_lift"), std::string::npos) << e.what();
   }
-  // The force budget is output: not the case.
+  // The force budget and the velocity profile are output: not the case.
   CaseParams budget;
   apply_override(budget, "output.force_budget_y=true");
   validate(budget);
   EXPECT_EQ(case_id(budget), case_id(dflt));
+  CaseParams profile;
+  apply_override(profile, "output.velocity_profile_y=true");
+  validate(profile);
+  EXPECT_EQ(case_id(profile), case_id(dflt));
 }
 
 TEST(CaseParams, AStoredRecordWithoutALateKeyHadItsOldBehaviour) {

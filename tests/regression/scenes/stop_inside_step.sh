@@ -6,7 +6,8 @@
 # is (with >99 % of its time in sub-steps) almost surely inside a step; a stop that falls between
 # steps is a plain stop, and the attempt is repeated (at most 4 times) until one falls inside.
 # With RANKS > 1 under mpirun (which forwards the signal), the force budget on: every rank asks
-# the same collective question at the same sub-step.
+# the same collective question at the same sub-step. The velocity profile is on in both: the
+# checkpoint at the step's start carries its sums, and the resumed profile is the reference's.
 #   stop_inside_step.sh BOYCOTT_BIN CASE.toml [RANKS]
 set -uo pipefail
 bin=$1; case_file=$2; ranks=${3:-1}
@@ -16,7 +17,7 @@ launch=()
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 sets=(--set time.dt_dem=1e-9 --set time.dt_cfd=1e-4 --set time.end=0.0008 --set time.average_from=0.0001
-      --set particles.volume_fraction=0.01 --set time.checkpoint_every=0.0003)
+      --set particles.volume_fraction=0.01 --set time.checkpoint_every=0.0003 --set output.velocity_profile_y=true)
 [ "$ranks" -gt 1 ] && sets+=(--set output.force_budget_y=true)
 "${launch[@]}" "$bin" case run "$case_file" --out "$work/ref" "${sets[@]}" --quiet > /dev/null 2>&1 || fail "the reference run failed"
 inside=0
@@ -41,6 +42,7 @@ for attempt in 1 2 3 4; do
     cmp -s "$work/ref/force_budget_y.csv" "$dir/force_budget_y.csv" || fail "the resumed force budget differs"
   fi
   cmp -s "$work/ref/timeseries.csv" "$dir/timeseries.csv" || fail "the resumed time series differs from the reference"
+  cmp -s "$work/ref/velocity_profile_y.csv" "$dir/velocity_profile_y.csv" || fail "the resumed velocity profile differs"
   python3 - "$work/ref/summary.json" "$dir/summary.json" << 'PY' || fail "the resumed summary differs"
 import json, sys
 a, b = (json.load(open(p)) for p in sys.argv[1:])
