@@ -40,6 +40,71 @@ Reference reference(const std::vector<double>& x, std::int64_t len, std::int64_t
   return r;
 }
 
+// chi^2 with one degree of freedom at 99 %: a decay that fits the segment means no better than
+// that beyond a common offset is noise.
+constexpr double kDecayShown = 6.63;
+
+// Where the modelled rest of a detected transient no longer biases what is kept: the first
+// half's segment means less the reference's, e_j, fitted by A rho^j (the shape of a relaxation
+// at its slowest rate), rho at the slow end of its profile interval (the largest decay time whose
+// squared residuals exceed the best fit's by at most kDecayProfile segment variances), so that an
+// uncertain decay errs late. Returns the first cut at which the model's rest, averaged over the
+// kept samples, is below kResidualBias of the kept mean's standard error (segment_var len /
+// kept)^1/2; half the series when none is; 0 where no decay shows beyond the segments' scatter.
+// The fit is not rejected for a poor shape: a head that no exponential follows well gets a slow
+// end that errs late, which costs samples, not bias.
+std::int64_t cut_past_fitted_decay(const std::vector<double>& x, std::int64_t len, std::int64_t segments,
+                                   const Reference& ref) {
+  const auto n = static_cast<std::int64_t>(x.size());
+  std::vector<double> e(static_cast<std::size_t>(segments));
+  for (std::int64_t j = 0; j < segments; ++j)
+    e[static_cast<std::size_t>(j)] = segment_mean(x, j * len, len) - ref.mean;
+  // Decay times of 0.05-500 segments, 100 per decade: for each, A by least squares and the
+  // squared residuals.
+  struct Fit {
+    double rho = 0.0, amplitude = 0.0, residuals = 0.0;
+  };
+  constexpr int kGrid = 400;
+  std::vector<Fit> fits(kGrid + 1);
+  double best = std::numeric_limits<double>::infinity();
+  for (int k = 0; k <= kGrid; ++k) {
+    const double rho = std::exp(-1.0 / (0.05 * std::pow(10.0, 4.0 * k / kGrid)));
+    double se = 0.0, ss = 0.0, ee = 0.0, p = 1.0;
+    for (double ej : e) {
+      se += ej * p;
+      ss += p * p;
+      ee += ej * ej;
+      p *= rho;
+    }
+    fits[static_cast<std::size_t>(k)] = {rho, se / ss, ee - se * se / ss};
+    best = std::min(best, ee - se * se / ss);
+  }
+  // A stationary series' segment means differ from the reference's by a common offset (the
+  // reference mean's own error) plus noise: a decay must fit them better than the offset does by
+  // more than their scatter allows, else (a head detected by its spread alone, a swing that
+  // averages out within a segment) the spans' guard alone.
+  double sum = 0.0, squares = 0.0;
+  for (double ej : e) sum += ej, squares += ej * ej;
+  const double offset_residuals = squares - sum * sum / static_cast<double>(segments);
+  if (offset_residuals - best < kDecayShown * ref.segment_var) return 0;
+  Fit slow;
+  for (const Fit& f : fits)
+    if (f.residuals - best <= TransientEnd::kDecayProfile * ref.segment_var) slow = f;
+  // The model per sample: a exp(-i / D) with D = len / ln(1 / rho), whose segment means are
+  // A rho^j; what is left of it from sample k on sums to A len rho^(k / len) / (1 - rho). Cuts
+  // are tried every tenth of a segment, so that a decay shorter than a segment is not cut at the
+  // next segment's end.
+  const std::int64_t step = std::max<std::int64_t>(1, len / 10);
+  for (std::int64_t k = 0; k < n / 2; k += step) {
+    const double kept = static_cast<double>(n - k);
+    const double bias = std::abs(slow.amplitude) * static_cast<double>(len) *
+                        std::pow(slow.rho, static_cast<double>(k) / static_cast<double>(len)) /
+                        (1.0 - slow.rho) / kept;
+    if (bias < TransientEnd::kResidualBias * std::sqrt(ref.segment_var * static_cast<double>(len) / kept))
+      return k;
+  }
+  return n / 2;
+}
 }  // namespace
 
 TransientEnd transient_end(const std::vector<double>& x) {
@@ -76,7 +141,9 @@ TransientEnd transient_end(const std::vector<double>& x) {
     const double span = std::isfinite(e.span_times) && e.span_times > 0.0
                             ? static_cast<double>(refs * len) / e.span_times
                             : 0.0;
-    cut.start = std::min<std::int64_t>(n / 2, cut.detected + std::llround(TransientEnd::kGuardSpans * span));
+    const std::int64_t guarded =
+        std::min<std::int64_t>(n / 2, cut.detected + std::llround(TransientEnd::kGuardSpans * span));
+    cut.start = std::max(guarded, cut_past_fitted_decay(x, len, segments, ref));
   }
   return cut;
 }

@@ -13,11 +13,15 @@ namespace boycott::stats {
 /// degrees of freedom, two-sided kFalseAlarm) times the scatter of the reference's own segment
 /// means, and its spread within kSpreadFactor times the reference's variance (a swing that
 /// averages out, as stages I and II of a settling run can, shows in the spread). The transient
-/// is detected to end after the last segment that fails before two that pass (`detected`); the
-/// window is cut kGuardSpans correlation spans of the reference further in (the
-/// upper end of AutocorrelationError::span; at most half the series): a decay that a segment can
-/// no longer tell from noise still biases a mean over many segments, and a decay as slow as the
-/// series' own memory is what the segments see least.
+/// is detected to end after the last segment that fails before two that pass (`detected`). The
+/// window is cut at the later of two guards beyond it: kGuardSpans correlation spans of the
+/// reference (the upper end of AutocorrelationError::span), and where an exponential fitted to
+/// the first half's segment means (its decay time at the slow end of its profile interval) says
+/// the transient's rest biases the kept mean by less than kResidualBias standard errors; at most
+/// half the series. A decay that a segment can no longer tell from noise still biases a mean over
+/// many segments: the spans cover a decay as slow as the series' own memory, the fit one slower
+/// than that (a slow part or an oscillation's envelope under fast noise, whose transient the
+/// spans cut too early).
 ///
 /// Why the scatter of the reference's segments and not a correlation time: it is the variance of
 /// a segment's mean whatever the correlation inside a segment, an oscillation's part-periods and
@@ -31,10 +35,15 @@ namespace boycott::stats {
 /// error of what is kept is the ordinary one (docs/validation.md, "Transients").
 /// 20 segments and 5 spans: a swing that ends at 1.4 % of the window costs < 10 % of it, a strong
 /// fast decay on white noise is cut where it has fallen to the noise (tests TransientEnd.*,
-/// TransientReport.*). A guard of 3.5 times the detected end (or 10 segments and 5 times) cut
-/// more of a weak slow decay under a two-scale or oscillating series, but threw away a quarter of
-/// a window whose transient is short and cut such a decay at twice the time it had fallen to the
-/// noise; 1.5 times plus 5 spans still cut it 20 % too late where the steps are uneven.
+/// TransientReport.*). A guard of 3.5 times the detected end instead of the fit cut a weak slow
+/// decay less far (0.86 and 0.47 of two-scale and oscillating series left unbiased, against 0.99
+/// and 0.91 with the fit), threw away a quarter of a window whose transient is short and cut a
+/// fast decay at twice the time it had fallen to the noise.
+/// kResidualBias = 0.25: an interval of one standard error about a mean biased by that much
+/// still holds it Phi(0.75) - Phi(-1.25) = 0.667 of the time, leaving the estimator's own
+/// shortfall room above 0.65 (0.35, where that figure is 0.653, left the two-scale family at 0.645).
+/// kDecayProfile = 2.71: chi^2 with one degree of freedom at 90 %, the segment means' residuals
+/// being in units of a segment mean's variance.
 struct TransientEnd {
   std::int64_t start = 0;     ///< first sample of the stationary part: the cut
   std::int64_t detected = 0;  ///< where the segments stop differing from the reference
@@ -43,6 +52,8 @@ struct TransientEnd {
   static constexpr double kFalseAlarm = 0.02;
   static constexpr double kSpreadFactor = 4.0;
   static constexpr double kGuardSpans = 5.0;
+  static constexpr double kResidualBias = 0.25;
+  static constexpr double kDecayProfile = 2.71;
 };
 TransientEnd transient_end(const std::vector<double>& x);
 
