@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Rebuilds the full-size curve of docs/results.md from the committed summaries alone (no campaign
-# database): each docs/results/runs/<case_id>.json becomes the summary.json of a run folder, `study
-# collect` records them in a scratch database, and `query curve` writes the CSV and the plots.
+# database): each docs/results/runs/<case_id>/summary.json becomes the summary.json of a run folder,
+# `study collect` records them in a scratch database, and `query curve` writes the CSV and the plots.
 #   scripts/results_from_summaries.sh [BOYCOTT_BIN]
 # Writes docs/results/paper_base_full.csv and docs/plots/paper_base_full.{png,pdf}.
 set -euo pipefail
@@ -9,9 +9,10 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${1:-$root/build/driver/boycott}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-for f in "$root"/docs/results/runs/*.json; do
-  mkdir -p "$work/full.db.runs/$(basename "$f" .json)"
-  cp "$f" "$work/full.db.runs/$(basename "$f" .json)/summary.json"
+for f in "$root"/docs/results/runs/*/summary.json; do
+  id=$(basename "$(dirname "$f")")
+  mkdir -p "$work/full.db.runs/$id"
+  cp "$f" "$work/full.db.runs/$id/summary.json"
 done
 "$bin" study collect "$root/studies/paper_base_full.toml" --db "$work/full.db" > /dev/null
 "$bin" query curve --db "$work/full.db" --study paper_base_full --format csv > "$root/docs/results/paper_base_full.csv"

@@ -23,14 +23,15 @@ std::string format_curve(const std::vector<CurvePoint>& pts, ListingFormat f) {
   };
   if (f == ListingFormat::kCsv) {
     s = "group,angle_deg,mean_settling_velocity_m_s,error_m_s,error_basis,stderr_m_s,n_replicas,"
-        "between_replica_stderr_m_s,mean_within_run_stderr_m_s,r_acc,r_acc_err,error_method,case_id,"
-        "setting\n";
+        "between_replica_stderr_m_s,mean_within_run_stderr_m_s,r_acc,r_acc_err,error_method,n_particles,"
+        "average_from_s,end_s,case_id,setting\n";
     for (const auto& p : pts)
-      s += fmt::format("{},{:g},{:.9g},{},{},{},{},{},{},{},{},{},{},{}\n", report::csv_field(p.group),
+      s += fmt::format("{},{:g},{:.9g},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", report::csv_field(p.group),
                        p.angle_deg, p.w_m_s, opt9(p.error.error_m_s), report::csv_field(p.error.basis),
                        opt9(p.w_err_m_s), p.n_replicas, opt9(p.between_replica_stderr_m_s),
                        opt9(p.mean_within_run_stderr_m_s), opt(p.r_acc), opt(p.r_acc_err), p.error_method,
-                       p.case_id, report::csv_field(p.setting));
+                       p.n_particles ? std::to_string(*p.n_particles) : std::string(), opt9(p.average_from_s),
+                       opt9(p.end_s), p.case_id, report::csv_field(p.setting));
   } else if (f == ListingFormat::kJson) {
     nlohmann::json j = nlohmann::json::array();
     for (const auto& p : pts) {
@@ -48,6 +49,9 @@ std::string format_curve(const std::vector<CurvePoint>& pts, ListingFormat f) {
       e["error_method"] = p.error_method;
       e["r_acc"] = opt_json(p.r_acc);
       e["r_acc_err"] = opt_json(p.r_acc_err);
+      e["n_particles"] = p.n_particles ? nlohmann::json(*p.n_particles) : nlohmann::json(nullptr);
+      e["average_from_s"] = opt_json(p.average_from_s);
+      e["end_s"] = opt_json(p.end_s);
       e["replica_case_ids"] = p.replica_case_ids;
       e["replica_mean_settling_velocities_m_s"] = p.replica_w_m_s;
       j.push_back(e);

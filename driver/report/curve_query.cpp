@@ -46,6 +46,9 @@ std::vector<CurveRun> curve_runs(Database& db, const std::string& study, const s
     p.w_err_m_s = r.w_err_m_s;
     p.error_method = std::move(r.error_method);
     p.run_dof = r.error_dof;
+    p.n_particles = r.n_particles;
+    p.average_from_s = r.average_from_s;
+    p.end_s = r.end_s;
     runs.push_back({p, r.position});
   }
   return runs;

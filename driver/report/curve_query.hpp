@@ -2,6 +2,7 @@
 // `query curve`'s points: the correlation curve <<w_p>>(theta) and r_acc(theta) of a study's
 // finished cases, read through the store, the replicas of a point averaged with their error
 // (stats/point_error.hpp). curve.hpp shows them.
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -42,6 +43,10 @@ struct CurvePoint {
   /// <<w_p>>/<<w_p>>(90 deg), unset without a 90 deg case; its covering error, from the two
   /// points' errors, unset when an error it depends on is.
   std::optional<double> r_acc, r_acc_err;
+  /// The first replica's particle count and averaging window [average_from_s, end_s] (s), as
+  /// case_id is the first replica's; unset where its summary or the case did not say.
+  std::optional<std::int64_t> n_particles;
+  std::optional<double> average_from_s, end_s;
 };
 
 /// The correlation curve of finished cases, per group in study order, by angle; the replicas of

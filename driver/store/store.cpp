@@ -326,7 +326,8 @@ std::vector<CurveResult> curve_results(Database& db, const std::string& study, c
       "r.settling_velocity_stderr_m_s, "
       " MIN(sc.position) AS pos, "
       " COALESCE(json_extract(r.summary_json, '$.settling_velocity_error_method'), 'batch_means'), "
-      " json_extract(r.summary_json, '$.settling_velocity_error_dof') "
+      " json_extract(r.summary_json, '$.settling_velocity_error_dof'), "
+      " json_extract(r.summary_json, '$.particle_count'), r.average_from_s, r.average_to_s "
       "FROM study_cases sc JOIN cases c ON c.id = sc.case_id "
       "JOIN results r ON r.case_id = c.id WHERE sc.study = ?1 AND (?2 = '' OR sc.group_name = ?2) "
       "AND r.mean_settling_velocity_m_s IS NOT NULL GROUP BY sc.group_name, c.id");
@@ -342,6 +343,9 @@ std::vector<CurveResult> curve_results(Database& db, const std::string& study, c
     r.position = st.integer(5);
     r.error_method = st.text(6);
     if (!st.is_null(7)) r.error_dof = st.real(7);
+    if (!st.is_null(8)) r.n_particles = st.integer(8);
+    if (!st.is_null(9)) r.average_from_s = st.real(9);
+    if (!st.is_null(10)) r.end_s = st.real(10);
     out.push_back(std::move(r));
   }
   return out;

@@ -97,6 +97,10 @@ struct CurveResult {
   std::int64_t position = 0;        ///< its first position in the study within the group
   std::string error_method;         ///< settling_velocity_error_method; "batch_means" when none
   std::optional<double> error_dof;  ///< settling_velocity_error_dof
+  std::optional<std::int64_t> n_particles;  ///< summary.json particle_count
+  /// The run's averaging window (s): where it began (its own choice with average_from = "auto")
+  /// and the simulated time it ended at (results.average_from_s, average_to_s).
+  std::optional<double> average_from_s, end_s;
 };
 
 /// The study's cases with a recorded <<w_p>> (of one group, `group` non-empty), once per group.

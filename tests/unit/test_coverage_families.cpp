@@ -228,7 +228,7 @@ namespace {
 // The committed full-size 75 deg run's <w_p> rows (every 0.01 s; docs/results.md), from where the
 // product's own cut puts the end of its start-up transient.
 std::vector<double> plateau_75_degrees() {
-  std::ifstream in(BOYCOTT_SOURCE_DIR "/docs/results/timeseries/9592e8d74a5a4760.csv");
+  std::ifstream in(BOYCOTT_SOURCE_DIR "/docs/results/runs/9592e8d74a5a4760/timeseries.csv");
   std::string line;
   std::getline(in, line);  // time_s,mean_wp_m_s,...
   std::vector<double> w;

@@ -91,9 +91,9 @@ TEST(SeriesMean, OnTheCommitted75DegreeRowsItAgreesWithTheRunsSummaryWithinTheSa
   // series whose correlation time is ~0.3 s, well inside the error; the errors, both from the
   // window's two halves, agree to the same degree. Measured: -193.51 +- 4.71 mm/s from the 481
   // rows, -193.89 +- 4.92 from the 5695 steps (0.08 errors apart, errors 4 % apart).
-  const std::string dir = BOYCOTT_SOURCE_DIR "/docs/results/";
-  const auto summary = nlohmann::json::parse(slurp(dir + "runs/9592e8d74a5a4760.json"));
-  const auto t = parse_series_table(slurp(dir + "timeseries/9592e8d74a5a4760.csv"), "75 deg rows");
+  const std::string dir = BOYCOTT_SOURCE_DIR "/docs/results/runs/9592e8d74a5a4760/";
+  const auto summary = nlohmann::json::parse(slurp(dir + "summary.json"));
+  const auto t = parse_series_table(slurp(dir + "timeseries.csv"), "75 deg rows");
   const auto rows = series_means(t, {"mean_wp_m_s"}, parse_average_from("5"));
   ASSERT_EQ(rows.size(), 1u);
   const double mean = summary["mean_settling_velocity_m_s"], error = summary["settling_velocity_error_m_s"];

@@ -14,6 +14,7 @@
 #include "core/run_status.hpp"
 #include "stats/distributions.hpp"
 
+#include "driver/report/curve.hpp"
 #include "driver/report/curve_query.hpp"
 #include "driver/store/database.hpp"
 #include "driver/store/schema_files.hpp"
@@ -307,6 +308,53 @@ TEST(StudyDatabase, CurveRatioAndPropagatedErrorFollowTheRecordedResults) {
             "SELECT COUNT(*) FROM results WHERE validation_errors_json LIKE '%max_rel_error_vs_analytic%' "
             "AND average_from_s = 1.0 AND average_to_s = 2.0"),
       4);
+}
+
+// docs/results/*.csv carry, per point, the particle count and the window its <<w_p>> averages
+// over (../shared/design.md, section 7): from the summary where it says (a window chosen by
+// average_from = "auto", the simulated time reached), else from the case.
+TEST(StudyDatabase, CurveRowsCarryTheParticleCountAndTheWindowOfTheirRuns) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(R"(
+name = "win"
+[base.time]
+end = 2.0
+average_from = 1.0
+[matrix]
+"gravity.angle_deg" = [45, 90]
+)");
+  bd::register_study(db, study);
+  for (const auto& c : study.cases) {
+    nlohmann::json summary = {{"scene", "inclined_settling"},
+                              {"case_id", c.id},
+                              {"status", "completed"},
+                              {"mean_settling_velocity_m_s", c.params.gravity.angle_deg == 90.0 ? -0.08 : -0.16},
+                              {"settling_velocity_stderr_m_s", 0.001},
+                              {"particle_count", 2398}};
+    // 45 deg: a run that chose its own window and stopped at 1.75 s; 90 deg: the case's window.
+    if (c.params.gravity.angle_deg == 45.0) {
+      summary["average_from_s"] = 0.6;
+      summary["simulated_time_s"] = 1.75;
+    }
+    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, summary);
+  }
+  const auto pts = bd::query_curve(db, "win");
+  ASSERT_EQ(pts.size(), 2u);
+  EXPECT_EQ(*pts[0].n_particles, 2398);
+  EXPECT_DOUBLE_EQ(*pts[0].average_from_s, 0.6);
+  EXPECT_DOUBLE_EQ(*pts[0].end_s, 1.75);
+  EXPECT_DOUBLE_EQ(*pts[1].average_from_s, 1.0);
+  EXPECT_DOUBLE_EQ(*pts[1].end_s, 2.0);
+  const std::string csv = bd::format_curve(pts, bd::ListingFormat::kCsv);
+  const std::string header = csv.substr(0, csv.find('\n'));
+  for (const char* col : {"angle_deg", "mean_settling_velocity_m_s", "error_m_s", "n_particles", "average_from_s",
+                          "end_s", "group"})
+    EXPECT_NE(("," + header + ",").find(std::string(",") + col + ","), std::string::npos) << col << ": " << header;
+  EXPECT_NE(csv.find(",2398,0.6,1.75,"), std::string::npos) << csv;
+  const auto json = nlohmann::json::parse(bd::format_curve(pts, bd::ListingFormat::kJson));
+  EXPECT_EQ(json[1]["n_particles"], 2398);
+  EXPECT_DOUBLE_EQ(json[1]["end_s"].get<double>(), 2.0);
 }
 
 TEST(StudyDatabase, CurveAveragesReplicasAndPropagatesTheirScatterIntoRacc) {
