@@ -2,6 +2,7 @@
 """Where the particles sit across the gap, and which forces hold them there.
 
   scripts/gap_profile.py [--budget] [--profile] RUN_DIR [RUN_DIR ...]
+  scripts/gap_profile.py --layers RUN_DIR [RUN_DIR ...]
 
 Averages pdf_y.csv (with --budget force_budget_y.csv, with --profile velocity_profile_y.csv) of the
 runs given (replicas of one
@@ -14,7 +15,20 @@ case), prints the profile as density over its mean from wall to wall, and two nu
 With --budget, the mean y-force per particle of every term by band, over the buoyant weight,
 and the band's mean particle and shear Reynolds numbers (the lift law's inputs). With --profile,
 the band's mean w_p, the w_f its particles see and their slip (mm/s), and its share of the flux (%).
+With --layers (runs that wrote all three files), per wall (y = 0 and y = W, each measured from its
+own wall) the layers next to it, as the mean over the runs and the standard error of that mean:
+  touching    density of the bands whose centre lies within 0.075 mm of d/2 (the particles
+              touching the wall), over the uniform density a centre can have, 1 / (W - d);
+  next        the same from d/2 + 0.075 mm to d/2 + 0.45 mm (the paper's Fig. 12(a): a rise at the
+              wall; at full size the product holds 0.70-0.80 there);
+  w_p, w_f    the particles' mean velocity along the channel and the fluid's they see in `next`
+              (mm/s, + upward);
+  v_f seen    the transverse fluid velocity the particles see from d/2 + 0.075 to d/2 + 1.2 mm
+              (mm/s, + away from this wall; their own transverse velocity averages to ~0);
+  drag, pressure, lift, contacts, net: the mean transverse forces from d/2 + 0.075 to d/2 + 0.6 mm
+              in % of the buoyant weight, + away from this wall (net = m dv/dt).
 """
+import json
 import csv
 import statistics
 import sys
@@ -35,7 +49,53 @@ def mean_columns(dirs, name):
     return out
 
 
+def layers(dirs):
+    """The layers next to each wall (see the module's doc), over the runs in dirs."""
+    per_wall = {"y = 0": [], "y = W": []}
+    for d in dirs:
+        radius_mm = json.loads((Path(d) / "params.json").read_text())["particles"]["diameter"] * 500
+        pdf = read(Path(d) / "pdf_y.csv")
+        prof = read(Path(d) / "velocity_profile_y.csv")
+        bud = read(Path(d) / "force_budget_y.csv")
+        y_mm = [float(r["y_m"]) * 1e3 for r in pdf]
+        width_mm = 2 * y_mm[0] * len(y_mm)
+        uniform = 1e3 / (width_mm - 2 * radius_mm)  # 1/m
+        for wall, sign in (("y = 0", 1), ("y = W", -1)):
+            dist = [yy if sign > 0 else width_mm - yy for yy in y_mm]
+
+            def mean_in(lo, hi, values):
+                sel = [v for x, v in zip(dist, values) if radius_mm + lo <= x < radius_mm + hi and v == v]
+                return statistics.fmean(sel) if sel else float("nan")
+
+            dens = [float(r["probability_density"]) / uniform for r in pdf]
+            row = {
+                "touching": mean_in(-0.075, 0.075, dens),
+                "next": mean_in(0.075, 0.45, dens),
+                "w_p": mean_in(0.075, 0.45, [float(r["wp_m_s"]) * 1e3 for r in prof]),
+                "w_f": mean_in(0.075, 0.45, [float(r["wf_seen_m_s"]) * 1e3 for r in prof]),
+                "v_f seen": mean_in(0.075, 1.2, [sign * float(r["vf_seen_m_s"]) * 1e3 for r in prof]),
+            }
+            for t in ("drag", "pressure_gradient", "lift", "particle_contacts", "net"):
+                row[t] = mean_in(0.075, 0.6, [sign * float(r[t + "_per_weight"]) * 100 for r in bud])
+            per_wall[wall].append(row)
+    n = len(dirs)
+    print(f"runs {n}; mean and standard error over the runs")
+    for wall, rows in per_wall.items():
+        parts = []
+        for k in rows[0]:
+            vals = [r[k] for r in rows]
+            err = f" ± {statistics.stdev(vals) / n ** 0.5:.2f}" if n > 1 else ""
+            parts.append(f"{k} {statistics.fmean(vals):.2f}{err}")
+        print(f"{wall}: " + "; ".join(parts))
+
+
 def main(argv):
+    if "--layers" in argv:
+        dirs = [a for a in argv if a != "--layers"]
+        if not dirs:
+            sys.exit(__doc__)
+        layers(dirs)
+        return
     budget = "--budget" in argv
     profile = "--profile" in argv
     dirs = [a for a in argv if a not in ("--budget", "--profile")]
