@@ -8,8 +8,10 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "core/key_docs.hpp"
 #include "driver/report/curve_query.hpp"
 #include "driver/report/report_util.hpp"
+#include "stats/point_error.hpp"
 #include "stats/relative_difference.hpp"
 
 namespace boycott::driver {
@@ -32,6 +34,7 @@ struct Measured {
   double angle_deg = 0;
   double w_m_s = 0, w_err_m_s = 0;  ///< NaN error when a single run gave none
   int n_replicas = 1;
+  stats::PointError error;                     ///< the point's covering error (the curve's)
   std::optional<double> wall_time_s;           ///< mean over the replicas that recorded one
   std::optional<std::int64_t> particle_steps;  ///< likewise
 };
@@ -42,7 +45,7 @@ std::vector<Measured> measured_points(Database& db, const std::string& study) {
   std::vector<Measured> out;
   for (const auto& p : query_curve(db, study)) {
     Measured m{p.group,      p.case_id, p.angle_deg, p.w_m_s, p.w_err_m_s.value_or(std::nan("")),
-               p.n_replicas, {},        {}};
+               p.n_replicas, p.error,   {},          {}};
     double wall = 0.0, steps = 0.0;
     int n_wall = 0, n_steps = 0;
     for (const auto& id : p.replica_case_ids) {
@@ -140,6 +143,8 @@ WorkPrecision query_work_precision(Database& db, const std::string& study,
         stats::relative_difference(run.w_m_s, run.w_err_m_s, ref.w_m_s, ref.w_err_m_s);
     row.rel_error_w = e.value;
     row.rel_error_w_unc = e.stderr_of_value;
+    // w / w_ref - 1 has the error of the ratio w / w_ref.
+    row.rel_error_w_err = stats::ratio_error(run.w_m_s, run.error, ref.w_m_s, ref.error);
     wp.rows.push_back(std::move(row));
     if (std::none_of(wp.references.begin(), wp.references.end(),
                      [&](const ReferenceRun& r) { return r.case_id == ref.case_id; }))
@@ -202,6 +207,7 @@ std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
            {"reference_stderr_m_s", r.w_ref_err_m_s},
            {"rel_error_w", r.rel_error_w},
            {"rel_error_w_uncertainty", r.rel_error_w_unc},
+           {"rel_error_w_error", opt_json(r.rel_error_w_err)},
            {"rel_error_r_acc", opt_json(r.rel_error_r_acc)},
            {"rel_error_r_acc_uncertainty", opt_json(r.rel_error_r_acc_unc)},
            {"case_id", r.case_id},
@@ -217,29 +223,31 @@ std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
     std::string s =
         "group,setting,angle_deg,wall_time_s,particle_steps,mean_settling_velocity_m_s,stderr_m_s,reference_"
         "m_s,"
-        "reference_stderr_m_s,rel_error_w,rel_error_w_uncertainty,rel_error_r_acc,rel_error_r_acc_"
-        "uncertainty,"
+        "reference_stderr_m_s,rel_error_w,rel_error_w_uncertainty,rel_error_w_error,rel_error_r_acc,"
+        "rel_error_r_acc_uncertainty,"
         "case_id,reference_case_id,n_replicas,reference_n_replicas\n";
     for (const auto& r : wp.rows)
-      s += fmt::format("{},{},{:g},{},{},{:.9g},{},{:.9g},{},{:.9g},{},{},{},{},{},{},{}\n",
+      s += fmt::format("{},{},{:g},{},{},{:.9g},{},{:.9g},{},{:.9g},{},{},{},{},{},{},{},{}\n",
                        report::csv_field(r.group), report::csv_field(report::join_values(r.setting)),
                        r.angle_deg, opt_csv(r.wall_time_s),
                        r.particle_steps ? std::to_string(*r.particle_steps) : "", r.w_m_s,
                        opt_csv(r.w_err_m_s), r.w_ref_m_s, opt_csv(r.w_ref_err_m_s), r.rel_error_w,
-                       opt_csv(r.rel_error_w_unc), opt_csv(r.rel_error_r_acc), opt_csv(r.rel_error_r_acc_unc),
+                       opt_csv(r.rel_error_w_unc), opt_csv(r.rel_error_w_err), opt_csv(r.rel_error_r_acc),
+                       opt_csv(r.rel_error_r_acc_unc),
                        r.case_id, r.ref_case_id, r.n_replicas, r.ref_n_replicas);
     return s;
   }
   if (wp.rows.empty())
     return fmt::format("(no finished cases outside the reference group '{}')\n", wp.reference_group);
   report::TextTable t({"group", "setting", "angle", "runs", "wall (s)", "particle steps", "<<w_p>> (mm/s)",
-                       "ref (mm/s)", "error <<w_p>>", "error r_acc"},
+                       "ref (mm/s)", "error <<w_p>> +- 68 %", "error r_acc +- s.e."},
                       {false, false, true, true, true, true, true, true, true, true});
   for (const auto& r : wp.rows)
     t.add({r.group, report::join_values(r.setting), fmt::format("{:g}", r.angle_deg),
            std::to_string(r.n_replicas), r.wall_time_s ? report::seconds(*r.wall_time_s) : "-",
            r.particle_steps ? std::to_string(*r.particle_steps) : "-", fmt::format("{:.4f}", r.w_m_s * 1e3),
-           fmt::format("{:.4f}", r.w_ref_m_s * 1e3), percent_pm(r.rel_error_w, r.rel_error_w_unc),
+           fmt::format("{:.4f}", r.w_ref_m_s * 1e3),
+           percent_pm(r.rel_error_w, r.rel_error_w_err.value_or(std::nan(""))),
            r.rel_error_r_acc ? percent_pm(*r.rel_error_r_acc, *r.rel_error_r_acc_unc) : "-"});
   std::string s = t.str();
   for (const auto& r : wp.references)
@@ -269,10 +277,25 @@ bool setting_before(const std::vector<SweptValue>& a, const std::vector<SweptVal
   return a.size() < b.size();
 }
 
-/// A point's label: the values of its setting ("5e-05", "[25, 3, 25]").
+/// A value in its key's unit for people: times in s, ms or µs ("50 µs"), other units appended
+/// ("0.01 m"), pure numbers and lists as they are.
+std::string value_with_unit(const SweptValue& v) {
+  const auto doc = key_doc(v.key);
+  const std::string unit = doc ? doc->unit : "";
+  if (!v.value_num || unit.empty() || unit == "-") return v.display();
+  const double x = *v.value_num;
+  if (unit == "s" && x != 0.0 && std::abs(x) < 1.0)
+    return std::abs(x) < 1e-3 ? fmt::format("{:g} µs", x * 1e6) : fmt::format("{:g} ms", x * 1e3);
+  return fmt::format("{} {}", v.display(), unit);
+}
+
+/// A point's label: each varied key's last part and its value ("dt_dem 50 µs", "cells [10, 3, 10]").
 std::string setting_label(const std::vector<SweptValue>& v) {
   std::string s;
-  for (const auto& x : v) s += (s.empty() ? "" : "; ") + x.display();
+  for (const auto& x : v) {
+    const auto dot = x.key.rfind('.');
+    s += (s.empty() ? "" : "; ") + x.key.substr(dot == std::string::npos ? 0 : dot + 1) + " " + value_with_unit(x);
+  }
   return s;
 }
 
@@ -281,12 +304,12 @@ bool plotted(const WorkPrecisionRow& r) {
   return r.wall_time_s && *r.wall_time_s > 0;
 }
 
-/// `query work-precision --plot`: one log-log panel of |error| against wall time per angle, each
-/// group a line through its settings, the reference runs' wall times as dashed lines.
+/// `query work-precision --plot`: one panel per angle of the signed relative error (%) against
+/// wall time (log), each group a line through its settings, the reference at 0 and its runs' wall
+/// time as a dashed line.
 class WorkPrecisionFigure {
  public:
-  static constexpr double kFloor = kWorkPrecisionErrorFloor;
-  static constexpr double w = 360, h = 360, y0 = 60, gap = 80;
+  static constexpr double w = 400, h = 360, y0 = 60, gap = 90;
 
   explicit WorkPrecisionFigure(const WorkPrecision& wp) : wp_(wp) {
     for (const auto& r : wp.rows) {
@@ -300,7 +323,7 @@ class WorkPrecisionFigure {
   }
 
   double width() const { return 90 + angles_.size() * (w + gap) + 170; }
-  static constexpr double height() { return 490; }
+  static constexpr double height() { return 520; }
 
   void draw(plot::Canvas& c, const std::string& title) const {
     c.text((90 + angles_.size() * (w + gap) - gap) / 2 + 45, 24, title, plot::Anchor::kMiddle, 15);
@@ -309,38 +332,43 @@ class WorkPrecisionFigure {
   }
 
  private:
-  /// The range is the points', not their error bars': a large bar is clipped at the frame rather
-  /// than squeezing every point together.
+  static double percent_of(double rel) { return rel * 100.0; }
+  static double bar_of(const WorkPrecisionRow& r) { return r.rel_error_w_err ? *r.rel_error_w_err : 0.0; }
+
+  /// x: the points' and the references' wall times; y: the points with their bars and 0 (the
+  /// reference), the same in every panel so that the angles compare at a glance.
   void set_ranges() {
+    ylo_ = 0.0, yhi_ = 0.0;
     for (const auto& r : wp_.rows) {
       if (!plotted(r)) continue;
       xlo_ = std::min(xlo_, *r.wall_time_s), xhi_ = std::max(xhi_, *r.wall_time_s);
-      const double e = std::max(std::abs(r.rel_error_w), kFloor);
-      ylo_ = std::min(ylo_, e), yhi_ = std::max(yhi_, e);
+      const double e = percent_of(r.rel_error_w), b = percent_of(bar_of(r));
+      ylo_ = std::min(ylo_, e - b), yhi_ = std::max(yhi_, e + b);
     }
     for (const auto& r : wp_.references)
       if (r.wall_time_s && *r.wall_time_s > 0)
         xlo_ = std::min(xlo_, *r.wall_time_s), xhi_ = std::max(xhi_, *r.wall_time_s);
     if (!std::isfinite(xlo_)) xlo_ = 1, xhi_ = 10;
-    if (!std::isfinite(ylo_)) ylo_ = 1e-3, yhi_ = 1e-1;
-    // A margin of a fifth of a decade (at least one decade in view) keeps markers off the frame.
+    // At least a decade of wall time and 2 % of error in view, with margins.
     if (xhi_ / xlo_ < 10) {
       const double m = std::sqrt(10 * xlo_ / xhi_);
       xlo_ /= m, xhi_ *= m;
     }
-    if (yhi_ / ylo_ < 10) {
-      const double m = std::sqrt(10 * ylo_ / yhi_);
-      ylo_ /= m, yhi_ *= m;
+    xlo_ /= 1.6, xhi_ *= 1.6;
+    if (yhi_ - ylo_ < 2.0) {
+      const double m = (2.0 - (yhi_ - ylo_)) / 2;
+      ylo_ -= m, yhi_ += m;
     }
-    xlo_ /= 1.6, xhi_ *= 1.6, ylo_ /= 1.6, yhi_ *= 1.6;
+    const double pad = 0.08 * (yhi_ - ylo_);
+    ylo_ -= pad, yhi_ += pad;
   }
 
   double px(double x0, double t) const {
     return x0 + (std::log10(t) - std::log10(xlo_)) / (std::log10(xhi_) - std::log10(xlo_)) * w;
   }
-  double py(double e) const {
-    e = std::clamp(e, ylo_, yhi_);
-    return y0 + h - (std::log10(e) - std::log10(ylo_)) / (std::log10(yhi_) - std::log10(ylo_)) * h;
+  double py(double pct) const {
+    pct = std::clamp(pct, ylo_, yhi_);
+    return y0 + h - (pct - ylo_) / (yhi_ - ylo_) * h;
   }
 
   void draw_panel(plot::Canvas& c, std::size_t a) const {
@@ -350,33 +378,55 @@ class WorkPrecisionFigure {
       c.line(px(x0, t), y0, px(x0, t), y0 + h, "#ddd");
       c.text(px(x0, t), y0 + h + 18, fmt::format("{:g}", t), Anchor::kMiddle);
     }
-    for (double e : report::log_ticks(ylo_, yhi_)) {
+    for (double e : report::ticks(ylo_, yhi_)) {
       c.line(x0, py(e), x0 + w, py(e), "#ddd");
-      c.text(x0 - 6, py(e) + 4, fmt::format("{:g}", e), Anchor::kEnd);
+      c.text(x0 - 6, py(e) + 4, e == 0.0 ? std::string("0") : fmt::format("{:+g}", e), Anchor::kEnd);
     }
+    c.line(x0, py(0.0), x0 + w, py(0.0), "#555", 1.2, {}, "zero");
     c.stroke_rect(x0, y0, w, h, "#000", "panel");
     c.text(x0 + w / 2, y0 - 8, fmt::format("θ = {:g}°", angle), Anchor::kMiddle);
-    c.text(x0 + w / 2, y0 + h + 40, "wall time (s)", Anchor::kMiddle);
+    c.text(x0 + w / 2, y0 + h + 40, "wall time of one run (s)", Anchor::kMiddle);
     if (a == 0)
-      c.label(x0 - 62, y0 + h / 2, "|⟨⟨w_{p}⟩⟩ / ⟨⟨w_{p}⟩⟩_{ref} − 1| (dimensionless)", Anchor::kMiddle, 13,
-              true);
-    bool any_floor = false;
-    for (const auto& r : wp_.rows)
-      if (r.angle_deg == angle && plotted(r) && std::abs(r.rel_error_w) < kFloor) any_floor = true;
-    if (any_floor) c.line(x0, py(kFloor), x0 + w, py(kFloor), "#999", 1.0, {2, 3}, "floor");
-    // The reference run's cost: how much cheaper each point is than the run it is measured against.
+      c.label(x0 - 62, y0 + h / 2, "⟨⟨w_{p}⟩⟩ / ⟨⟨w_{p}⟩⟩_{ref} − 1 (%)", Anchor::kMiddle, 13, true);
+    // The reference: at 0 on the error axis, and its cost.
     for (const auto& r : wp_.references) {
       if (r.angle_deg != angle || !r.wall_time_s || *r.wall_time_s <= 0) continue;
       const double x = px(x0, *r.wall_time_s);
       c.line(x, y0, x, y0 + h, "#555", 1.0, {6, 4}, "reference");
       c.text(x - 4, y0 + h - 6, wp_.reference_group, Anchor::kStart, 11, "#555", true);
     }
-    for (std::size_t g = 0; g < groups_.size(); ++g) draw_group(c, x0, angle, g);
+    std::vector<Box> taken;
+    for (std::size_t g = 0; g < groups_.size(); ++g) draw_group(c, x0, angle, g, taken);
+  }
+
+  struct Box {
+    double x0, y0, x1, y1;
+    bool overlaps(const Box& o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
+  };
+
+  /// Where a label of width `tw` next to a marker at (x, y) goes: the first of eight places around
+  /// it (right above, right below, left above, ...) that overlaps no label, marker or the frame
+  /// edge already placed; else further down on the right.
+  static Box place_label(double x, double y, double tw, double x0, const std::vector<Box>& taken) {
+    constexpr double th = 11;  // the text's height at 10 px
+    const double right = x + 7, left = x - 7 - tw;
+    const double spots[][2] = {{right, y - 5},  {right, y + 5 + th}, {left, y - 5},       {left, y + 5 + th},
+                               {right, y + 4},  {left, y + 4},       {right, y - 5 - th}, {left, y - 5 - th}};
+    for (const auto& s : spots) {
+      const Box b{s[0], s[1] - th, s[0] + tw, s[1]};
+      if (b.x0 < x0 + 2 || b.x1 > x0 + w - 2 || b.y0 < y0 + 2 || b.y1 > y0 + h - 2) continue;
+      if (std::none_of(taken.begin(), taken.end(), [&](const Box& o) { return b.overlaps(o); })) return b;
+    }
+    double base = y + 5 + th;
+    Box b{right, base - th, right + tw, base};
+    while (std::any_of(taken.begin(), taken.end(), [&](const Box& o) { return b.overlaps(o); }) && b.y1 < y0 + h)
+      b.y0 += th, b.y1 += th;
+    return b;
   }
 
   /// One group at one angle, joined in the order of the varied setting, each point labelled with
-  /// its value.
-  void draw_group(plot::Canvas& c, double x0, double angle, std::size_t g) const {
+  /// its setting where no other label or marker is.
+  void draw_group(plot::Canvas& c, double x0, double angle, std::size_t g, std::vector<Box>& taken) const {
     const char* color = report::color(g);
     std::vector<const WorkPrecisionRow*> mine;
     for (const auto& r : wp_.rows)
@@ -386,31 +436,36 @@ class WorkPrecisionFigure {
       return setting_before(p->setting, q->setting);
     });
     auto at = [&](const WorkPrecisionRow* r) {
-      return std::pair{px(x0, *r->wall_time_s), py(std::max(std::abs(r->rel_error_w), kFloor))};
+      return std::pair{px(x0, *r->wall_time_s), py(percent_of(r->rel_error_w))};
     };
     std::vector<std::pair<double, double>> line;
     for (const auto* r : mine) line.push_back(at(r));
     c.polyline(line, color, 1.5, "group");
-    // Error bars are clipped to the panel's frame.
-    c.clip(x0, y0, w, h);
+    c.clip(x0, y0, w, h);  // bars are clipped to the panel's frame
     for (const auto* r : mine) {
-      if (!(r->rel_error_w_unc > 0)) continue;  // none, or NaN: no bar
-      const double e = std::abs(r->rel_error_w), x = at(r).first;
-      const double top = e + r->rel_error_w_unc, bottom = std::max(e - r->rel_error_w_unc, kFloor);
-      c.line(x, py(bottom), x, py(top), color, 1.0, {}, "errorbar");
-      c.line(x - 4, py(top), x + 4, py(top), color);
+      if (!(bar_of(*r) > 0)) continue;  // none: no bar
+      const double e = percent_of(r->rel_error_w), b = percent_of(bar_of(*r)), x = at(r).first;
+      c.line(x, py(e - b), x, py(e + b), color, 1.0, {}, "errorbar");
+      c.line(x - 4, py(e + b), x + 4, py(e + b), color);
+      c.line(x - 4, py(e - b), x + 4, py(e - b), color);
     }
     c.unclip();
     for (const auto* r : mine) {
       const auto [x, y] = at(r);
-      c.marker(report::marker_kind(g), x, y, color, std::abs(r->rel_error_w) < kFloor);
+      c.marker(report::marker_kind(g), x, y, color);
+      taken.push_back({x - 5, y - 5, x + 5, y + 5});
+    }
+    for (const auto* r : mine) {
       const std::string label = setting_label(r->setting);
-      if (!label.empty()) c.text(x + 6, y - 6, label, plot::Anchor::kStart, 10, color, false, "setting");
+      if (label.empty()) continue;
+      const auto [x, y] = at(r);
+      const Box b = place_label(x, y, c.text_width(label, 10), x0, taken);
+      taken.push_back(b);
+      c.text(b.x0, b.y1 - 1, label, plot::Anchor::kStart, 10, color, false, "setting");
     }
   }
 
-  /// The legend right of the panels, and the caption: what a bar is, and why a point may have
-  /// none (a window too short for an error of its own).
+  /// The legend right of the panels, and the caption: what a bar is and how to read one.
   void draw_legend(plot::Canvas& c) const {
     const double lx = 90 + angles_.size() * (w + gap) - gap + 20;
     double ly = y0 + 10;
@@ -418,21 +473,20 @@ class WorkPrecisionFigure {
       c.marker(report::marker_kind(g), lx + 8, ly, report::color(g));
       c.text(lx + 20, ly + 4, groups_[g], plot::Anchor::kStart, 13, "#000", false, "legend");
     }
-    c.line(lx, ly, lx + 16, ly, "#555", 1.0, {6, 4});
-    c.text(lx + 20, ly + 4, "reference wall time");
+    c.line(lx, ly, lx + 16, ly, "#555", 1.2);
+    c.text(lx + 20, ly + 4, fmt::format("reference ({})", wp_.reference_group));
     ly += 20;
-    if (std::any_of(wp_.rows.begin(), wp_.rows.end(), [&](const WorkPrecisionRow& r) {
-          return plotted(r) && std::abs(r.rel_error_w) < kFloor;
-        })) {
-      c.marker("circle", lx + 8, ly, "#555", true);
-      c.text(lx + 20, ly + 4, fmt::format("|error| < {:g}, drawn at {:g}", kFloor, kFloor));
-    }
+    c.line(lx, ly, lx + 16, ly, "#555", 1.0, {6, 4});
+    c.text(lx + 20, ly + 4, "its wall time");
     const bool any_without = std::any_of(wp_.rows.begin(), wp_.rows.end(), [&](const WorkPrecisionRow& r) {
-      return plotted(r) && !(r.rel_error_w_unc > 0);
+      return plotted(r) && !(bar_of(r) > 0);
     });
+    c.text(90, height() - 30,
+           "bars: the interval that holds the true difference ~68 % of the time (the replicas' scatter of the point "
+           "and of the reference, Student's t at Welch's degrees of freedom)",
+           plot::Anchor::kStart, 11, "#333", false, "caption");
     c.text(90, height() - 14,
-           std::string(
-               "bars: 68 % interval of the error from the statistical errors of the run and the reference") +
+           std::string("a bar that crosses 0: the setting cannot be told from the reference at these errors") +
                (any_without ? "; no bar: a run gave no error estimate (window too short)" : ""),
            plot::Anchor::kStart, 11, "#333", false, "caption");
   }
@@ -440,7 +494,7 @@ class WorkPrecisionFigure {
   const WorkPrecision& wp_;
   std::vector<std::string> groups_;
   std::vector<double> angles_;
-  double xlo_ = INFINITY, xhi_ = -INFINITY, ylo_ = INFINITY, yhi_ = -INFINITY;
+  double xlo_ = INFINITY, xhi_ = -INFINITY, ylo_ = 0, yhi_ = 0;
 };
 
 }  // namespace

@@ -34,6 +34,10 @@ struct WorkPrecisionRow {
   /// have the sign of gravity, so this is (|w| - |w_ref|)/|w_ref| whenever w and w_ref agree in sign).
   double rel_error_w = 0;
   double rel_error_w_unc = 0;  ///< first-order propagation of both standard errors, independent
+  /// The half-width that covers the true rel_error_w ~68 % of the time: the points' plain errors
+  /// propagated, times Student's t at Welch's degrees of freedom of the two (stats::ratio_error,
+  /// as r_acc's). Unset where either point has no error of its own.
+  std::optional<double> rel_error_w_err;
   /// r_acc(theta) / r_acc_ref(theta) - 1, r_acc = w(theta)/w(90) within the same group and
   /// setting; unset at 90 deg and where the group has no 90 deg case of the same setting.
   std::optional<double> rel_error_r_acc, rel_error_r_acc_unc;
@@ -62,12 +66,12 @@ WorkPrecision query_work_precision(Database& db, const std::string& study,
 
 std::string format_work_precision(const WorkPrecision& wp, ListingFormat f);
 
-/// Below this |relative error| a point is drawn on the floor of the log axis, hollow.
-inline constexpr double kWorkPrecisionErrorFloor = 1e-6;
-/// Log-log |rel_error_w| against wall time, one panel per angle: one colour and marker per group,
-/// its points joined in the order of the varied setting and labelled with its value, error bars
-/// clipped to the frame, the reference's wall time as a dashed vertical line. Drawn with Cairo as
-/// SVG, PDF or PNG (driver/report/plot_cairo.hpp).
+/// rel_error_w in % (signed, linear, the reference at 0) against wall time (log), one panel per
+/// angle: one colour and marker per group, its points joined in the order of the varied setting
+/// and labelled with its key and value in the key's unit ("dt_dem 50 µs"), labels moved apart
+/// where they would overlap, covering error bars (rel_error_w_err) clipped to the frame, the
+/// reference's wall time as a dashed vertical line. A bar that crosses 0 is a setting that cannot
+/// be told from the reference. Drawn with Cairo as SVG, PDF or PNG (driver/report/plot_cairo.hpp).
 plot::Plot work_precision_plot(const WorkPrecision& wp, const std::string& title,
                                plot::Format format = plot::Format::kSvg);
 

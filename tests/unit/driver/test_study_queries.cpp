@@ -308,7 +308,7 @@ void expect_svg(const std::string& svg, int width, int height) {
   EXPECT_GT(count_in(svg, "<use"), 20u);              // the glyphs of the text, placed
 }
 
-TEST(WorkPrecision, PlotHasAPanelPerAngleALinePerGroupInEachAndFlagsZeroErrors) {
+TEST(WorkPrecision, PlotHasAPanelPerAngleALinePerGroupSignedErrorsWithBarsAndLabelsInTheKeysUnits) {
   TempDir d;
   bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
   const auto study = bd::expand_study_string(kWorkPrecisionStudy);
@@ -316,7 +316,7 @@ TEST(WorkPrecision, PlotHasAPanelPerAngleALinePerGroupInEachAndFlagsZeroErrors) 
   record(db, study, kRuns);
   const auto wp = bd::query_work_precision(db, "wp");
   const auto plot = bd::work_precision_plot(wp, "wp & co");
-  expect_svg(plot.data, 90 + 2 * 440 + 170, 490);  // two angles
+  expect_svg(plot.data, 90 + 2 * 490 + 170, 520);  // two angles
   EXPECT_EQ(plot.count("panel"), 2);               // one per angle
   EXPECT_TRUE(plot.has_text("θ = 65°"));
   EXPECT_TRUE(plot.has_text("θ = 90°"));
@@ -324,17 +324,20 @@ TEST(WorkPrecision, PlotHasAPanelPerAngleALinePerGroupInEachAndFlagsZeroErrors) 
   EXPECT_EQ(plot.count("legend"), 2);
   EXPECT_TRUE(plot.has_text("dt_dem"));
   EXPECT_TRUE(plot.has_text("cells"));
-  EXPECT_EQ(plot.count("reference"), 2);  // one per angle
+  EXPECT_TRUE(plot.has_text("reference (reference)"));
+  EXPECT_EQ(plot.count("zero"), 2);       // the reference's 0 in each panel
+  EXPECT_EQ(plot.count("reference"), 2);  // its wall time, one per angle
   EXPECT_EQ(plot.count("errorbar"), 4);   // every point: both runs have an error
-  // Each point is labelled with the value of its group's setting.
+  // Each point is labelled with its key's last part and its value in the key's unit.
   EXPECT_EQ(plot.count("setting"), 4);
-  EXPECT_TRUE(plot.has_text("4e-05"));
+  EXPECT_TRUE(plot.has_text("dt_dem 40 µs"));
+  EXPECT_TRUE(plot.has_text("cells [100, 6, 50]"));
   EXPECT_TRUE(plot.has_text("wp & co"));
-  EXPECT_TRUE(plot.has_text("wall time (s)"));
-  // cells at 65 deg equals the reference: drawn hollow on the floor of the log axis (and keyed).
-  EXPECT_EQ(plot.count("floor"), 1);
-  EXPECT_EQ(plot.count("hollow marker"), 2);
-  EXPECT_EQ(plot.count("marker"), 5);  // the other three points, the groups' keys
+  EXPECT_TRUE(plot.has_text("wall time of one run (s)"));
+  // Signed: cells at 65 deg equals the reference, a filled marker on the 0 line like the others.
+  EXPECT_EQ(plot.count("hollow marker"), 0);
+  EXPECT_EQ(plot.count("marker"), 6);  // four points, the groups' keys
+  EXPECT_EQ(plot.count("caption"), 2);
 
   // The same drawing as PDF.
   const auto pdf = bd::work_precision_plot(wp, "wp & co", bd::plot::Format::kPdf);
@@ -343,6 +346,59 @@ TEST(WorkPrecision, PlotHasAPanelPerAngleALinePerGroupInEachAndFlagsZeroErrors) 
   EXPECT_NE(pdf.data.find("%%EOF"), std::string::npos);
   EXPECT_EQ(pdf.drawn, plot.drawn);
   EXPECT_EQ(pdf.texts, plot.texts);
+}
+
+// The bar of a work-precision point covers like r_acc's: the two points' plain errors (here the
+// replicas' scatter, 2 degrees of freedom each) propagated, times Student's t at Welch's degrees
+// of freedom, 6 for two equal parts of 2 each; with runs of unknown dof it is the plain error.
+TEST(WorkPrecision, ErrorBarIsTheRatiosCoveringErrorAtWelchsDegreesOfFreedom) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(R"(
+name = "wpr"
+replicas = 3
+[base.time]
+end = 2.0
+average_from = 1.0
+[[group]]
+name = "reference"
+set = { "time.dt_dem" = 1e-5 }
+[[group]]
+name = "dt_dem"
+set = { "time.dt_dem" = 4e-5 }
+[matrix]
+"gravity.angle_deg" = [65]
+)");
+  bd::register_study(db, study);
+  // Replicas: dt_dem -0.110 +- {0, -0.002, +0.002} (sd 0.002), reference -0.1 +- {0, -0.0018,
+  // +0.0018} (sd 0.0018): parts (0.002/sqrt 3 / 0.1)^2 and (1.1 * 0.0018/sqrt 3 / 0.1)^2, nearly equal.
+  for (const auto& c : study.cases) {
+    const double k = c.replica == 0 ? 0.0 : (c.replica == 1 ? -1.0 : 1.0);
+    const double w = c.group == "reference" ? -0.1 + 0.0018 * k : -0.110 + 0.002 * k;
+    bd::record_result(db, bd::begin_attempt(db, c.id, 1, "x"), c.id, summary_of(c, {w, 0.0005, 10.0}));
+  }
+  const auto wp = bd::query_work_precision(db, "wpr");
+  const auto& r = row(wp, "dt_dem", 65);
+  EXPECT_NEAR(r.rel_error_w, 0.10, 1e-12);
+  const double a = 0.002 / std::sqrt(3.0) / 0.1, b = 1.1 * 0.0018 / std::sqrt(3.0) / 0.1;
+  const double var = a * a + b * b;
+  const double nu = var * var / (a * a * a * a / 4.0 + b * b * b * b / 4.0) - 2.0;
+  EXPECT_NEAR(nu, 6.0, 0.01);
+  ASSERT_TRUE(r.rel_error_w_err.has_value());
+  EXPECT_NEAR(*r.rel_error_w_err, std::sqrt(var) * boycott::stats::one_sigma_t_factor(nu), 1e-9);
+  EXPECT_GT(*r.rel_error_w_err, 1.08 * r.rel_error_w_unc);  // t_6 at 68 %: 1.09
+  const auto csv = bd::format_work_precision(wp, bd::ListingFormat::kCsv);
+  EXPECT_NE(csv.find("rel_error_w_uncertainty,rel_error_w_error,"), std::string::npos) << csv;
+  EXPECT_NE(bd::format_work_precision(wp, bd::ListingFormat::kTable).find("error <<w_p>> +- 68 %"),
+            std::string::npos);
+  // Runs without degrees of freedom (the fixture's): the plain propagated error.
+  TempDir d2;
+  bd::Database db2((d2.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto plain = bd::expand_study_string(kWorkPrecisionStudy);
+  bd::register_study(db2, plain);
+  record(db2, plain, kRuns);
+  const auto wp2 = bd::query_work_precision(db2, "wp");
+  EXPECT_NEAR(*row(wp2, "dt_dem", 65).rel_error_w_err, row(wp2, "dt_dem", 65).rel_error_w_unc, 1e-12);
 }
 
 TEST(CurvePlot, DrawsBothPanelsWithErrorBarsReplicasAndThePaperOverlayAsSvgPdfAndPng) {
