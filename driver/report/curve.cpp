@@ -26,12 +26,12 @@ std::string format_curve(const std::vector<CurvePoint>& pts, ListingFormat f) {
         "between_replica_stderr_m_s,mean_within_run_stderr_m_s,r_acc,r_acc_err,error_method,n_particles,"
         "average_from_s,end_s,case_id,setting\n";
     for (const auto& p : pts)
-      s += fmt::format("{},{:g},{:.9g},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", report::csv_field(p.group),
-                       p.angle_deg, p.w_m_s, opt9(p.error.error_m_s), report::csv_field(p.error.basis),
-                       opt9(p.w_err_m_s), p.n_replicas, opt9(p.between_replica_stderr_m_s),
-                       opt9(p.mean_within_run_stderr_m_s), opt(p.r_acc), opt(p.r_acc_err), p.error_method,
-                       p.n_particles ? std::to_string(*p.n_particles) : std::string(), opt9(p.average_from_s),
-                       opt9(p.end_s), p.case_id, report::csv_field(p.setting));
+      s += fmt::format(
+          "{},{:g},{:.9g},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", report::csv_field(p.group),
+          p.angle_deg, p.w_m_s, opt9(p.error.error_m_s), report::csv_field(p.error.basis), opt9(p.w_err_m_s),
+          p.n_replicas, opt9(p.between_replica_stderr_m_s), opt9(p.mean_within_run_stderr_m_s), opt(p.r_acc),
+          opt(p.r_acc_err), p.error_method, p.n_particles ? std::to_string(*p.n_particles) : std::string(),
+          opt9(p.average_from_s), opt9(p.end_s), p.case_id, report::csv_field(p.setting));
   } else if (f == ListingFormat::kJson) {
     nlohmann::json j = nlohmann::json::array();
     for (const auto& p : pts) {

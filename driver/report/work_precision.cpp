@@ -227,14 +227,13 @@ std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
         "rel_error_r_acc_uncertainty,"
         "case_id,reference_case_id,n_replicas,reference_n_replicas\n";
     for (const auto& r : wp.rows)
-      s += fmt::format("{},{},{:g},{},{},{:.9g},{},{:.9g},{},{:.9g},{},{},{},{},{},{},{},{}\n",
-                       report::csv_field(r.group), report::csv_field(report::join_values(r.setting)),
-                       r.angle_deg, opt_csv(r.wall_time_s),
-                       r.particle_steps ? std::to_string(*r.particle_steps) : "", r.w_m_s,
-                       opt_csv(r.w_err_m_s), r.w_ref_m_s, opt_csv(r.w_ref_err_m_s), r.rel_error_w,
-                       opt_csv(r.rel_error_w_unc), opt_csv(r.rel_error_w_err), opt_csv(r.rel_error_r_acc),
-                       opt_csv(r.rel_error_r_acc_unc),
-                       r.case_id, r.ref_case_id, r.n_replicas, r.ref_n_replicas);
+      s += fmt::format(
+          "{},{},{:g},{},{},{:.9g},{},{:.9g},{},{:.9g},{},{},{},{},{},{},{},{}\n", report::csv_field(r.group),
+          report::csv_field(report::join_values(r.setting)), r.angle_deg, opt_csv(r.wall_time_s),
+          r.particle_steps ? std::to_string(*r.particle_steps) : "", r.w_m_s, opt_csv(r.w_err_m_s),
+          r.w_ref_m_s, opt_csv(r.w_ref_err_m_s), r.rel_error_w, opt_csv(r.rel_error_w_unc),
+          opt_csv(r.rel_error_w_err), opt_csv(r.rel_error_r_acc), opt_csv(r.rel_error_r_acc_unc), r.case_id,
+          r.ref_case_id, r.n_replicas, r.ref_n_replicas);
     return s;
   }
   if (wp.rows.empty())
@@ -294,7 +293,8 @@ std::string setting_label(const std::vector<SweptValue>& v) {
   std::string s;
   for (const auto& x : v) {
     const auto dot = x.key.rfind('.');
-    s += (s.empty() ? "" : "; ") + x.key.substr(dot == std::string::npos ? 0 : dot + 1) + " " + value_with_unit(x);
+    s += (s.empty() ? "" : "; ") + x.key.substr(dot == std::string::npos ? 0 : dot + 1) + " " +
+         value_with_unit(x);
   }
   return s;
 }
@@ -410,8 +410,8 @@ class WorkPrecisionFigure {
   static Box place_label(double x, double y, double tw, double x0, const std::vector<Box>& taken) {
     constexpr double th = 11;  // the text's height at 10 px
     const double right = x + 7, left = x - 7 - tw;
-    const double spots[][2] = {{right, y - 5},  {right, y + 5 + th}, {left, y - 5},       {left, y + 5 + th},
-                               {right, y + 4},  {left, y + 4},       {right, y - 5 - th}, {left, y - 5 - th}};
+    const double spots[][2] = {{right, y - 5}, {right, y + 5 + th}, {left, y - 5},       {left, y + 5 + th},
+                               {right, y + 4}, {left, y + 4},       {right, y - 5 - th}, {left, y - 5 - th}};
     for (const auto& s : spots) {
       const Box b{s[0], s[1] - th, s[0] + tw, s[1]};
       if (b.x0 < x0 + 2 || b.x1 > x0 + w - 2 || b.y0 < y0 + 2 || b.y1 > y0 + h - 2) continue;
@@ -419,7 +419,8 @@ class WorkPrecisionFigure {
     }
     double base = y + 5 + th;
     Box b{right, base - th, right + tw, base};
-    while (std::any_of(taken.begin(), taken.end(), [&](const Box& o) { return b.overlaps(o); }) && b.y1 < y0 + h)
+    while (std::any_of(taken.begin(), taken.end(), [&](const Box& o) { return b.overlaps(o); }) &&
+           b.y1 < y0 + h)
       b.y0 += th, b.y1 += th;
     return b;
   }
@@ -482,13 +483,15 @@ class WorkPrecisionFigure {
       return plotted(r) && !(bar_of(r) > 0);
     });
     c.text(90, height() - 30,
-           "bars: the interval that holds the true difference ~68 % of the time (the replicas' scatter of the point "
+           "bars: the interval that holds the true difference ~68 % of the time (the replicas' scatter of "
+           "the point "
            "and of the reference, Student's t at Welch's degrees of freedom)",
            plot::Anchor::kStart, 11, "#333", false, "caption");
-    c.text(90, height() - 14,
-           std::string("a bar that crosses 0: the setting cannot be told from the reference at these errors") +
-               (any_without ? "; no bar: a run gave no error estimate (window too short)" : ""),
-           plot::Anchor::kStart, 11, "#333", false, "caption");
+    c.text(
+        90, height() - 14,
+        std::string("a bar that crosses 0: the setting cannot be told from the reference at these errors") +
+            (any_without ? "; no bar: a run gave no error estimate (window too short)" : ""),
+        plot::Anchor::kStart, 11, "#333", false, "caption");
   }
 
   const WorkPrecision& wp_;

@@ -92,11 +92,11 @@ std::vector<StoredResult> stored_results(Database& db, const std::string& study)
 struct CurveResult {
   std::string group, case_id;
   double angle_deg = 0;
-  double w_m_s = 0;                 ///< <<w_p>>
-  std::optional<double> w_err_m_s;  ///< its standard error; unset when the run recorded none
-  std::int64_t position = 0;        ///< its first position in the study within the group
-  std::string error_method;         ///< settling_velocity_error_method; "batch_means" when none
-  std::optional<double> error_dof;  ///< settling_velocity_error_dof
+  double w_m_s = 0;                         ///< <<w_p>>
+  std::optional<double> w_err_m_s;          ///< its standard error; unset when the run recorded none
+  std::int64_t position = 0;                ///< its first position in the study within the group
+  std::string error_method;                 ///< settling_velocity_error_method; "batch_means" when none
+  std::optional<double> error_dof;          ///< settling_velocity_error_dof
   std::optional<std::int64_t> n_particles;  ///< summary.json particle_count
   /// The run's averaging window (s): where it began (its own choice with average_from = "auto")
   /// and the simulated time it ended at (results.average_from_s, average_to_s).

@@ -326,12 +326,13 @@ average_from = 1.0
 )");
   bd::register_study(db, study);
   for (const auto& c : study.cases) {
-    nlohmann::json summary = {{"scene", "inclined_settling"},
-                              {"case_id", c.id},
-                              {"status", "completed"},
-                              {"mean_settling_velocity_m_s", c.params.gravity.angle_deg == 90.0 ? -0.08 : -0.16},
-                              {"settling_velocity_stderr_m_s", 0.001},
-                              {"particle_count", 2398}};
+    nlohmann::json summary = {
+        {"scene", "inclined_settling"},
+        {"case_id", c.id},
+        {"status", "completed"},
+        {"mean_settling_velocity_m_s", c.params.gravity.angle_deg == 90.0 ? -0.08 : -0.16},
+        {"settling_velocity_stderr_m_s", 0.001},
+        {"particle_count", 2398}};
     // 45 deg: a run that chose its own window and stopped at 1.75 s; 90 deg: the case's window.
     if (c.params.gravity.angle_deg == 45.0) {
       summary["average_from_s"] = 0.6;
@@ -348,9 +349,10 @@ average_from = 1.0
   EXPECT_DOUBLE_EQ(*pts[1].end_s, 2.0);
   const std::string csv = bd::format_curve(pts, bd::ListingFormat::kCsv);
   const std::string header = csv.substr(0, csv.find('\n'));
-  for (const char* col : {"angle_deg", "mean_settling_velocity_m_s", "error_m_s", "n_particles", "average_from_s",
-                          "end_s", "group"})
-    EXPECT_NE(("," + header + ",").find(std::string(",") + col + ","), std::string::npos) << col << ": " << header;
+  for (const char* col : {"angle_deg", "mean_settling_velocity_m_s", "error_m_s", "n_particles",
+                          "average_from_s", "end_s", "group"})
+    EXPECT_NE(("," + header + ",").find(std::string(",") + col + ","), std::string::npos)
+        << col << ": " << header;
   EXPECT_NE(csv.find(",2398,0.6,1.75,"), std::string::npos) << csv;
   const auto json = nlohmann::json::parse(bd::format_curve(pts, bd::ListingFormat::kJson));
   EXPECT_EQ(json[1]["n_particles"], 2398);
