@@ -354,21 +354,7 @@ TEST(WorkPrecision, PlotHasAPanelPerAngleALinePerGroupSignedErrorsWithBarsAndLab
 TEST(WorkPrecision, ErrorBarIsTheRatiosCoveringErrorAtWelchsDegreesOfFreedom) {
   TempDir d;
   bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
-  const auto study = bd::expand_study_string(R"(
-name = "wpr"
-replicas = 3
-[base.time]
-end = 2.0
-average_from = 1.0
-[[group]]
-name = "reference"
-set = { "time.dt_dem" = 1e-5 }
-[[group]]
-name = "dt_dem"
-set = { "time.dt_dem" = 4e-5 }
-[matrix]
-"gravity.angle_deg" = [65]
-)");
+  const auto study = dt_dem_study("name = \"wpr\"\nreplicas = 3\n", "\"gravity.angle_deg\" = [65]\n");
   bd::register_study(db, study);
   // Replicas: dt_dem -0.110 +- {0, -0.002, +0.002} (sd 0.002), reference -0.1 +- {0, -0.0018,
   // +0.0018} (sd 0.0018): parts (0.002/sqrt 3 / 0.1)^2 and (1.1 * 0.0018/sqrt 3 / 0.1)^2, nearly equal.
