@@ -135,12 +135,12 @@ void check_lift_range(const CaseParams& p, double re_p, Preflight& r) {
         re_p, instead));
   // Mei (1992) fitted Dandy & Dwyer's (1990) computations over 0.1 <= Re_p <= 100 and
   // 0.005 <= Re_w / (2 Re_p) <= 0.4.
-  if (law == "saffman_mei" && (re_p < 0.1 || re_p > 100.0))
-    r.warnings.push_back(
-        fmt::format("forces.lift = \"saffman_mei\" at Re_p = {:.3g}: Mei's (1992) factor is a fit over 0.1 "
-                    "<= Re_p <= 100 "
-                    "and 0.005 <= Re_w / (2 Re_p) <= 0.4 (Dandy & Dwyer's 1990 computations){}",
-                    re_p, re_p < 0.1 ? "; below it mclaughlin (Re_p << 1, Re_w << 1) is the theory" : ""));
+  if ((law == "saffman_mei" || law == "saffman_mei_continuous") && (re_p < 0.1 || re_p > 100.0))
+    r.warnings.push_back(fmt::format(
+        "forces.lift = \"{}\" at Re_p = {:.3g}: Mei's (1992) factor is a fit over 0.1 "
+        "<= Re_p <= 100 "
+        "and 0.005 <= Re_w / (2 Re_p) <= 0.4 (Dandy & Dwyer's 1990 computations){}",
+        law, re_p, re_p < 0.1 ? "; below it mclaughlin (Re_p << 1, Re_w << 1) is the theory" : ""));
 }
 
 /// The settling scales from the case's own drag law, and the steps and cells measured against

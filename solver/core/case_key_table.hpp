@@ -128,8 +128,8 @@ void visit_keys(P& p, V&& visitor) {
     "drag law (difelice_paper: Eqs. 13-15 as the paper prints them)");
   v("forces.saffman_lift", p.forces.saffman_lift, any(), "shear lift on or off (off: forces.lift = none)");
   v("forces.lift", p.forces.lift, choice(lift_law_names()),
-    "shear lift law (saffman: Eq. 16; saffman_mei: Mei's 1992 finite-Re factor; mclaughlin: "
-    "McLaughlin's 1991 J(epsilon) / J(inf))");
+    "shear lift law (saffman: Eq. 16; saffman_mei: Mei's 1992 finite-Re factor; saffman_mei_continuous: "
+    "the same without its jump at Re_p = 40; mclaughlin: McLaughlin's 1991 J(epsilon) / J(inf))");
   v("forces.added_mass", p.forces.added_mass, any(), "added-mass force on or off");
   v("forces.pressure_gradient", p.forces.pressure_gradient, any(), "pressure-gradient force on or off");
   v("forces.viscous", p.forces.viscous, any(), "viscous-stress (divergence of tau) force on or off");

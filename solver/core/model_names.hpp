@@ -17,7 +17,8 @@ inline const std::vector<std::string>& drag_law_names() {
 }
 /// forces.lift (coupling/lift_laws.hpp)
 inline const std::vector<std::string>& lift_law_names() {
-  static const std::vector<std::string> n = {"saffman", "saffman_mei", "mclaughlin", "none"};
+  static const std::vector<std::string> n = {"saffman", "saffman_mei", "saffman_mei_continuous", "mclaughlin",
+                                             "none"};
   return n;
 }
 /// numerics.void_fraction_kernel

@@ -306,6 +306,10 @@ void CoupledSystem::activate_models(ModelTimers& t) const {
     t.activate("saffman_lift", "Eq. 16 (timed with coupling_sample)");
   if (coupler_->settings().lift == LiftLaw::saffman_mei)
     t.activate("saffman_mei_lift", "Eq. 16 times Mei's (1992) finite-Re factor (timed with coupling_sample)");
+  if (coupler_->settings().lift == LiftLaw::saffman_mei_continuous)
+    t.activate(
+        "saffman_mei_continuous_lift",
+        "Eq. 16 times Mei's (1992) factor, its jump at Re_p = 40 bridged (timed with coupling_sample)");
   if (coupler_->settings().lift == LiftLaw::mclaughlin)
     t.activate("mclaughlin_lift",
                "Eq. 16 times McLaughlin's (1991) J(epsilon) / J(inf) (timed with coupling_sample)");

@@ -10,7 +10,15 @@
 //                  f = (1 - 0.3314 beta^1/2) exp(-Re_p / 10) + 0.3314 beta^1/2   (Re_p <= 40)
 //                  f = 0.0524 (beta Re_p)^1/2                                    (Re_p > 40)
 //                fitted over 0.1 <= Re_p <= 100 and 0.005 <= beta <= 0.4; it falls to ~0.1-0.3 of
-//                Saffman's at the Re_p of 20-50 of a proppant suspension.
+//                Saffman's at the Re_p of 20-50 of a proppant suspension. The fit jumps down at
+//                Re_p = 40 by (1 - 0.3314 beta^1/2) e^-4 (~0.016 of Saffman's, 12 % of the factor
+//                at beta 0.13): its high branch starts at the low branch's asymptote, 0.0524
+//                sqrt(40) = 0.3314, not at the low branch's value.
+//   saffman_mei_continuous
+//                Mei's fit without the jump, to measure what the jump does: the low branch up to
+//                Re_p = 40 and max(low, high) above, i.e. the low branch until the rising high
+//                branch meets it (Re_p ~46 at beta 0.13, 44-55 over 0.4 >= beta >= 0.005), then
+//                Mei's high branch. Continuous, never below Mei's, equal to it outside 40-55.
 //   mclaughlin   McLaughlin (1991), J. Fluid Mech. 224, 261: f = J(epsilon) / J(inf), epsilon =
 //                Re_w^1/2 / Re_p = (|w| nu)^1/2 / |u_f - u_p|. Saffman's analysis with the slip's
 //                inertia kept beside the shear's: Re_p << 1 and Re_w << 1, epsilon free (Saffman's
@@ -34,11 +42,12 @@
 
 namespace boycott::coupling {
 
-enum class LiftLaw { saffman, saffman_mei, mclaughlin, none };
+enum class LiftLaw { saffman, saffman_mei, saffman_mei_continuous, mclaughlin, none };
 
 inline LiftLaw lift_law_from_name(const std::string& s) {
   if (s == "saffman") return LiftLaw::saffman;
   if (s == "saffman_mei") return LiftLaw::saffman_mei;
+  if (s == "saffman_mei_continuous") return LiftLaw::saffman_mei_continuous;
   if (s == "mclaughlin") return LiftLaw::mclaughlin;
   if (s == "none") return LiftLaw::none;
   throw InputError(fmt::format("forces.lift = \"{}\": not a lift law of the coupling", s));
@@ -52,6 +61,16 @@ inline double mei_lift_factor(double re_p, double re_w) {
     return (1.0 - a) * std::exp(-0.1 * re_p) + a;
   }
   return 0.0524 * std::sqrt(beta * re_p);
+}
+
+/// Mei's ratio with its jump at Re_p = 40 bridged (saffman_mei_continuous): the low branch until
+/// the high branch rises above it; re_p > 0, re_w >= 0.
+inline double mei_continuous_lift_factor(double re_p, double re_w) {
+  const double beta = 0.5 * re_w / re_p;
+  const double a = 0.3314 * std::sqrt(beta);
+  const double low = (1.0 - a) * std::exp(-0.1 * re_p) + a;
+  if (re_p <= 40.0) return low;
+  return std::max(low, 0.0524 * std::sqrt(beta * re_p));
 }
 
 /// McLaughlin's (1991) J(epsilon) as a table over log10 epsilon = -1.6 (epsilon 0.0251) to 2
@@ -139,11 +158,13 @@ inline void lift_force(LiftLaw law, const double (&s)[3], const double (&w)[3], 
   const double wn = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
   if (wn <= 0.0) return;
   double c = 1.61 * rho * d * d * std::sqrt(nu / wn);
-  if (law == LiftLaw::saffman_mei || law == LiftLaw::mclaughlin) {
+  if (law != LiftLaw::saffman) {
     const double sn = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
     if (sn <= 0.0) return;
     const double re_p = sn * d / nu, re_w = wn * d * d / nu;
-    c *= law == LiftLaw::saffman_mei ? mei_lift_factor(re_p, re_w) : mclaughlin_lift_factor(re_p, re_w);
+    c *= law == LiftLaw::saffman_mei              ? mei_lift_factor(re_p, re_w)
+         : law == LiftLaw::saffman_mei_continuous ? mei_continuous_lift_factor(re_p, re_w)
+                                                  : mclaughlin_lift_factor(re_p, re_w);
   }
   f[0] = c * (s[1] * w[2] - s[2] * w[1]);
   f[1] = c * (s[2] * w[0] - s[0] * w[2]);

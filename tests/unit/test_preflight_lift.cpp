@@ -72,6 +72,11 @@ TEST(PreflightLift, MeisFactorIsNamedOutsideItsFittedRange) {
   EXPECT_TRUE(names(w, "a fit over 0.1 <= Re_p <= 100")) << w.size();
   p.forces.lift = "mclaughlin";
   EXPECT_TRUE(names(lift_warnings(p), "no lift law here covers Re_p > 100"));
+  // Mei's fit with its jump bridged rests on the same fit, and is named with it.
+  p.forces.lift = "saffman_mei_continuous";
+  w = lift_warnings(p);
+  EXPECT_TRUE(names(w, "forces.lift = \"saffman_mei_continuous\" at Re_p")) << w.size();
+  EXPECT_TRUE(names(w, "a fit over 0.1 <= Re_p <= 100")) << w.size();
 }
 
 }  // namespace

@@ -93,6 +93,61 @@ TEST(LiftLaws, SaffmanMeiIsSaffmanTimesTheFactorAndNoneIsZero) {
   for (double v : fm) EXPECT_EQ(v, 0.0);
 }
 
+TEST(LiftLaws, MeiContinuousBridgesTheJumpAndIsMeiOutsideTheBridge) {
+  for (double beta : {0.005, 0.05, 0.13, 0.4}) {
+    const auto re_w = [beta](double re_p) { return 2.0 * beta * re_p; };
+    // Up to Re_p = 40 it is Mei's low branch, bit for bit.
+    for (double re_p : {0.5, 10.0, 39.9, 40.0})
+      EXPECT_EQ(bc::mei_continuous_lift_factor(re_p, re_w(re_p)), bc::mei_lift_factor(re_p, re_w(re_p)));
+    // No jump at 40 (Mei's is (1 - 0.3314 beta^1/2) e^-4, ~0.015-0.018): across 1e-9 in Re_p the
+    // factor moves by no more than its slope, |d f / d Re_p| < 0.01, allows.
+    const double below = bc::mei_continuous_lift_factor(40.0, re_w(40.0));
+    const double above = bc::mei_continuous_lift_factor(40.0 + 1e-9, re_w(40.0 + 1e-9));
+    EXPECT_NEAR(below, above, 1e-10) << beta;
+    // Continuous everywhere on 30-70 (steps of 1e-4 in Re_p move it by < 1e-5), never below
+    // Mei's, and Mei's again from where the high branch crosses the low one (44-55 over this
+    // beta range) on.
+    double prev = bc::mei_continuous_lift_factor(30.0, re_w(30.0)), last_above = 0.0;
+    for (double re_p = 30.0001; re_p < 70.0; re_p += 1e-4) {
+      const double f = bc::mei_continuous_lift_factor(re_p, re_w(re_p)),
+                   m = bc::mei_lift_factor(re_p, re_w(re_p));
+      ASSERT_LT(std::abs(f - prev), 1e-5) << beta << " " << re_p;
+      ASSERT_GE(f, m) << beta << " " << re_p;
+      if (f > m) last_above = re_p;
+      prev = f;
+    }
+    EXPECT_GT(last_above, 43.0) << beta;
+    EXPECT_LT(last_above, 56.0) << beta;
+  }
+  // The suspension's beta 0.13: the bridge ends at Re_p 46.09 (bisection of low = high by hand).
+  const double beta = 0.13, a = 0.3314 * std::sqrt(beta);
+  const auto gap = [&](double r) {
+    return (1.0 - a) * std::exp(-0.1 * r) + a - 0.0524 * std::sqrt(beta * r);
+  };
+  EXPECT_GT(gap(46.0), 0.0);
+  EXPECT_LT(gap(46.2), 0.0);
+  EXPECT_GT(bc::mei_continuous_lift_factor(46.0, 2.0 * beta * 46.0),
+            bc::mei_lift_factor(46.0, 2.0 * beta * 46.0));
+  EXPECT_EQ(bc::mei_continuous_lift_factor(46.2, 2.0 * beta * 46.2),
+            bc::mei_lift_factor(46.2, 2.0 * beta * 46.2));
+}
+
+TEST(LiftLaws, SaffmanMeiContinuousIsSaffmanTimesItsFactor) {
+  // The channel's case at Re_p = 42 (inside the bridge) and 30 (below it).
+  const double w_x = 150.0;
+  for (double re_p : {30.0, 42.0}) {
+    const double s_z = re_p * kNu / kD;
+    const double s[3] = {0.0, 0.0, s_z}, w[3] = {w_x, 0.0, 0.0};
+    double fs[3], fc[3];
+    bc::lift_force(bc::LiftLaw::saffman, s, w, kD, kRho, kNu, fs);
+    bc::lift_force(bc::LiftLaw::saffman_mei_continuous, s, w, kD, kRho, kNu, fc);
+    const double f = bc::mei_continuous_lift_factor(re_p, w_x * kD * kD / kNu);
+    EXPECT_NEAR(fc[1], f * fs[1], 1e-12 * std::abs(fs[1])) << re_p;
+    EXPECT_EQ(fc[0], 0.0);
+    EXPECT_EQ(fc[2], 0.0);
+  }
+}
+
 TEST(LiftLaws, McLaughlinIsSaffmanTimesJOverJInfinityAndReversesWhereJIsNegative) {
   // The channel's case (slip along z, vorticity along x) at three epsilon = (|w| nu)^1/2 / |s|:
   // 2 (J/J(inf) = 0.929), 0.5 (0.326) and 0.1 (J < 0: the lift points the other way).
