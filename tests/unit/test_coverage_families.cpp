@@ -9,6 +9,7 @@
 // error of a coverage near 0.68 at 10 000 series: 0.0047. Label `long` (minutes).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -92,11 +93,21 @@ TEST(FamilyCoverage, AnErrorFivePerCentTooNarrowFallsOutsideTheBand) {
 namespace {
 
 // A run that time.target_rel_error stops (PrecisionTarget, two-stage), on 1 + a family's series,
-// the target set to need ~`goal` slowest times; its reported error at the stop.
-double target_coverage(const std::string& name, double goal, std::uint64_t seed) {
+// the target set to need ~`goal` slowest times, and run to at most 12 times that (its time.end).
+// Every series counts: one the target stopped with the error it reports at the stop, one it did
+// not with the error a run reports at its end (the fixed window's), as a user gets them. Leaving
+// the unstopped out would select: they are the series whose first stage was noisiest.
+struct TargetFigures {
+  double coverage = 0.0;            // every series
+  double stopped_coverage = 0.0;    // those the target stopped
+  double unstopped_coverage = 0.0;  // those that ran to the end
+  int stopped = 0;
+};
+TargetFigures target_coverage(const std::string& name, double goal, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   const Family make = family(name);
-  int covered = 0, stopped = 0;
+  int covered_stopped = 0, covered_unstopped = 0;
+  TargetFigures t;
   for (int s = 0; s < kSeries; ++s) {
     const FamilySeries f = make(12.0 * goal, rng);
     const double rel = one_sigma_t_factor(7.0) * std::sqrt(2.0 * f.tau_int / (goal * f.slowest));
@@ -108,15 +119,21 @@ double target_coverage(const std::string& name, double goal, std::uint64_t seed)
       w.push_back(1.0 + v);
       if ((done = target.reached(w, 0.0, static_cast<double>(w.size())))) break;
     }
-    if (!done) continue;
-    ++stopped;
-    const WindowError e = window_error(w, 0.0, static_cast<double>(w.size()), &target.plan());
-    covered += std::abs(e.e.mean - 1.0) <= e.err.covering_error;
+    const WindowError e =
+        window_error(w, 0.0, static_cast<double>(w.size()), done ? &target.plan() : nullptr);
+    const bool covered = std::abs(e.e.mean - 1.0) <= e.err.covering_error;
+    t.stopped += done;
+    (done ? covered_stopped : covered_unstopped) += covered;
   }
-  const double c = static_cast<double>(covered) / stopped;
-  std::printf("coverage, target stop, %s, goal %g slowest times: %.4f (%d of %d stopped)\n", name.c_str(),
-              goal, c, stopped, kSeries);
-  return c;
+  const int unstopped = kSeries - t.stopped;
+  t.coverage = static_cast<double>(covered_stopped + covered_unstopped) / kSeries;
+  t.stopped_coverage = static_cast<double>(covered_stopped) / std::max(t.stopped, 1);
+  t.unstopped_coverage = static_cast<double>(covered_unstopped) / std::max(unstopped, 1);
+  std::printf(
+      "coverage, target stop, %s, goal %g slowest times: %.4f over every series; %.4f over the %d "
+      "the target stopped, %.4f over the %d run to the end\n",
+      name.c_str(), goal, t.coverage, t.stopped_coverage, t.stopped, t.unstopped_coverage, unstopped);
+  return t;
 }
 
 }  // namespace
@@ -138,17 +155,19 @@ TEST(EarlyStopCoverage, TheErrorAtTheStopCoversTwoThirdsOnAr1AtThreeTargets) {
 
 // Settled on 10 000 series per family under the tau_int trigger and 4 batches at the first stage
 // (the test was disabled after 2 000 series gave 0.653 / 0.646 on two scales / oscillation at an
-// earlier state of the rules; on the merged rules 2 000 series give 0.653 / 0.679). The series
-// that never stop within 12x the goal (0.8 / 2.0 / 6.4 %) are left out of the figure. Two scales
-// sits 1 binomial error above the promise's 0.65.
+// earlier state of the rules; on the merged rules 2 000 series give 0.653 / 0.679). Every series
+// counts: 0.8 / 2.0 / 6.4 % never stop within 12x the goal and report their end's fixed-window
+// error, which covers 0.618 / 0.618 / 0.686 of them; over the stopped ones alone the figures were
+// 0.6761 / 0.6547 / 0.6834. Two scales sits 1 binomial error above the promise's 0.65.
 TEST(FamilyCoverage, ARunTheTargetStopsCoversTwoThirdsOnEveryFamily) {
   struct Figure {
     const char* family;
     double goal, settled;
   };
-  const Figure figures[] = {{"ar1", 300, 0.6761}, {"two_scales", 300, 0.6547}, {"oscillation", 300, 0.6834}};
+  const Figure figures[] = {{"ar1", 300, 0.6757}, {"two_scales", 300, 0.6540}, {"oscillation", 300, 0.6835}};
   std::uint64_t seed = 62000;
-  for (const auto& f : figures) expect_figure(target_coverage(f.family, f.goal, ++seed), f.settled, f.family);
+  for (const auto& f : figures)
+    expect_figure(target_coverage(f.family, f.goal, ++seed).coverage, f.settled, f.family);
 }
 
 namespace {
@@ -220,6 +239,32 @@ TEST(FamilyCoverage, AnAutomaticWindowCutsAStrongTransientToBelowHalfAStandardEr
     expect_figure(a.coverage, f.coverage, f.family);
     EXPECT_NEAR(a.unbiased, f.unbiased, kBand) << f.family;
     EXPECT_GE(a.unbiased, 0.9) << f.family;
+  }
+}
+
+// A transient of 1 standard error is where an automatic window stops keeping the promise: what it
+// does not see it does not cut, and what is not cut keeps its whole bias. No rule that cuts at most
+// 10 % of stationary series can see it in more series than the Neyman-Pearson bound (the matched
+// filter, knowing the family's covariance and the decay's shape; scripts/transient_power_bound.py:
+// 0.866 / 0.831 / 0.759 of AR(1) / two-scale / oscillating series at 50 slowest times, decay 5
+// slowest times; 0.800 / 0.729 / 0.583 at the 6.1 / 5.2 / 3.8 % of stationary series the
+// product's rule cuts); the bound reaches 0.9 only from a bias of 1.07 / 1.14 / 1.29 standard
+// errors. The product's rule, which knows neither, leaves the settled figures below unbiased (a
+// half to a quarter of the bound at its own rate) and covers 0.62-0.66 (docs/validation.md).
+TEST(FamilyCoverage, AWeakTransientIsSeenNoMoreOftenThanTheBestTestAllows) {
+  struct Figure {
+    const char* family;
+    double coverage, unbiased, bound;
+  };
+  const Figure figures[] = {{"ar1", 0.6638, 0.4647, 0.866},
+                            {"two_scales", 0.6228, 0.3465, 0.831},
+                            {"oscillation", 0.6454, 0.1559, 0.759}};
+  std::uint64_t seed = 66000;
+  for (const auto& f : figures) {
+    const AutoFigures a = auto_window_figures(f.family, 50.0, 1.0, ++seed);
+    EXPECT_NEAR(a.coverage, f.coverage, kBand) << f.family;
+    EXPECT_NEAR(a.unbiased, f.unbiased, kBand) << f.family;
+    EXPECT_LE(a.unbiased, f.bound + kBand) << f.family;
   }
 }
 
