@@ -247,7 +247,7 @@ TEST(FamilyCoverage, AnAutomaticWindowCutsAStrongTransientToBelowHalfAStandardEr
 // 10 % of stationary series can see it in more series than the Neyman-Pearson bound (the matched
 // filter, knowing the family's covariance and the decay's shape; scripts/transient_power_bound.py:
 // 0.866 / 0.831 / 0.759 of AR(1) / two-scale / oscillating series at 50 slowest times, decay 5
-// slowest times; 0.800 / 0.729 / 0.583 at the 6.1 / 5.2 / 3.8 % of stationary series the
+// slowest times; 0.800 / 0.731 / 0.583 at the 6.1 / 5.2 / 3.8 % of stationary series the
 // product's rule cuts); the bound reaches 0.9 only from a bias of 1.07 / 1.14 / 1.29 standard
 // errors. The product's rule, which knows neither, leaves the settled figures below unbiased (a
 // half to a quarter of the bound at its own rate) and covers 0.62-0.66 (docs/validation.md).
