@@ -12,12 +12,14 @@
 //   highest is uncertain too), the 15.9 and 84.1 percentiles of the draws' vertices; the value's
 //   interval moved down by the draws' mean bias (the highest of noisy values exceeds the true
 //   maximum, and draws of noisy values plus noise more so);
-// - the model's error, added in quadrature on each side: half the larger distance from the
-//   parabola's vertex to that of the weighted quadratic through five points and to that of a
-//   Gaussian (a parabola through the logarithms) through the three.
+// - the model's error, added in quadrature on each side: the part of the disagreement between
+//   the parabola's vertex and those of the weighted quadratic through five points and of a
+//   Gaussian (a parabola through the logarithms) through the three that the points' noise does
+//   not explain (half the distance, less its scatter over draws of the points, in quadrature).
 // Coverage over noisy synthetic curves, one family at a time, after the refinement
-// (tests/unit/test_peak_coverage.cpp, docs/validation.md "Peaks"): 0.70 on skewed peaks, 0.74 on symmetric
-// ones (the model term errs on the safe side there). Why not a Gaussian process or a spline: with
+// (tests/unit/test_peak_coverage.cpp, docs/validation.md "Peaks"): position / value 0.708 / 0.716
+// on symmetric peaks, 0.682 / 0.680 on skewed ones (the half-distance alone, with the noise in it
+// counted twice: 0.737 / 0.738 and 0.697 / 0.706). Why not a Gaussian process or a spline: with
 // 5-15 points per curve they need a length scale the data cannot fix, and their intervals depend
 // on it; the parabola's assumption is local and the coverage tests check it.
 // The draws come from a generator of our own (SplitMix64 and Box-Muller), so the same points give
