@@ -59,6 +59,29 @@ double reached_s(const fs::path& runs_root, const StudyCase& c) {
   return std::clamp(simulated_time_s(runs_root / c.id), 0.0, c.params.time.end_s);
 }
 
+/// What a case has left to run: from where its run folder stands, at the fluid step its run
+/// takes now (its last row's dt_s) where the CFL limit or the packed-bed limit
+/// (numerics.drag_dt_limit) has cut time.dt_cfd: a 10 cP bed packs and steps at 0.13-0.3 ms
+/// where dt_cfd is 1 ms, so its rest costs several times the planned steps'. The DEM step is
+/// not cut; the fluid's cost per cell-step is taken as the model's.
+struct Rest {
+  double reached_s = 0.0;
+  double fluid_step_s = 0.0;  ///< the step the rest is costed at, s
+  CaseWork work;
+};
+Rest rest_of(const fs::path& runs_root, const StudyCase& c) {
+  Rest r;
+  r.reached_s = reached_s(runs_root, c);
+  r.work = work_of(c, r.reached_s);
+  r.fluid_step_s = c.params.time.dt_cfd_s;
+  const double now_s = r.reached_s > 0.0 ? last_row_value(runs_root / c.id, "dt_s") : 0.0;
+  if (now_s > 0.0 && now_s < r.fluid_step_s) {
+    r.work.fluid_cell_steps *= r.fluid_step_s / now_s;
+    r.fluid_step_s = now_s;
+  }
+  return r;
+}
+
 std::string swept_text(const StudyCase& c) {
   std::string s;
   for (const auto& [k, v] : c.swept) s += (s.empty() ? "" : " ") + k + "=" + readable_value(v);
@@ -76,7 +99,7 @@ PlanEstimate plan_estimate(Database& db, const Study& study, const std::vector<s
   std::map<std::string, bool> scenes;
   for (const auto& id : to_run_ids)
     if (const auto it = by_id.find(id); it != by_id.end()) {
-      costs.push_back(model.core_s(work_of(*it->second, reached_s(runs_root, *it->second))));
+      costs.push_back(model.core_s(rest_of(runs_root, *it->second).work));
       scenes[it->second->params.scene] = true;
     }
   std::string basis;
@@ -118,15 +141,17 @@ PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<st
     const double est = model.core_s(work_of(c));
     out.total_core_s += est;
     // A case that has run part of its time needs only the rest.
-    const double reached = st == CaseStatus::kDone ? 0.0 : reached_s(root, c);
-    const double left = st == CaseStatus::kDone ? 0.0
-                        : reached > 0.0         ? model.core_s(work_of(c, reached))
-                                                : est;
+    const Rest rest = st == CaseStatus::kDone ? Rest{} : rest_of(root, c);
+    const double reached = rest.reached_s;
+    const double left = st == CaseStatus::kDone ? 0.0 : reached > 0.0 ? model.core_s(rest.work) : est;
     if (st != CaseStatus::kDone) out.pending_costs.push_back(left);
+    // The step the rest is costed at, where the run's own step is below time.dt_cfd.
+    const bool cut_step = reached > 0.0 && rest.fluid_step_s < c.params.time.dt_cfd_s;
     nlohmann::json row = {
         {"group", c.group},         {"swept", swept_text(c)},  {"case_id", c.id},
         {"state", to_string(st)},   {"estimated_core_s", est}, {"reached_s", reached},
         {"remaining_core_s", left}, {"scene", c.params.scene}, {"cost_basis", model.basis(c.params.scene)}};
+    if (cut_step) row["remaining_fluid_step_s"] = rest.fluid_step_s;
     const auto m = measured_by_id.find(c.id);
     if (m != measured_by_id.end()) row["measured_core_s"] = m->second->core_s;
     if (opt.check_model && m != measured_by_id.end()) {
@@ -138,8 +163,11 @@ PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<st
     }
     std::vector<std::string> cells{
         c.group, swept_text(c), c.id, to_string(st),
-        reached > 0.0 ? fmt::format("{} ({} left from t = {:g} s)", duration(est), duration(left), reached)
-                      : duration(est)};
+        reached > 0.0
+            ? fmt::format("{} ({} left from t = {:g} s{})", duration(est), duration(left), reached,
+                          cut_step ? fmt::format(" at its step of {:.3g} ms", 1e3 * rest.fluid_step_s)
+                                   : std::string())
+            : duration(est)};
     if (opt.check_model)
       cells.push_back(row.contains("predicted_by_others_core_s")
                           ? fmt::format("measured {}, from the others {}", duration(m->second->core_s),
@@ -153,11 +181,17 @@ PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<st
 
 /// The rows with their numbers in seconds (the table shows them for people).
 std::string plan_csv(const nlohmann::json& rows) {
-  const char* cols[] = {"group",           "swept",
-                        "case_id",         "state",
-                        "scene",           "estimated_core_s",
-                        "reached_s",       "remaining_core_s",
-                        "measured_core_s", "predicted_by_others_core_s",
+  const char* cols[] = {"group",
+                        "swept",
+                        "case_id",
+                        "state",
+                        "scene",
+                        "estimated_core_s",
+                        "reached_s",
+                        "remaining_core_s",
+                        "remaining_fluid_step_s",
+                        "measured_core_s",
+                        "predicted_by_others_core_s",
                         "cost_basis"};
   std::string out;
   for (const char* c : cols) out += fmt::format("{}{}", out.empty() ? "" : ",", c);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <utility>
 
 #include <fmt/format.h>
@@ -30,21 +31,56 @@ std::string eta_text(double s) {
   return fmt::format("{}s", v);
 }
 
-double simulated_time_s(const fs::path& run_dir) {
-  std::ifstream in(run_dir / "timeseries.csv", std::ios::ate);
-  if (!in) return 0.0;
+namespace {
+/// The last non-empty line of a file, read from its end (a run's series grows to megabytes).
+std::string last_line(const fs::path& file) {
+  std::ifstream in(file, std::ios::ate);
+  if (!in) return {};
   const auto size = static_cast<std::streamoff>(in.tellg());
   const std::streamoff back = std::min<std::streamoff>(size, 4096);
   in.seekg(size - back);
   std::string chunk(static_cast<std::size_t>(back), '\0');
   in.read(chunk.data(), back);
   auto end = chunk.find_last_not_of("\n\r ");
-  if (end == std::string::npos) return 0.0;
+  if (end == std::string::npos) return {};
   const auto begin = chunk.rfind('\n', end);
-  const std::string line = chunk.substr(begin == std::string::npos ? 0 : begin + 1, end + 1);
+  return chunk.substr(begin == std::string::npos ? 0 : begin + 1, end + 1);
+}
+}  // namespace
+
+double simulated_time_s(const fs::path& run_dir) {
+  const std::string line = last_line(run_dir / "timeseries.csv");
   char* stop = nullptr;
   const double t = std::strtod(line.c_str(), &stop);
   return stop == line.c_str() ? 0.0 : t;
+}
+
+double last_row_value(const fs::path& run_dir, const std::string& column) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::ifstream in(run_dir / "timeseries.csv");
+  std::string header;
+  if (!in || !std::getline(in, header)) return nan;
+  if (!header.empty() && header.back() == '\r') header.pop_back();
+  int index = -1, k = 0;
+  for (std::size_t from = 0;; ++k) {
+    const auto comma = header.find(',', from);
+    if (header.substr(from, comma == std::string::npos ? std::string::npos : comma - from) == column)
+      index = k;
+    if (comma == std::string::npos) break;
+    from = comma + 1;
+  }
+  if (index < 0) return nan;
+  const std::string line = last_line(run_dir / "timeseries.csv");
+  if (line == header) return nan;
+  std::size_t from = 0;
+  for (int i = 0; i < index; ++i) {
+    from = line.find(',', from);
+    if (from == std::string::npos) return nan;
+    ++from;
+  }
+  char* stop = nullptr;
+  const double v = std::strtod(line.c_str() + from, &stop);
+  return stop == line.c_str() + from ? nan : v;
 }
 
 ProgressDisplay::ProgressDisplay(std::string study, int jobs, bool live, double plain_every_s)

@@ -21,6 +21,9 @@ std::string count_of(long long n, const std::string& noun);
 /// Simulated time of a running case: first column of the last line of <run_dir>/timeseries.csv;
 /// 0 before the solver wrote one.
 double simulated_time_s(const std::filesystem::path& run_dir);
+/// The value in the column named `column` of the last line of <run_dir>/timeseries.csv (its
+/// header names the columns); NaN where the file, the column or a number there is missing.
+double last_row_value(const std::filesystem::path& run_dir, const std::string& column);
 
 /// What the counts line shows.
 struct ProgressCounts {

@@ -72,6 +72,10 @@ MeasuredCost measured_cost(const std::string& case_id, const std::string& params
     // A branch started from its parent's time: only its own interval was paid for.
     const double from = s.contains("parent") ? s["parent"].value("time_s", 0.0) : 0.0;
     m.work = case_work(p, from, t);
+    // The fluid steps it took, where the CFL or the packed-bed limit cut time.dt_cfd: the work
+    // done, not the work planned (a branch's count includes its parent's steps: planned there).
+    const double dt_cfd = num(p, "time", "dt_cfd", 0.0), steps = s.value("cfd_steps", 0.0);
+    if (!s.contains("parent") && dt_cfd > 0 && steps > 0) m.work.fluid_cell_steps *= steps / (t / dt_cfd);
     // One attempt from the start: its CPU time (steadier on a shared machine); a resumed run's
     // earlier attempts are only in its wall time.
     const bool one_attempt = !s.value("resumed_from_checkpoint", false);
@@ -94,7 +98,26 @@ CostModel::CostModel(const std::vector<MeasuredCost>& finished) {
     // Relative least squares: sum over runs of ((prediction - measured) / measured)^2. A term
     // whose coefficient comes out negative (or that no run exercises) is dropped and the rest
     // refitted; the start-up term is dropped last.
-    std::array<bool, 3> use = {true, true, true};
+    // Runs whose fluid and particle work stand in one proportion (one box, one particle count,
+    // the time varied: a campaign's angles) cannot tell the two costs apart, and a free fit puts
+    // all of it on one term: a case whose fluid step is later cut would then cost nothing more.
+    // Such runs fit one scale on the defaults' split between particles and fluid instead.
+    double lo = 0.0, hi = 0.0;
+    for (const auto* m : ms) {
+      if (!(m->work.particle_steps > 0 && m->work.fluid_cell_steps > 0)) {
+        lo = hi = 0.0;
+        break;
+      }
+      const double r = m->work.fluid_cell_steps / m->work.particle_steps;
+      lo = lo > 0 ? std::min(lo, r) : r, hi = std::max(hi, r);
+    }
+    c.one_proportion = lo > 0 && hi < kSeparatingSpread * lo;
+    const auto features = [&](const CaseWork& w) -> std::array<double, 3> {
+      if (c.one_proportion)
+        return {1.0, kParticleStepS * w.particle_steps + kCellStepS * w.fluid_cell_steps, 0.0};
+      return {1.0, w.particle_steps, w.fluid_cell_steps};
+    };
+    std::array<bool, 3> use = {true, true, !c.one_proportion};
     bool fitted = false;
     for (int tries = 0; tries < 3 && ms.size() >= 3 && !fitted; ++tries) {
       std::vector<int> idx;
@@ -104,7 +127,7 @@ CostModel::CostModel(const std::vector<MeasuredCost>& finished) {
       std::array<std::array<double, 3>, 3> a{};
       std::array<double, 3> b{}, x{};
       for (const auto* m : ms) {
-        const std::array<double, 3> f = {1.0, m->work.particle_steps, m->work.fluid_cell_steps};
+        const std::array<double, 3> f = features(m->work);
         const double w = 1.0 / (m->core_s * m->core_s);
         for (int r = 0; r < n; ++r) {
           for (int q = 0; q < n; ++q) a[r][q] += w * f[idx[r]] * f[idx[q]];
@@ -129,6 +152,8 @@ CostModel::CostModel(const std::vector<MeasuredCost>& finished) {
       std::array<double, 3> coef = {0.0, 0.0, 0.0};
       for (int r = 0; r < n; ++r) coef[idx[r]] = x[r];
       c.start_s = coef[0], c.particle_step_s = coef[1], c.cell_step_s = coef[2];
+      if (c.one_proportion)
+        c.particle_step_s = coef[1] * kParticleStepS, c.cell_step_s = coef[1] * kCellStepS;
       fitted = true;
     }
     if (!fitted) {
@@ -152,7 +177,10 @@ double CostModel::core_s(const CaseWork& w) const {
 std::string CostModel::basis(const std::string& scene) const {
   const auto it = by_scene_.find(scene);
   if (it == by_scene_.end()) return "default";
-  return (it->second.fitted ? "fit to " : "default scaled by ") + std::to_string(it->second.runs) + " runs";
+  return (it->second.fitted ? "fit to " : "default scaled by ") + std::to_string(it->second.runs) + " runs" +
+         (it->second.fitted && it->second.one_proportion
+              ? " (their particle and fluid work in one proportion: split as the defaults)"
+              : "");
 }
 
 double ranks_efficiency(int ranks) {

@@ -1,7 +1,8 @@
 #pragma once
 // What a case costs, for `study plan` and the estimate `study run` prints before it starts. Per
 // scene, core-seconds = a + b * particle-steps + c * fluid cell-steps, fitted to the finished runs
-// of the database (relative least squares, terms that would be negative dropped); with fewer than
+// of the database (relative least squares, terms that would be negative dropped; runs whose two
+// kinds of work stand in one proportion fit a and one scale of the defaults' b : c); with fewer than
 // three finished runs of a scene, the default coefficients below, scaled by the mean ratio of
 // the measured to the predicted cost of those there are.
 #include <map>
@@ -20,8 +21,8 @@ struct CaseWork {
 };
 CaseWork case_work(const nlohmann::json& params, double from_s, double to_s);
 
-/// One finished run: its work and what it cost in core-seconds (the CPU time of a run done in
-/// one attempt, else wall time x ranks).
+/// One finished run: its work (its fluid cell-steps at the steps it took, `cfd_steps`) and what
+/// it cost in core-seconds (the CPU time of a run done in one attempt, else wall time x ranks).
 struct MeasuredCost {
   std::string case_id;
   CaseWork work;
@@ -42,6 +43,9 @@ class CostModel {
   /// is then predicted within 1.5x. The cost per particle-step grows with the box (cache) and
   /// with the sliding bed's contacts, which a model linear in the work cannot follow further.
   static constexpr double kStartS = 2.0, kParticleStepS = 76e-9, kCellStepS = 1.35e-6;
+  /// Runs whose fluid-to-particle work ratios all lie within this factor fit one scale on the
+  /// defaults' split instead of the two costs apart (they cannot separate them).
+  static constexpr double kSeparatingSpread = 1.5;
 
   explicit CostModel(const std::vector<MeasuredCost>& finished);
   /// Core-seconds of this work.
@@ -54,6 +58,7 @@ class CostModel {
     double start_s = kStartS, particle_step_s = kParticleStepS, cell_step_s = kCellStepS;
     int runs = 0;
     bool fitted = false;
+    bool one_proportion = false;  ///< fitted as one scale on the defaults' split
   };
   std::map<std::string, Coefficients> by_scene_;
 };

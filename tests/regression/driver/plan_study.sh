@@ -3,7 +3,7 @@
 # study ran, each finished case's cost (its CPU time) predicted by the model fitted to the other
 # five (leave one out) is within 30 % of its measured cost in at least one of two identical
 # studies; a case that has run part of its time counts only the rest (all of it in a scene that
-# keeps no checkpoints: its rerun starts over); swept numbers are shown as
+# keeps no checkpoints: its rerun starts over), at the fluid step it takes now; swept numbers are shown as
 # written; bad --jobs exits 2; `study run` prints
 # the plan line before it starts and writes the tree of readable names beside the run folders.
 #   plan_study.sh BOYCOTT_BIN STUDY.toml
@@ -43,7 +43,26 @@ assert part["estimated_wall_s"] < fresh["estimated_wall_s"], (part["estimated_wa
 for a, b in zip(fresh["cases"][1:], part["cases"][1:]):
     assert a["remaining_core_s"] == b["remaining_core_s"] == a["estimated_core_s"], (a, b)
 PY
-grep -q 'left from t = 0.225 s' "$work/plan_part.txt" || { cat "$work/plan_part.txt"; exit 1; }
+grep -q 'left from t = 0.225 s)' "$work/plan_part.txt" || { cat "$work/plan_part.txt"; exit 1; }
+# A run whose fluid step has been cut (the CFL or the packed-bed limit: its last row's dt_s below
+# time.dt_cfd, 1 ms here) costs its rest at that step: the rest's fluid cell-steps grow as
+# dt_cfd / dt_s, its particle steps (at dt_dem, never cut) stay; a dt_s at dt_cfd changes nothing.
+for dt in 0.001 0.0005 0.000333333333333; do
+  printf 'time_s,mean_wp_m_s,dt_s\n0.15,-0.01,0.001\n0.225,-0.01,%s\n' "$dt" > "$db.runs/$first/timeseries.csv"
+  "$bin" study plan "$study" --db "$db" --format json > "$work/plan_dt$dt.json"
+done
+"$bin" study plan "$study" --db "$db" > "$work/plan_cut.txt"
+grep -q 'left from t = 0.225 s at its step of 0.333 ms)' "$work/plan_cut.txt" || { cat "$work/plan_cut.txt"; exit 1; }
+python3 - "$work/plan_part.json" "$work/plan_dt0.001.json" "$work/plan_dt0.0005.json" \
+  "$work/plan_dt0.000333333333333.json" <<'PY'
+import json, sys
+part, r1, r2, r3 = (json.load(open(f))["cases"][0] for f in sys.argv[1:])
+assert r1["remaining_core_s"] == part["remaining_core_s"] and "remaining_fluid_step_s" not in r1, (part, r1)
+assert r2["remaining_fluid_step_s"] == 0.0005, r2
+# At dt_cfd / 2 one more rest's worth of fluid stepping, at dt_cfd / 3 two more.
+fluid = r2["remaining_core_s"] - r1["remaining_core_s"]
+assert fluid > 0 and abs((r3["remaining_core_s"] - r1["remaining_core_s"]) / fluid - 2.0) < 1e-6, (r1, r2, r3)
+PY
 rm -rf "$db.runs"
 # A scene that keeps no checkpoints (dem_only) starts over: its time series does not count.
 printf 'name = "plan_restart"\n[base]\nscene = "dem_only"\n[base.domain]\nlength_x = 0.01\nheight_z = 0.01\n[base.time]\nend = 0.3\naverage_from = 0.05\n' \

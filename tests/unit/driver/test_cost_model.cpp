@@ -79,12 +79,59 @@ TEST(CostModel, ScenesAreFittedApart) {
   EXPECT_NEAR(model.core_s(a), 2.0 * model.core_s(b), 1e-9 * model.core_s(a));
 }
 
+// A campaign's angles in one box: every run's fluid work a fixed multiple of its particle work,
+// so the runs cannot tell the two costs apart. Costs made exactly as 5 s + 3x the defaults' split:
+// the fit recovers it, and a case whose fluid step is cut (twice the cell-steps) costs more by
+// 3x the defaults' fluid term, where a free fit would have put everything on one term.
+TEST(CostModel, RunsInOneProportionOfFluidToParticleWorkKeepTheDefaultSplit) {
+  const auto cost = [](double ps, double cs) {
+    return 5.0 + 3.0 * (CostModel::kParticleStepS * ps + CostModel::kCellStepS * cs);
+  };
+  std::vector<MeasuredCost> runs;
+  for (double ps : {1e9, 2e9, 4e9, 8e9}) runs.push_back(run(ps, 0.02 * ps, cost(ps, 0.02 * ps)));
+  const CostModel model(runs);
+  EXPECT_EQ(model.basis("s"),
+            "fit to 4 runs (their particle and fluid work in one proportion: split as the defaults)");
+  const CaseWork planned{"s", 3e9, 6e7}, cut{"s", 3e9, 1.2e8};
+  EXPECT_NEAR(model.core_s(planned), cost(3e9, 6e7), 1e-9 * cost(3e9, 6e7));
+  EXPECT_NEAR(model.core_s(cut) - model.core_s(planned), 3.0 * CostModel::kCellStepS * 6e7, 1e-6);
+  // The same runs with one whose proportion differs by just over the separating spread are fitted
+  // apart.
+  const double wider = 0.02 * 1.01 * CostModel::kSeparatingSpread * 1e9;
+  runs.push_back(run(1e9, wider, cost(1e9, wider)));
+  EXPECT_EQ(CostModel(runs).basis("s"), "fit to 5 runs");
+}
+
 TEST(CostModel, StudyWallTimePlacesTheLongestCasesFirstOnTheSlotThatFreesFirst) {
   // 6, 5, 4, 3 core-s on two single-core slots: {6, 3} and {5, 4} end at 9.
   EXPECT_DOUBLE_EQ(study_wall_s({3.0, 4.0, 5.0, 6.0}, 2, 1), 9.0);
   EXPECT_DOUBLE_EQ(study_wall_s({3.0, 4.0, 5.0, 6.0}, 1, 1), 18.0);
   // Two ranks per case at efficiency 0.9: 18 core-s over 2 * 0.9 cores.
   EXPECT_DOUBLE_EQ(study_wall_s({3.0, 4.0, 5.0, 6.0}, 1, 2), 18.0 / 1.8);
+}
+
+// A run whose fluid step was cut (the CFL or the packed-bed limit) did more fluid work than its
+// time over dt_cfd: it is fitted against the steps it took. A branch's count includes its
+// parent's steps, so there the planned work over its own interval stays.
+TEST(CostModel, AFinishedRunIsFittedAgainstTheFluidStepsItTook) {
+  const std::string params =
+      R"({"scene": "inclined_settling", "particles": {"count": 100}, "domain": {"cells": [10, 2, 5]},
+          "time": {"dt_cfd": 0.001, "dt_dem": 0.00002}})";
+  bool ok = false;
+  const auto planned = measured_cost("a", params, R"({"wall_time_s": 10, "simulated_time_s": 2})", &ok);
+  ASSERT_TRUE(ok);
+  EXPECT_NEAR(planned.work.fluid_cell_steps, 100.0 * 2000, 1e-6);
+  EXPECT_NEAR(planned.work.particle_steps, 100.0 * 2 / 0.00002, 1e-3);
+  const auto cut =
+      measured_cost("b", params, R"({"wall_time_s": 10, "simulated_time_s": 2, "cfd_steps": 7000})", &ok);
+  ASSERT_TRUE(ok);
+  EXPECT_NEAR(cut.work.fluid_cell_steps, 100.0 * 7000, 1e-6);
+  EXPECT_NEAR(cut.work.particle_steps, planned.work.particle_steps, 1e-3);
+  const auto branch = measured_cost(
+      "c", params,
+      R"({"wall_time_s": 10, "simulated_time_s": 2, "cfd_steps": 7000, "parent": {"time_s": 1}})", &ok);
+  ASSERT_TRUE(ok);
+  EXPECT_NEAR(branch.work.fluid_cell_steps, 100.0 * 1000, 1e-6);
 }
 
 }  // namespace
