@@ -54,23 +54,29 @@ inline LiftLaw lift_law_from_name(const std::string& s) {
 }
 
 /// Mei's (1992) ratio of the finite-Re lift to Saffman's; re_p > 0, re_w >= 0.
+namespace mei {
+/// Mei's fit below Re_p = 40, at beta = Re_w / (2 Re_p); it tends to 0.3314 beta^1/2.
+inline double low_branch(double re_p, double beta) {
+  const double a = 0.3314 * std::sqrt(beta);
+  return (1.0 - a) * std::exp(-0.1 * re_p) + a;
+}
+/// Mei's fit above Re_p = 40.
+inline double high_branch(double re_p, double beta) {
+  return 0.0524 * std::sqrt(beta * re_p);
+}
+}  // namespace mei
+
 inline double mei_lift_factor(double re_p, double re_w) {
   const double beta = 0.5 * re_w / re_p;
-  if (re_p <= 40.0) {
-    const double a = 0.3314 * std::sqrt(beta);
-    return (1.0 - a) * std::exp(-0.1 * re_p) + a;
-  }
-  return 0.0524 * std::sqrt(beta * re_p);
+  return re_p <= 40.0 ? mei::low_branch(re_p, beta) : mei::high_branch(re_p, beta);
 }
 
 /// Mei's ratio with its jump at Re_p = 40 bridged (saffman_mei_continuous): the low branch until
 /// the high branch rises above it; re_p > 0, re_w >= 0.
 inline double mei_continuous_lift_factor(double re_p, double re_w) {
   const double beta = 0.5 * re_w / re_p;
-  const double a = 0.3314 * std::sqrt(beta);
-  const double low = (1.0 - a) * std::exp(-0.1 * re_p) + a;
-  if (re_p <= 40.0) return low;
-  return std::max(low, 0.0524 * std::sqrt(beta * re_p));
+  const double low = mei::low_branch(re_p, beta);
+  return re_p <= 40.0 ? low : std::max(low, mei::high_branch(re_p, beta));
 }
 
 /// McLaughlin's (1991) J(epsilon) as a table over log10 epsilon = -1.6 (epsilon 0.0251) to 2
