@@ -3,7 +3,8 @@
 # database): each docs/results/runs/<case_id>/summary.json becomes the summary.json of a run folder,
 # `study collect` records them in a scratch database, and `query curve` writes the CSV and the plots.
 #   scripts/results_from_summaries.sh [BOYCOTT_BIN]
-# Writes docs/results/paper_base_full.csv and docs/plots/paper_base_full.{png,pdf}.
+# Writes docs/results/paper_base_full.csv, each group's peak (query peak) to
+# docs/results/paper_base_full_peaks.csv and docs/plots/paper_base_full.{png,pdf}.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${1:-$root/build/driver/boycott}
@@ -16,8 +17,11 @@ for f in "$root"/docs/results/runs/*/summary.json; do
 done
 "$bin" study collect "$root/studies/paper_base_full.toml" --db "$work/full.db" > /dev/null
 "$bin" query curve --db "$work/full.db" --study paper_base_full --format csv > "$root/docs/results/paper_base_full.csv"
+"$bin" query peak --db "$work/full.db" --study paper_base_full --format csv \
+  > "$root/docs/results/paper_base_full_peaks.csv"
 for ext in png pdf; do
   "$bin" query curve --db "$work/full.db" --study paper_base_full --overlay-paper \
     --plot "$root/docs/plots/paper_base_full.$ext" > /dev/null
 done
 "$bin" query curve --db "$work/full.db" --study paper_base_full
+"$bin" query peak --db "$work/full.db" --study paper_base_full
