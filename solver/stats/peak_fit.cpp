@@ -188,8 +188,9 @@ std::vector<Vertex> model_deviations(const std::vector<PeakPoint>& p, const std:
 /// curve where all are exact (a symmetric peak); the observed half-distance D then has E[D^2] =
 /// D_true^2 + var(D), with var(D) measured over draws of the points within their errors (from the
 /// draws' 15.9-84.1 percentile range, which a change of the top point in a few draws does not
-/// blow up; a quarter of the intervals' draws: the percentiles' own scatter, ~8 %, matters little
-/// beside D). The model error is sqrt(max(0, D^2 - var(D))), the larger over the two estimators.
+/// blow up; a quarter as many draws as the intervals take, from a stream of their own (seed + 1):
+/// the percentiles' own scatter, ~8 %, matters little beside D). The model error is
+/// sqrt(max(0, D^2 - var(D))), the larger over the two estimators.
 Vertex model_spread(const std::vector<PeakPoint>& p, const std::vector<double>& y, const Vertex& v,
                     const PeakFitOptions& options) {
   Vertex spread;
