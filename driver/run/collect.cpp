@@ -120,8 +120,9 @@ std::optional<nlohmann::json> finished_summary(const std::string& case_id, const
 
 }  // namespace
 
-bool finished_summary_in(const fs::path& dir, const std::string& case_id) {
-  return finished_summary(case_id, dir).has_value();
+bool collectable_summary_in(Database& db, const fs::path& dir, const std::string& case_id) {
+  const auto s = finished_summary(case_id, dir);
+  return s && summary_reaches_end(db, case_id, s->dump());
 }
 
 void prepare_study_database(Database& db, const Study& study, const fs::path& runs_root) {

@@ -33,8 +33,10 @@ CollectResult collect_run_folders(Database& db, const Study& study, const std::f
 /// scheme migrated (run folders renamed), the study registered.
 void prepare_study_database(Database& db, const Study& study, const std::filesystem::path& runs_root);
 
-/// Whether <dir>/summary.json is a finished run (completed or converged) of case_id.
-bool finished_summary_in(const std::filesystem::path& dir, const std::string& case_id);
+/// Whether <dir>/summary.json is what `study collect` would record: a finished run (completed or
+/// converged) of case_id that reaches the case's time.end (a run finished at an end since raised
+/// is continued by `study run`, not collected).
+bool collectable_summary_in(Database& db, const std::filesystem::path& dir, const std::string& case_id);
 
 /// `boycott study collect STUDY.toml --db FILE`: exit 0, or 2 on a bad study or database.
 int study_collect(const std::string& study_file, const std::string& db_path, int retries);

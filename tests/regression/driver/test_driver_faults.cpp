@@ -257,6 +257,24 @@ fs::path fake_study_db(const TempDir& d) {
 
 }  // namespace
 
+// A finished run whose case's time.end has since been raised (time.end is not part of the id) is
+// continued by `study run`, not recorded by `study collect`: `study status` must not send the user
+// to collect it.
+TEST(StudyStatus, ARunFinishedAtAnEndSinceRaisedIsNotListedAsUncollected) {
+  TempDir d;
+  const auto db = fake_study_db(d);
+  auto study = std::string(kTwo);
+  study.replace(study.find("end = 0.3"), 9, "end = 0.6");
+  write(d.path / "s.toml", study);
+  // `study collect` registers the raised end and records nothing.
+  const auto c = run({"study", "collect", (d.path / "s.toml").string(), "--db", db.string()}, d.path);
+  ASSERT_EQ(c.rc, 0) << c.err;
+  const auto r = run({"study", "status", (d.path / "s.toml").string(), "--db", db.string()}, d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_NE(r.out.find("2 cases: 0 done"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("not recorded yet"), std::string::npos) << r.out;
+}
+
 TEST(Queries, ReadOnlyDatabaseIsQueriedWithoutWritingToIt) {
   TempDir d;
   const auto db = fake_study_db(d);
