@@ -214,7 +214,7 @@ TEST(FamilyCoverage, AnAutomaticWindowCutsFewStationarySeriesAndItsErrorCovers) 
     const char* family;
     double settled;
   };
-  const Figure figures[] = {{"ar1", 0.6836}, {"two_scales", 0.6576}, {"oscillation", 0.6929}};
+  const Figure figures[] = {{"ar1", 0.6810}, {"two_scales", 0.6529}, {"oscillation", 0.6915}};
   std::uint64_t seed = 63000;
   for (const auto& f : figures) {
     const AutoFigures a = auto_window_figures(f.family, 50.0, 0.0, ++seed);
@@ -228,11 +228,13 @@ TEST(FamilyCoverage, AnAutomaticWindowCutsAStrongTransientToBelowHalfAStandardEr
     const char* family;
     double coverage, unbiased;
   };
-  // Settled with the fitted decay's guard (transient.hpp); before it the two-scale and oscillating
-  // families were cut too early: unbiased 0.33 and 0.17, coverage 0.63 and 0.62. The oscillation's
-  // ceiling is the share of its series whose transient is seen at all (0.933 cut).
+  // Settled with the fitted decay's guard, which also detects a decay that no single segment shows
+  // (transient.hpp). Before the guard the two-scale and oscillating families were cut too early:
+  // unbiased 0.33 and 0.17, coverage 0.63 and 0.62; with the guard but detection by segments
+  // alone the oscillation's transient went unseen in 6.7 % of series (0.904 unbiased, 0.672
+  // covered), now in 1.1 %.
   const Figure figures[] = {
-      {"ar1", 0.6926, 0.9991}, {"two_scales", 0.6565, 0.9834}, {"oscillation", 0.6717, 0.9044}};
+      {"ar1", 0.6926, 0.9994}, {"two_scales", 0.6569, 0.9847}, {"oscillation", 0.6847, 0.9603}};
   std::uint64_t seed = 64000;
   for (const auto& f : figures) {
     const AutoFigures a = auto_window_figures(f.family, 50.0, 3.0, ++seed);
@@ -247,18 +249,19 @@ TEST(FamilyCoverage, AnAutomaticWindowCutsAStrongTransientToBelowHalfAStandardEr
 // 10 % of stationary series can see it in more series than the Neyman-Pearson bound (the matched
 // filter, knowing the family's covariance and the decay's shape; scripts/transient_power_bound.py:
 // 0.866 / 0.831 / 0.759 of AR(1) / two-scale / oscillating series at 50 slowest times, decay 5
-// slowest times; 0.800 / 0.731 / 0.583 at the 6.1 / 5.2 / 3.8 % of stationary series the
+// slowest times; 0.852 / 0.787 / 0.599 at the 9.0 / 7.4 / 4.2 % of stationary series the
 // product's rule cuts); the bound reaches 0.9 only from a bias of 1.07 / 1.14 / 1.29 standard
-// errors. The product's rule, which knows neither, leaves the settled figures below unbiased (a
-// half to a quarter of the bound at its own rate) and covers 0.62-0.66 (docs/validation.md).
+// errors. The product's rule, which knows neither, leaves the settled figures below unbiased
+// (0.71 / 0.62 / 0.35 of the bound at its own rates; 0.58 / 0.47 / 0.27 when only a single
+// segment's failure detected a transient) and covers 0.63-0.68 (docs/validation.md).
 TEST(FamilyCoverage, AWeakTransientIsSeenNoMoreOftenThanTheBestTestAllows) {
   struct Figure {
     const char* family;
     double coverage, unbiased, bound;
   };
-  const Figure figures[] = {{"ar1", 0.6638, 0.4647, 0.866},
-                            {"two_scales", 0.6228, 0.3465, 0.831},
-                            {"oscillation", 0.6454, 0.1559, 0.759}};
+  const Figure figures[] = {{"ar1", 0.6783, 0.6085, 0.866},
+                            {"two_scales", 0.6299, 0.4856, 0.831},
+                            {"oscillation", 0.6423, 0.2116, 0.759}};
   std::uint64_t seed = 66000;
   for (const auto& f : figures) {
     const AutoFigures a = auto_window_figures(f.family, 50.0, 1.0, ++seed);
