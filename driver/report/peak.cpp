@@ -1,5 +1,8 @@
 #include "driver/report/peak.hpp"
 
+#include <cmath>
+#include <optional>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -8,6 +11,11 @@
 namespace boycott::driver {
 namespace {
 
+/// A number, or nothing where it is not known (NaN: an angle's interval from too few points).
+std::optional<double> known(double v) {
+  return std::isfinite(v) ? std::optional<double>(v) : std::nullopt;
+}
+
 nlohmann::json json_of(const PeakRow& r) {
   const auto opt = [](const std::optional<double>& v) {
     return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
@@ -15,9 +23,9 @@ nlohmann::json json_of(const PeakRow& r) {
   return {{"group", r.group},
           {"setting", r.setting},
           {"angle_deg", r.peak.x},
-          {"angle_err_deg", r.peak.x_error()},
-          {"angle_low_deg", r.peak.x_low},
-          {"angle_high_deg", r.peak.x_high},
+          {"angle_err_deg", opt(known(r.peak.x_error()))},
+          {"angle_low_deg", opt(known(r.peak.x_low))},
+          {"angle_high_deg", opt(known(r.peak.x_high))},
           {"mean_settling_velocity_m_s", r.w_m_s},
           {"error_m_s", r.peak.y_error()},
           {"r_acc", opt(r.r_acc)},
@@ -38,13 +46,13 @@ std::string csv(const std::vector<PeakRow>& rows) {
   const auto opt = [](const std::optional<double>& v) {
     return v ? fmt::format("{:.6g}", *v) : std::string();
   };
+  const auto err = [](double v) { return std::isfinite(v) ? fmt::format("{:.4g}", v) : std::string(); };
   for (const auto& r : rows)
-    s += report::csv_line({r.group, r.setting, fmt::format("{:.6g}", r.peak.x),
-                           fmt::format("{:.4g}", r.peak.x_error()), fmt::format("{:.6g}", r.peak.x_low),
-                           fmt::format("{:.6g}", r.peak.x_high), fmt::format("{:.9g}", r.w_m_s),
-                           fmt::format("{:.4g}", r.peak.y_error()), opt(r.r_acc), opt(r.r_acc_err),
-                           std::to_string(r.points), std::to_string(r.added), r.resolved ? "true" : "false",
-                           r.status, r.objective, r.why});
+    s += report::csv_line({r.group, r.setting, fmt::format("{:.6g}", r.peak.x), err(r.peak.x_error()),
+                           opt(known(r.peak.x_low)), opt(known(r.peak.x_high)),
+                           fmt::format("{:.9g}", r.w_m_s), fmt::format("{:.4g}", r.peak.y_error()),
+                           opt(r.r_acc), opt(r.r_acc_err), std::to_string(r.points), std::to_string(r.added),
+                           r.resolved ? "true" : "false", r.status, r.objective, r.why});
   return s;
 }
 
@@ -55,8 +63,11 @@ std::string table(const std::vector<PeakRow>& rows) {
                       {false, true, false, true, true, true, false, false});
   std::string notes;
   for (const auto& r : rows) {
-    t.add({r.group, fmt::format("{:.1f} +- {:.1f}", r.peak.x, r.peak.x_error()),
-           fmt::format("[{:.1f}, {:.1f}]", r.peak.x_low, r.peak.x_high),
+    const bool interval = std::isfinite(r.peak.x_error());
+    t.add({r.group,
+           interval ? fmt::format("{:.1f} +- {:.1f}", r.peak.x, r.peak.x_error())
+                    : fmt::format("{:.1f} (highest point)", r.peak.x),
+           interval ? fmt::format("[{:.1f}, {:.1f}]", r.peak.x_low, r.peak.x_high) : std::string("-"),
            fmt::format("{:.2f} +- {:.2f}", r.w_m_s * 1e3, r.peak.y_error() * 1e3),
            r.r_acc ? fmt::format("{:.3f} +- {:.3f}", *r.r_acc, r.r_acc_err.value_or(0.0)) : "-",
            fmt::format("{} ({})", r.points, r.added), r.resolved ? "yes" : "no (" + r.status + ")",

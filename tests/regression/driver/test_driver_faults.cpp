@@ -275,6 +275,31 @@ TEST(StudyStatus, ARunFinishedAtAnEndSinceRaisedIsNotListedAsUncollected) {
   EXPECT_EQ(r.out.find("not recorded yet"), std::string::npos) << r.out;
 }
 
+// Two angles bracket no peak: `query peak` shows the higher point, says why, and gives its angle
+// no interval (a zero-width one would read as a peak known exactly).
+TEST(Queries, APeakOfTwoPointsIsNotEstimatedAndSaysSo) {
+  TempDir d;
+  const auto db = fake_study_db(d);
+  const auto q = run({"query", "peak", "--db", db.string(), "--study", "small", "--format", "json"}, d.path);
+  ASSERT_EQ(q.rc, 0) << q.err;
+  const auto rows = nlohmann::json::parse(q.out);
+  ASSERT_EQ(rows.size(), 1u) << q.out;
+  EXPECT_EQ(rows[0]["n_points"], 2);
+  EXPECT_EQ(rows[0]["status"], "too_few_points");
+  EXPECT_EQ(rows[0]["resolved"], false);
+  for (const char* key : {"angle_err_deg", "angle_low_deg", "angle_high_deg"})
+    EXPECT_TRUE(rows[0][key].is_null()) << key << ": " << q.out;
+  const double angle = rows[0]["angle_deg"].get<double>();
+  EXPECT_TRUE(angle == 60.0 || angle == 90.0) << q.out;
+  const auto t = run({"query", "peak", "--db", db.string(), "--study", "small"}, d.path);
+  ASSERT_EQ(t.rc, 0) << t.err;
+  EXPECT_NE(t.out.find("(highest point)"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("2 points: a peak needs 3 to be bracketed"), std::string::npos) << t.out;
+  const auto c = run({"query", "peak", "--db", db.string(), "--study", "small", "--format", "csv"}, d.path);
+  ASSERT_EQ(c.rc, 0) << c.err;
+  EXPECT_EQ(c.out.find("nan"), std::string::npos) << c.out;
+}
+
 TEST(Queries, ReadOnlyDatabaseIsQueriedWithoutWritingToIt) {
   TempDir d;
   const auto db = fake_study_db(d);
