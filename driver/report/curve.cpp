@@ -232,7 +232,7 @@ class CurveFigure {
     for (const auto& r : *peaks_) {
       const std::string name = r.setting.empty() ? r.group : r.group + " " + r.setting;
       const auto g = std::find(series_.begin(), series_.end(), name);
-      if (g == series_.end() || r.points < 3) continue;
+      if (g == series_.end() || !r.peak.bracketed()) continue;
       const char* color = report::color(static_cast<std::size_t>(g - series_.begin()));
       if (panel == 0) {
         const double v = r.w_m_s * 1e3, e = r.peak.y_error() * 1e3;

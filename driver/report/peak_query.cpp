@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <exception>
-#include <limits>
 #include <map>
 #include <set>
 #include <utility>
@@ -82,16 +81,11 @@ PeakRow peak_row(const std::vector<const CurvePoint*>& curve, const std::optiona
     row.status = "no_refine";
     row.why = "the study has no [refine]: resolved means inside the range, the points bending down";
   }
-  // Three points bracket a peak; fewer give only the highest measured one, which would read as a
-  // peak known exactly (an interval of zero width): its angle is shown, without an interval.
-  if (pts.size() < 3) {
-    row.peak.x_low = row.peak.x_high = std::numeric_limits<double>::quiet_NaN();
+  if (!row.peak.bracketed()) {
     row.resolved = false;
     row.status = stats::to_string(stats::RefineStop::kTooFewPoints);
-    row.why = fmt::format(
-        "{} point{}: a peak needs 3 to be bracketed; shown: the highest measured, its angle "
-        "without an interval",
-        pts.size(), pts.size() == 1 ? "" : "s");
+    row.why = stats::too_few_points_why(pts.size()) +
+              "; shown: the highest measured, its angle without an interval";
   }
   // Signed as the curve's largest value (settling is downward: negative).
   const CurvePoint* top = curve.front();

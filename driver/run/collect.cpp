@@ -120,9 +120,11 @@ std::optional<nlohmann::json> finished_summary(const std::string& case_id, const
 
 }  // namespace
 
-bool collectable_summary_in(Database& db, const fs::path& dir, const std::string& case_id) {
-  const auto s = finished_summary(case_id, dir);
-  return s && summary_reaches_end(db, case_id, s->dump());
+std::optional<nlohmann::json> collectable_summary(Database& db, const fs::path& dir,
+                                                  const std::string& case_id) {
+  auto s = finished_summary(case_id, dir);
+  if (s && !summary_reaches_end(db, case_id, s->dump())) s.reset();
+  return s;
 }
 
 void prepare_study_database(Database& db, const Study& study, const fs::path& runs_root) {
@@ -181,7 +183,7 @@ CollectResult collect_run_folders(Database& db, const Study& study, const fs::pa
     // A finished summary that no attempt record brought in: the task ended the solver but not yet
     // its record, or the folder was run by hand or by a driver that died.
     // One that stopped at an earlier time.end than the case now has is continued, not recorded.
-    if (const auto s = finished_summary(c.id, dir); s && summary_reaches_end(db, c.id, s->dump())) {
+    if (const auto s = collectable_summary(db, dir, c.id)) {
       auto attempt = latest_open_attempt(db, c.id);
       if (!attempt) attempt = begin_attempt(db, c.id, s->value("mpi_ranks", 1), dir.string());
       if (record_left_summary(db, *attempt, c.id, dir)) ++out.results;

@@ -9,8 +9,11 @@
 // without an end stays an open attempt, and a summary counts only with a finished status and this
 // case's id. An open attempt whose job squeue no longer lists is closed as abandoned.
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "driver/store/database.hpp"
 #include "driver/study/study.hpp"
@@ -33,10 +36,11 @@ CollectResult collect_run_folders(Database& db, const Study& study, const std::f
 /// scheme migrated (run folders renamed), the study registered.
 void prepare_study_database(Database& db, const Study& study, const std::filesystem::path& runs_root);
 
-/// Whether <dir>/summary.json is what `study collect` would record: a finished run (completed or
+/// <dir>/summary.json where it is what `study collect` would record: a finished run (completed or
 /// converged) of case_id that reaches the case's time.end (a run finished at an end since raised
-/// is continued by `study run`, not collected).
-bool collectable_summary_in(Database& db, const std::filesystem::path& dir, const std::string& case_id);
+/// is continued by `study run`, not collected); nullopt otherwise.
+std::optional<nlohmann::json> collectable_summary(Database& db, const std::filesystem::path& dir,
+                                                  const std::string& case_id);
 
 /// `boycott study collect STUDY.toml --db FILE`: exit 0, or 2 on a bad study or database.
 int study_collect(const std::string& study_file, const std::string& db_path, int retries);

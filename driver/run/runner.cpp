@@ -213,7 +213,7 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
     const auto job = jobs.find(c.id);
     ++counts[st];
     if ((it == known.end() || it->second.status != CaseStatus::kDone) &&
-        collectable_summary_in(*db, runs / c.id, c.id))
+        collectable_summary(*db, runs / c.id, c.id))
       ++uncollected;
     std::vector<std::string> row = {
         c.id, c.group, fmt::format("{:.1f}", c.params.gravity.angle_deg), st,

@@ -158,17 +158,19 @@ double quantile(const std::vector<double>& sorted, double q) {
   return sorted[i] + (pos - static_cast<double>(i)) * (sorted[i + 1] - sorted[i]);
 }
 
-constexpr std::size_t kWindow = 3;      ///< the highest point and its neighbours
-constexpr std::size_t kWideWindow = 5;  ///< two neighbours on each side: the model check
+constexpr std::size_t kWindow = kBracketPoints;  ///< the highest point and its neighbours
+constexpr std::size_t kWideWindow = 5;           ///< two neighbours on each side: the model check
 
-/// Half the signed distances from the parabola's vertex v to the vertices of the other two
-/// estimators: the quadratic through five points and a Gaussian (a parabola through the
-/// logarithms) through the three; empty with three points or fewer.
+/// Half the signed distances from the parabola's vertex v to the vertices of the other
+/// estimators: the quadratic through five points (with more than three) and a Gaussian (a
+/// parabola through the logarithms, values all positive) through the three; empty with fewer
+/// than three points.
 std::vector<Vertex> model_deviations(const std::vector<PeakPoint>& p, const std::vector<double>& y,
                                      const Vertex& v) {
   std::vector<Vertex> d;
-  if (p.size() <= kWindow) return d;
-  std::vector<Vertex> others{top_vertex(p, y, kWideWindow)};
+  if (p.size() < kWindow) return d;
+  std::vector<Vertex> others;
+  if (p.size() > kWindow) others.push_back(top_vertex(p, y, kWideWindow));
   if (std::all_of(y.begin(), y.end(), [](double yi) { return yi > 0.0; })) {
     std::vector<PeakPoint> lp = p;
     std::vector<double> ly(p.size());
@@ -273,6 +275,11 @@ PeakEstimate estimate_peak(std::vector<PeakPoint> points, const PeakFitOptions& 
   e.x = v.x;
   e.y = v.y;
   draw_intervals(p, options, e);
+  e.at_edge = e.x == p.front().x || e.x == p.back().x;
+  if (!e.bracketed()) {
+    e.x_low = e.x_high = std::numeric_limits<double>::quiet_NaN();
+    return e;
+  }
   const Vertex model = model_spread(p, y, v, options);
   e.model_error = model.x;
   e.x_low = e.x - std::hypot(e.x - e.x_low, model.x);
@@ -282,7 +289,6 @@ PeakEstimate estimate_peak(std::vector<PeakPoint> points, const PeakFitOptions& 
   // The peak is no further out than the points that were sampled.
   e.x_low = std::max(e.x_low, p.front().x);
   e.x_high = std::min(e.x_high, p.back().x);
-  e.at_edge = e.x == p.front().x || e.x == p.back().x;
   return e;
 }
 

@@ -13,9 +13,11 @@
 //   interval moved down by the draws' mean bias (the highest of noisy values exceeds the true
 //   maximum, and draws of noisy values plus noise more so);
 // - the model's error, added in quadrature on each side: the part of the disagreement between
-//   the parabola's vertex and those of the weighted quadratic through five points and of a
-//   Gaussian (a parabola through the logarithms) through the three that the points' noise does
-//   not explain (half the distance, less its scatter over draws of the points, in quadrature).
+//   the parabola's vertex and those of the weighted quadratic through five points (where there
+//   are more than three) and of a Gaussian (a parabola through the logarithms) through the three
+//   that the points' noise does not explain (half the distance, less its scatter over draws of
+//   the points, in quadrature). Three points alone give the Gaussian only: it checks how the
+//   value between them depends on the shape, little of where the vertex lies.
 // Coverage over noisy synthetic curves, one family at a time, after the refinement
 // (tests/unit/test_peak_coverage.cpp, docs/validation.md "Peaks"): position / value 0.708 / 0.716
 // on symmetric peaks, 0.682 / 0.680 on skewed ones (the half-distance alone, with the noise in it
@@ -41,6 +43,9 @@ struct PeakFitOptions {
   std::uint64_t seed = 2021;  ///< of the draws: fixed, so an estimate is a function of its points
 };
 
+/// Points that bracket a peak: the highest and a neighbour on each side.
+inline constexpr int kBracketPoints = 3;
+
 /// The maximum of a curve and its 68 % intervals.
 struct PeakEstimate {
   bool valid = false;  ///< false with no point
@@ -52,6 +57,9 @@ struct PeakEstimate {
   std::size_t top = 0;     ///< index (in x order) of the highest measured point
   bool at_edge = false;    ///< the estimate lies at the first or last sampled abscissa
   double model_error = 0;  ///< the quadratic's own part of the position's uncertainty (above)
+  /// Fewer than kBracketPoints points bracket no peak: x is the highest measured abscissa and its
+  /// interval is NaN (unknown, where a zero-width one would read as known exactly).
+  bool bracketed() const { return points >= kBracketPoints; }
   double x_error() const { return 0.5 * (x_high - x_low); }
   double y_error() const { return 0.5 * (y_high - y_low); }
 };

@@ -103,13 +103,18 @@ const char* to_string(RefineStop s) {
   return "?";
 }
 
+std::string too_few_points_why(std::size_t points) {
+  return fmt::format("{} point{}: a peak needs {} to be bracketed", points, points == 1 ? "" : "s",
+                     kBracketPoints);
+}
+
 RefineStep next_refinement(const std::vector<PeakPoint>& points, int added, const RefineRule& rule,
                            const PeakFitOptions& options) {
   RefineStep s;
   const std::vector<PeakPoint> p = sorted_by_x(points);
-  if (p.size() < 3) {
+  if (p.size() < kBracketPoints) {
     s.stop = RefineStop::kTooFewPoints;
-    s.why = fmt::format("{} points: a peak needs 3 to be bracketed", p.size());
+    s.why = too_few_points_why(p.size());
     return s;
   }
   s.peak = estimate_peak(p, options);

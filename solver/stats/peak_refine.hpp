@@ -41,6 +41,8 @@ enum class RefineStop {
 };
 /// resolved, at_range_edge, max_points, indistinct, too_few_points, continue.
 const char* to_string(RefineStop s);
+/// Why a curve of `points` (< kBracketPoints) points has no peak estimate: one sentence.
+std::string too_few_points_why(std::size_t points);
 
 struct RefineStep {
   RefineStop stop = RefineStop::kContinue;

@@ -137,23 +137,23 @@ TransientEnd transient_end(const std::vector<double>& x) {
     clean = differs ? 0 : clean + 1;
     if (differs) end = j + 1;
   }
-  cut.detected = end * len;
-  if (end > 0) {
-    // The reference's correlation span, its upper end (samples): how long the series remembers.
-    const AutocorrelationError e = autocorrelation_error(std::vector<double>(x.end() - refs * len, x.end()));
-    const double span = std::isfinite(e.span_times) && e.span_times > 0.0
-                            ? static_cast<double>(refs * len) / e.span_times
-                            : 0.0;
-    const std::int64_t guarded =
-        std::min<std::int64_t>(n / 2, cut.detected + std::llround(TransientEnd::kGuardSpans * span));
-    cut.start = std::max(guarded, cut_past_fitted_decay(x, len, segments, ref));
-  } else {
-    // No segment alone differs, yet the fit, which pools the segments, may show a decay: a weak
-    // transient spread over several segments (one that biases the mean by about one standard
-    // error) is seen there far more often than by any one segment.
-    cut.start = cut_past_fitted_decay(x, len, segments, ref);
-    cut.detected = cut.start;
+  // The fit pools the segments: a weak transient spread over several of them (one that biases
+  // the mean by about one standard error) shows there far more often than in any one segment.
+  const std::int64_t past_decay = cut_past_fitted_decay(x, len, segments, ref);
+  if (end == 0) {
+    cut.start = past_decay;
+    cut.detected = past_decay;
+    return cut;
   }
+  cut.detected = end * len;
+  // The reference's correlation span, its upper end (samples): how long the series remembers.
+  const AutocorrelationError e = autocorrelation_error(std::vector<double>(x.end() - refs * len, x.end()));
+  const double span = std::isfinite(e.span_times) && e.span_times > 0.0
+                          ? static_cast<double>(refs * len) / e.span_times
+                          : 0.0;
+  const std::int64_t guarded =
+      std::min<std::int64_t>(n / 2, cut.detected + std::llround(TransientEnd::kGuardSpans * span));
+  cut.start = std::max(guarded, past_decay);
   return cut;
 }
 

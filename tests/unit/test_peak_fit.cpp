@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,39 @@ TEST(PeakFit, ParabolaThroughThreeExactPointsHasItsVertexAndValue) {
   EXPECT_LE(e.x_low, 63.0);
   EXPECT_GE(e.x_high, 63.0);
   EXPECT_LT(e.x_error(), 2.0);
+}
+
+// Two points bracket no peak: the higher one is shown, its abscissa with no interval (NaN: a
+// zero-width one would read as known exactly), its value with the draws' interval.
+TEST(PeakFit, TwoPointsGiveTheHigherOneAndNoIntervalForItsPosition) {
+  const PeakEstimate e = estimate_peak({{60, 1.8, 0.05}, {90, 1.2, 0.05}});
+  ASSERT_TRUE(e.valid);
+  EXPECT_FALSE(e.bracketed());
+  EXPECT_EQ(e.x, 60.0);
+  EXPECT_TRUE(std::isnan(e.x_low) && std::isnan(e.x_high));
+  EXPECT_TRUE(e.at_edge);
+  EXPECT_GT(e.y_error(), 0.0);
+  const RefineStep s = next_refinement({{60, 1.8, 0.05}, {90, 1.2, 0.05}}, 0, {2.5, 4});
+  EXPECT_EQ(s.stop, RefineStop::kTooFewPoints);
+  EXPECT_EQ(s.why, "2 points: a peak needs 3 to be bracketed");
+}
+
+// Three points of a Gaussian peak (sigma 15 deg, maximum 1 at 70 deg) known almost exactly: the
+// parabola through them misses the maximum's value by far more than the points' errors, and
+// only the model's error (here the Gaussian through the three, which no fourth point is needed
+// for) can say so. Without it the value's interval was the points' 1e-6.
+TEST(PeakFit, ThreePointsAloneStillCarryTheShapesPartOfTheValuesError) {
+  std::vector<PeakPoint> pts;
+  for (double x : {60.0, 75.0, 90.0})
+    pts.push_back({x, std::exp(-0.5 * (x - 70.0) * (x - 70.0) / 225.0), 1e-6});
+  const PeakEstimate e = estimate_peak(pts);
+  ASSERT_TRUE(e.bracketed());
+  const double miss = std::abs(e.y - 1.0);
+  EXPECT_GT(miss, 1e-3);  // the parabola's own error on this shape
+  // Half the distance to the (here exact) Gaussian: the interval reaches half-way to the truth.
+  EXPECT_NEAR(e.y_error(), 0.5 * miss, 0.05 * miss);
+  EXPECT_LE(e.y_low, 1.0);
+  EXPECT_GE(e.y_high, e.y);
 }
 
 TEST(PeakFit, SamePointsInAnyOrderGiveTheSameEstimate) {
