@@ -22,6 +22,7 @@
 #include "driver/store/store.hpp"
 #include "driver/study/cost_model.hpp"
 #include "driver/study/refine.hpp"
+#include "stats/peak_fit.hpp"
 
 namespace fs = std::filesystem;
 
@@ -227,7 +228,8 @@ std::string plan_per_group(const Study& study, const nlohmann::json& rows) {
                      kListEveryCaseMax);
 }
 
-/// The most a study's [refine] may still add: per curve, the points max_points leaves, each with
+/// The most a study's [refine] may still add: per curve of three points or more, the points
+/// max_points leaves, each with
 /// as many replicas as its group may run, at the cost of the curve's first case with refine's set
 /// applied; the rounds run one after another, the curves of a round side by side.
 struct RefineBudget {
@@ -246,7 +248,10 @@ RefineBudget refine_budget(const Study& study, const CostModel& model, int jobs,
         static_cast<int>(std::count_if(curve.cases.begin(), curve.cases.end(), [](const StudyCase* c) {
           return c->refine_round >= 0 && c->replica == 0;
         }));
-    const int left = std::max(0, study.refine->max_points - added);
+    // A curve of fewer points than bracket a peak gets none (stats::next_refinement stops there).
+    const auto points = std::count_if(curve.cases.begin(), curve.cases.end(),
+                                      [](const StudyCase* c) { return c->replica == 0; });
+    const int left = points < stats::kBracketPoints ? 0 : std::max(0, study.refine->max_points - added);
     const auto plan = study.replica_plans.find(curve.group);
     const int replicas = plan == study.replica_plans.end() ? 1 : plan->second.max;
     const double point_s =

@@ -41,21 +41,38 @@ std::string node_text(const toml::node* n) {
   return out.str();
 }
 
-void read_set(const toml::table& set, const std::string& prefix, RefinePlan& plan) {
+/// The keys of a set table (`[refine] set` or a group's `refine_set`, named `where`), flattened.
+void read_set(const toml::table& set, const std::string& prefix, const std::string& refined_key,
+              const std::string& where, std::vector<std::pair<std::string, std::string>>& out) {
   for (const auto& [k, node] : set) {
     const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
     if (const auto* sub = node.as_table()) {
-      read_set(*sub, key, plan);
+      read_set(*sub, key, refined_key, where, out);
       continue;
     }
     const auto names = case_key_names();
     if (std::find(names.begin(), names.end(), key) == names.end())
-      throw InputError(fmt::format("[refine] set: unknown key '{}'{}", key, did_you_mean(key)), key);
-    if (key == plan.key)
+      throw InputError(fmt::format("{}: unknown key '{}'{}", where, key, did_you_mean(key)), key);
+    if (key == refined_key)
       throw InputError(
-          fmt::format("[refine] set: '{}' is the key refine chooses; set gives the keys zipped with it", key),
+          fmt::format("{}: '{}' is the key refine chooses; set gives the keys zipped with it", where, key),
           key);
-    plan.set.emplace_back(key, value_text(node));
+    out.emplace_back(key, value_text(node));
+  }
+}
+
+/// Each [[group]]'s `refine_set` (study.cpp refuses one in a study without [refine]).
+void read_group_sets(const toml::table& root, RefinePlan& plan) {
+  const auto* groups = root["group"].as_array();
+  if (!groups) return;
+  for (const auto& gn : *groups) {
+    const auto* gt = gn.as_table();
+    const auto name = gt ? (*gt)["name"].value<std::string>() : std::nullopt;
+    const auto* node = gt ? gt->get("refine_set") : nullptr;
+    if (!node || !name) continue;
+    const std::string where = fmt::format("group '{}': refine_set", *name);
+    if (!node->as_table()) throw InputError(where + " must be a table of key = value");
+    read_set(*node->as_table(), "", plan.key, where, plan.group_set[*name]);
   }
 }
 
@@ -95,16 +112,17 @@ RefinePlan read_table(const toml::table& t) {
   }
   if (const auto* set = t.get("set")) {
     if (!set->as_table()) throw InputError("[refine]: set must be a table of key = value");
-    read_set(*set->as_table(), "", plan);
+    read_set(*set->as_table(), "", plan.key, "[refine] set", plan.set);
   }
   return plan;
 }
 
 /// The keys that split a group's curves: besides the refined key and those refine sets, the keys
 /// that take two values or more at one angle among its listed cases.
-std::set<std::string> splitting_keys(const Study& s, const std::vector<const StudyCase*>& listed) {
+std::set<std::string> splitting_keys(const Study& s, const std::string& group,
+                                     const std::vector<const StudyCase*>& listed) {
   std::set<std::string> skip{s.refine->key};
-  for (const auto& [k, v] : s.refine->set) skip.insert(k);
+  for (const auto& [k, v] : s.refine->set_for(group)) skip.insert(k);
   std::map<std::string, std::map<double, std::set<std::string>>> values;  // key -> angle -> values
   for (const auto* c : listed)
     for (const auto& [k, v] : c->swept)
@@ -130,6 +148,20 @@ bool sweeps_key(const StudyCase& c, const std::string& key) {
 
 }  // namespace
 
+std::vector<std::pair<std::string, std::string>> RefinePlan::set_for(const std::string& group) const {
+  auto out = set;
+  const auto own = group_set.find(group);
+  if (own == group_set.end()) return out;
+  for (const auto& [k, v] : own->second) {
+    const auto at = std::find_if(out.begin(), out.end(), [&](const auto& kv) { return kv.first == k; });
+    if (at != out.end())
+      at->second = v;
+    else
+      out.emplace_back(k, v);
+  }
+  return out;
+}
+
 double refined_value(double x, double resolution) {
   const double grid = resolution / 10.0;
   return std::round(x / grid) * grid;
@@ -144,7 +176,7 @@ std::vector<RefineSeries> refine_series(const Study& s) {
       if (c.group == group && c.refine_round < 0 && c.replica == 0 && sweeps_key(c, s.refine->key))
         listed.push_back(&c);
     if (listed.empty()) continue;
-    const auto splitting = splitting_keys(s, listed);
+    const auto splitting = splitting_keys(s, group, listed);
     std::map<std::string, std::size_t> index;          // setting -> position in out
     std::map<std::string, std::string> point_setting;  // point id -> setting
     for (const auto* c : listed) {
@@ -175,21 +207,22 @@ StudyCase refined_case(const Study& s, const RefineSeries& series, double value,
   const std::string where =
       fmt::format("group '{}'{} refined {}={}", series.group,
                   series.setting.empty() ? "" : " (" + series.setting + ")", plan.key, text);
+  const auto set = plan.set_for(series.group);
   try {
     apply_value(c.params, plan.key, toml::value<double>(value));
-    for (const auto& [k, v] : plan.set) apply_value(c.params, k, *value_table(v).get("v"));
+    for (const auto& [k, v] : set) apply_value(c.params, k, *value_table(v).get("v"));
     checks::check_case(c.params);
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", where, e.what()), e.key());
   }
   std::map<std::string, std::string> replaced{{plan.key, text}};
-  for (const auto& [k, v] : plan.set) replaced[k] = v;
+  for (const auto& [k, v] : set) replaced[k] = v;
   for (auto& [k, v] : c.swept)
     if (const auto it = replaced.find(k); it != replaced.end()) {
       v = it->second;
       replaced.erase(it);
     }
-  for (const auto& [k, v] : plan.set)
+  for (const auto& [k, v] : set)
     if (replaced.count(k)) c.swept.emplace_back(k, v);
   c.id = case_id(c.params);
   c.point_id = c.id;
@@ -207,7 +240,9 @@ std::optional<RefinePlan> read_refine_plan(const std::string& text, const std::s
   if (!node) return std::nullopt;
   const auto* t = node->as_table();
   if (!t) throw InputError(fmt::format("{}: 'refine' must be a table: [refine]", origin));
-  return read_table(*t);
+  RefinePlan plan = read_table(*t);
+  read_group_sets(root, plan);
+  return plan;
 }
 
 }  // namespace boycott::driver

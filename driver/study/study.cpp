@@ -235,6 +235,7 @@ struct Group {
   std::vector<Axis> axes;  ///< the group's own [group.matrix] / [group.zip], before the study's
   ReplicaKeys replicas;
   std::optional<std::size_t> index;  ///< in the file's [[group]] array; none for the implicit one
+  bool has_refine_set = false;       ///< values for [refine]'s added points (refine.cpp reads them)
 };
 
 /// The [base] table as a case (every key not set there at its default).
@@ -257,14 +258,16 @@ Group read_group(const toml::table& gt, std::size_t index, const std::string& or
   check_name(origin + ": a group's name", *gname);
   g.name = *gname;
   static const std::set<std::string> kGroupKeys = {
-      "name", "set", "matrix", "zip", "replicas", "replicas_max", "replicas_target_rel_error"};
+      "name", "set", "matrix", "zip", "replicas", "replicas_max", "replicas_target_rel_error", "refine_set"};
   for (const auto& [k, node] : gt) {
     if (!kGroupKeys.count(std::string(k.str())))
       throw InputError(
           fmt::format("group '{}': unknown key '{}' (expected name, set, matrix, zip, replicas, "
-                      "replicas_target_rel_error, replicas_max)",
+                      "replicas_target_rel_error, replicas_max, refine_set)",
                       g.name, k.str()));
   }
+  // refine.cpp reads it, with [refine]; a study without [refine] adds no point to set it on.
+  g.has_refine_set = gt.contains("refine_set");
   g.replicas = read_replica_keys(gt, fmt::format("group '{}'", g.name));
   // A group may sweep its own keys (one setting varied at a time, as a work-precision study
   // does); they combine with the study's [matrix] as a product.
@@ -401,12 +404,14 @@ bool check_refine_axes(const RefinePlan& plan, const Group& g, const std::vector
     for (const auto& ax : *list) {
       const auto at = std::find(ax.keys.begin(), ax.keys.end(), plan.key);
       if (at == ax.keys.end()) continue;
+      const auto set = plan.set_for(g.name);
       for (const auto& k : ax.keys)
         if (k != plan.key &&
-            std::none_of(plan.set.begin(), plan.set.end(), [&](const auto& kv) { return kv.first == k; }))
-          throw InputError(fmt::format(
-              "[refine]: '{}' is zipped with '{}' (group '{}'): give the added points' value in [refine] set",
-              k, plan.key, g.name));
+            std::none_of(set.begin(), set.end(), [&](const auto& kv) { return kv.first == k; }))
+          throw InputError(
+              fmt::format("[refine]: '{}' is zipped with '{}' (group '{}'): give the added points' "
+                          "value in [refine] set, or the group's own in its refine_set",
+                          k, plan.key, g.name));
       const auto col = static_cast<std::size_t>(at - ax.keys.begin());
       const bool has_90 =
           std::any_of(ax.points.begin(), ax.points.end(), [&](const std::vector<StudyValue>& pt) {
@@ -457,6 +462,11 @@ Study expand_study(const toml::table& root, const std::string& text, const std::
   for (const auto& g : groups) {
     at_group = g.index;
     s.groups.push_back(g.name);
+    if (g.has_refine_set && !s.refine)
+      throw InputError(
+          fmt::format("group '{}': refine_set gives values to points [refine] adds; the study has "
+                      "no [refine]",
+                      g.name));
     if (s.refine) refined = check_refine_axes(*s.refine, g, axes) || refined;
     expand_group(s, g, base, axes, s.replica_plans[g.name], seen);
   }

@@ -48,6 +48,12 @@ struct RefinePlan {
   int max_points = 4;
   /// Keys set on the added points (those zipped with `key`: a new angle's time.end), TOML text.
   std::vector<std::pair<std::string, std::string>> set;
+  /// A group's own values of such keys (its `refine_set`), where its zip differs from the other
+  /// groups' (one group zips a packed-bed limit with the angle): by group name, over `set`.
+  std::map<std::string, std::vector<std::pair<std::string, std::string>>> group_set;
+  /// What the added points of `group` set: `set` with the group's own values in place of (or
+  /// after) its entries.
+  std::vector<std::pair<std::string, std::string>> set_for(const std::string& group) const;
   static constexpr int kMaxPointsLimit = 50;
 };
 

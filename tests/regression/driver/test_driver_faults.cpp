@@ -300,6 +300,36 @@ TEST(Queries, APeakOfTwoPointsIsNotEstimatedAndSaysSo) {
   EXPECT_EQ(c.out.find("nan"), std::string::npos) << c.out;
 }
 
+// `study plan` prices [refine]'s points only on curves that can bracket a peak: a group of two
+// angles gets none (the refinement stops at too_few_points), one of three its max_points.
+TEST(StudyPlan, RefinesBudgetLeavesOutCurvesOfTooFewPointsToBracketAPeak) {
+  TempDir d;
+  write(d.path / "s.toml", std::string(kTwo).replace(std::string(kTwo).find("[matrix]"), std::string::npos,
+                                                     R"([[group]]
+name = "three"
+zip = { "gravity.angle_deg" = [30, 60, 90] }
+[[group]]
+name = "two"
+set = { "fluid.viscosity" = 2.0e-3 }
+zip = { "gravity.angle_deg" = [60, 90] }
+[refine]
+key = "gravity.angle_deg"
+resolution = 5.0
+max_points = 2
+)"));
+  const auto r = run(
+      {"study", "plan", (d.path / "s.toml").string(), "--db", (d.path / "s.db").string(), "--format", "json"},
+      d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const auto curves = nlohmann::json::parse(r.out)["refinement"]["curves"];
+  ASSERT_EQ(curves.size(), 2u) << r.out;
+  EXPECT_EQ(curves[0]["group"], "three");
+  EXPECT_EQ(curves[0]["max_cases"], 2);
+  EXPECT_EQ(curves[1]["group"], "two");
+  EXPECT_EQ(curves[1]["max_cases"], 0);
+  EXPECT_EQ(curves[1]["max_core_s"], 0.0);
+}
+
 TEST(Queries, ReadOnlyDatabaseIsQueriedWithoutWritingToIt) {
   TempDir d;
   const auto db = fake_study_db(d);

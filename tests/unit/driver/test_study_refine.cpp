@@ -123,6 +123,61 @@ TEST(StudyRefine, RefusesWhatItCannotRefineNamingWhy) {
       std::string::npos);
 }
 
+namespace {
+
+// Two groups whose zips differ: "ga" also zips the packed-bed step limit with the angle (on at the
+// inclined angles, off at 90), as the paper's Ga 145.6 group does in studies/paper_base_full.toml.
+const char* kGroupSets = R"(
+name = "g"
+base = { scene = "inclined_settling", time = { end = 2.0, average_from = 1.0 }, numerics = { drag_dt_limit = false } }
+[[group]]
+name = "base"
+zip = { "gravity.angle_deg" = [30, 60, 90], "time.end" = [2.0, 3.0, 2.0] }
+[[group]]
+name = "ga"
+set = { "fluid.viscosity" = 1.0e-2 }
+zip = { "gravity.angle_deg" = [30, 60, 90], "time.end" = [2.0, 3.0, 2.0], "numerics.drag_dt_limit" = [true, true, false] }
+refine_set = { "numerics.drag_dt_limit" = true, "time.end" = 5.0 }
+[refine]
+key = "gravity.angle_deg"
+resolution = 2.5
+set = { "time.end" = 4.0 }
+)";
+
+}  // namespace
+
+// A group's refine_set gives its added points its own values of the keys zipped with the angle
+// (over [refine] set's); another group's added points keep [refine] set's and their own base.
+TEST(StudyRefine, AGroupsRefineSetGivesItsAddedPointsItsOwnValues) {
+  const auto s = bd::expand_study_string(kGroupSets);
+  const auto curves = bd::refine_series(s);
+  ASSERT_EQ(curves.size(), 2u);
+  EXPECT_EQ(curves[1].setting, "");  // the zipped limit splits no curve
+  const bd::StudyCase ga = bd::refined_case(s, curves[1], 70.0, 0);
+  EXPECT_EQ(ga.group, "ga");
+  EXPECT_TRUE(ga.params.numerics.drag_dt_limit);
+  EXPECT_EQ(ga.params.time.end_s, 5.0);
+  EXPECT_EQ(ga.params.fluid.viscosity_pa_s, 1.0e-2);
+  const bd::StudyCase base = bd::refined_case(s, curves[0], 70.0, 0);
+  EXPECT_FALSE(base.params.numerics.drag_dt_limit);
+  EXPECT_EQ(base.params.time.end_s, 4.0);
+  EXPECT_NE(ga.id, base.id);
+  // Without it, the zipped limit has no value for an added angle: refused, naming the group.
+  const std::string without = with(kGroupSets, "\"numerics.drag_dt_limit\" = true, ", "");
+  EXPECT_NE(refusal(without).find("'numerics.drag_dt_limit' is zipped with 'gravity.angle_deg' (group 'ga')"),
+            std::string::npos)
+      << refusal(without);
+  EXPECT_NE(refusal(with(kGroupSets, "\"time.end\" = 5.0", "\"time.ends\" = 5.0"))
+                .find("group 'ga': refine_set: unknown key 'time.ends'"),
+            std::string::npos);
+  // A study without [refine] adds no point for it to act on.
+  const std::string no_refine = kGroupSets;
+  EXPECT_NE(
+      refusal(no_refine.substr(0, no_refine.find("[refine]")))
+          .find("group 'ga': refine_set gives values to points [refine] adds; the study has no [refine]"),
+      std::string::npos);
+}
+
 // A study of more cases than a study may hold is refused before any case is made: one sentence
 // with the count and the limit (the large-study figures: docs/performance.md).
 TEST(StudySize, AStudyAboveTheLimitIsRefusedNamingItsCountAndTheLimit) {
