@@ -12,20 +12,6 @@
 namespace boycott::driver::report {
 namespace {
 
-// The cells of one CSV line (no quoting: a series file holds names and numbers), trimmed of
-// spaces and of a trailing carriage return.
-std::vector<std::string> cells_of(const std::string& line) {
-  std::vector<std::string> cells;
-  std::string cell;
-  std::istringstream in(line);
-  while (std::getline(in, cell, ',')) {
-    const auto a = cell.find_first_not_of(" \t\r"), b = cell.find_last_not_of(" \t\r");
-    cells.push_back(a == std::string::npos ? "" : cell.substr(a, b - a + 1));
-  }
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
-  return cells;
-}
-
 // The number a cell holds, or none (text, empty); NaN for "nan", infinity for "inf".
 std::optional<double> number_of(const std::string& cell) {
   if (cell.empty()) return std::nullopt;
@@ -38,16 +24,28 @@ std::optional<double> number_of(const std::string& cell) {
 
 }  // namespace
 
+std::vector<std::string> series_cells(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string cell;
+  std::istringstream in(line);
+  while (std::getline(in, cell, ',')) {
+    const auto a = cell.find_first_not_of(" \t\r"), b = cell.find_last_not_of(" \t\r");
+    cells.push_back(a == std::string::npos ? "" : cell.substr(a, b - a + 1));
+  }
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
 SeriesTable parse_series_table(const std::string& text, const std::string& path) {
   std::istringstream in(text);
   std::string line;
-  if (!std::getline(in, line) || cells_of(line).empty())
+  if (!std::getline(in, line) || series_cells(line).empty())
     throw InputError(fmt::format("'{}' has no header line of column names", path));
-  const std::vector<std::string> header = cells_of(line);
+  const std::vector<std::string> header = series_cells(line);
   std::vector<std::vector<std::optional<double>>> raw(header.size());
   for (std::size_t row = 2; std::getline(in, line); ++row) {
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    const auto cells = cells_of(line);
+    const auto cells = series_cells(line);
     if (cells.size() != header.size())
       throw InputError(fmt::format("row {} of '{}' has {} cells where the header names {} columns", row, path,
                                    cells.size(), header.size()));

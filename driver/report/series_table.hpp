@@ -15,6 +15,10 @@ struct SeriesTable {
   std::vector<std::vector<double>> columns;   ///< their values, one vector per name
 };
 
+/// The cells of one line of such a file (no quoting: names and numbers), trimmed of spaces and of
+/// a trailing carriage return.
+std::vector<std::string> series_cells(const std::string& line);
+
 /// The table in `text` (the file `path`, named in messages). A column with any cell that is not a
 /// number (text, an empty cell) is not numeric and is left out; a cell that reads as NaN or
 /// infinity is refused (a gap in a series makes every statistic of it meaningless).

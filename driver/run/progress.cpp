@@ -10,6 +10,8 @@
 
 #include <fmt/format.h>
 
+#include "driver/report/series_table.hpp"
+
 namespace fs = std::filesystem;
 
 namespace boycott::driver {
@@ -43,8 +45,9 @@ std::string last_line(const fs::path& file) {
   in.read(chunk.data(), back);
   auto end = chunk.find_last_not_of("\n\r ");
   if (end == std::string::npos) return {};
-  const auto begin = chunk.rfind('\n', end);
-  return chunk.substr(begin == std::string::npos ? 0 : begin + 1, end + 1);
+  const auto newline = chunk.rfind('\n', end);
+  const std::size_t begin = newline == std::string::npos ? 0 : newline + 1;
+  return chunk.substr(begin, end + 1 - begin);
 }
 }  // namespace
 
@@ -60,27 +63,16 @@ double last_row_value(const fs::path& run_dir, const std::string& column) {
   std::ifstream in(run_dir / "timeseries.csv");
   std::string header;
   if (!in || !std::getline(in, header)) return nan;
-  if (!header.empty() && header.back() == '\r') header.pop_back();
-  int index = -1, k = 0;
-  for (std::size_t from = 0;; ++k) {
-    const auto comma = header.find(',', from);
-    if (header.substr(from, comma == std::string::npos ? std::string::npos : comma - from) == column)
-      index = k;
-    if (comma == std::string::npos) break;
-    from = comma + 1;
-  }
-  if (index < 0) return nan;
+  const auto names = report::series_cells(header);
+  const auto at = std::find(names.begin(), names.end(), column);
   const std::string line = last_line(run_dir / "timeseries.csv");
-  if (line == header) return nan;
-  std::size_t from = 0;
-  for (int i = 0; i < index; ++i) {
-    from = line.find(',', from);
-    if (from == std::string::npos) return nan;
-    ++from;
-  }
+  if (at == names.end() || line == header) return nan;
+  const auto cells = report::series_cells(line);
+  const auto index = static_cast<std::size_t>(at - names.begin());
+  if (index >= cells.size()) return nan;
   char* stop = nullptr;
-  const double v = std::strtod(line.c_str() + from, &stop);
-  return stop == line.c_str() + from ? nan : v;
+  const double v = std::strtod(cells[index].c_str(), &stop);
+  return stop == cells[index].c_str() || *stop != '\0' ? nan : v;
 }
 
 ProgressDisplay::ProgressDisplay(std::string study, int jobs, bool live, double plain_every_s)
