@@ -77,9 +77,12 @@ PeakRow peak_row(const std::vector<const CurvePoint*>& curve, const std::optiona
   } else {
     row.peak = stats::estimate_peak(pts);
     const double reach = pts.empty() ? 0.0 : 0.5 * (pts.back().x - pts.front().x);
-    row.resolved = !row.peak.at_edge && stats::curvature_near(pts, row.peak.x, reach).peaked();
+    row.resolved =
+        row.peak.shape_checked && !row.peak.at_edge && stats::curvature_near(pts, row.peak.x, reach).peaked();
     row.status = "no_refine";
-    row.why = "the study has no [refine]: resolved means inside the range, the points bending down";
+    row.why =
+        "the study has no [refine]: resolved means inside the range, the points bending down, and more "
+        "than the parabola's three points";
   }
   if (!row.peak.bracketed()) {
     row.resolved = false;

@@ -271,6 +271,7 @@ PeakEstimate estimate_peak(std::vector<PeakPoint> points, const PeakFitOptions& 
   e.valid = true;
   e.top = argmax(y);
   e.points = static_cast<int>(std::min(kWindow, p.size()));
+  e.shape_checked = p.size() > kWindow;
   const Vertex v = top_vertex(p, y, kWindow);
   e.x = v.x;
   e.y = v.y;

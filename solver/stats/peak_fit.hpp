@@ -60,6 +60,10 @@ struct PeakEstimate {
   /// Fewer than kBracketPoints points bracket no peak: x is the highest measured abscissa and its
   /// interval is NaN (unknown, where a zero-width one would read as known exactly).
   bool bracketed() const { return points >= kBracketPoints; }
+  /// More points than the parabola's three: the five-point quadratic checks where its vertex lies.
+  /// Through exactly three the parabola is exact, and its position interval is the points' noise
+  /// alone, however wrong the shape: such an estimate is never called resolved.
+  bool shape_checked = false;
   double x_error() const { return 0.5 * (x_high - x_low); }
   double y_error() const { return 0.5 * (y_high - y_low); }
 };

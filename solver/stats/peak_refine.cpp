@@ -119,7 +119,8 @@ RefineStep next_refinement(const std::vector<PeakPoint>& points, int added, cons
   }
   s.peak = estimate_peak(p, options);
   const bool peaked = curvature_near(p, s.peak.x, kCurvatureReachResolutions * rule.resolution).peaked();
-  if (s.peak.x_error() <= rule.resolution && sampled_closely(p, s.peak.x, rule.resolution)) {
+  if (s.peak.shape_checked && s.peak.x_error() <= rule.resolution &&
+      sampled_closely(p, s.peak.x, rule.resolution)) {
     if (s.peak.at_edge) {
       s.stop = RefineStop::kAtRangeEdge;
       s.why = fmt::format("{}, at the edge of the sampled range: the curve may rise beyond it",

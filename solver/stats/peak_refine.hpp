@@ -3,7 +3,9 @@
 // rule behind `study run`'s refinement rounds, one added point per curve and round.
 //
 // From the points so far (peak_fit.hpp estimates the peak and its 68 % interval):
-// 1. stop when the position's half-width is at most the resolution, the nearest points on either
+// 1. stop when the curve has more than the parabola's three points (through three it is exact,
+//    and its interval holds the points' noise, not its shape: PeakEstimate::shape_checked), the
+//    position's half-width is at most the resolution, the nearest points on either
 //    side of the estimate lie within 2 resolutions of it (the quadratic's error on a skewed peak
 //    shrinks with that spacing) and the points within 4 resolutions bend down (their curvature
 //    below zero by twice its error: a peak, not a plateau within the errors): resolved; at the

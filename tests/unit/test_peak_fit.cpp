@@ -80,6 +80,23 @@ TEST(PeakFit, ThreePointsAloneStillCarryTheShapesPartOfTheValuesError) {
   EXPECT_GE(e.y_high, e.y);
 }
 
+// Three points 10-15 deg apart whose parabola's vertex interval is narrow (exact points): the
+// interval holds the points' noise and nothing of the shape, so the refinement adds a point there
+// instead of calling it resolved; with a fourth point near the vertex it can stop.
+TEST(PeakRefine, ThreePointsAreNeverResolvedOnTheirParabolaAlone) {
+  std::vector<PeakPoint> pts = {{65, 102.9, 0.2}, {75, 104.9, 0.2}, {90, 26.4, 0.1}};
+  const RefineStep s = next_refinement(pts, 0, {5.0, 2});
+  EXPECT_FALSE(s.peak.shape_checked);
+  EXPECT_LT(s.peak.x_error(), 5.0);  // narrow: it would pass the resolution
+  ASSERT_EQ(s.stop, RefineStop::kContinue) << s.why;
+  EXPECT_GT(s.next_x, 65.0);
+  EXPECT_LT(s.next_x, 75.0);
+  pts.push_back({s.next_x, 109.0, 0.2});
+  const RefineStep t = next_refinement(pts, 1, {5.0, 2});
+  EXPECT_TRUE(t.peak.shape_checked);
+  EXPECT_NE(t.stop, RefineStop::kTooFewPoints);
+}
+
 TEST(PeakFit, SamePointsInAnyOrderGiveTheSameEstimate) {
   std::vector<PeakPoint> pts = {{15, 1.1, 0.03}, {30, 1.4, 0.03}, {45, 1.9, 0.04},   {60, 2.2, 0.05},
                                 {75, 2.1, 0.05}, {90, 1.0, 0.02}, {67.5, 2.25, 0.05}};
