@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "checks/preflight.hpp"
 #include "core/error.hpp"
 #include "core/scene_specs.hpp"
 #include "driver/report/listing_format.hpp"
@@ -65,10 +66,16 @@ double reached_s(const fs::path& runs_root, const StudyCase& c) {
 /// (numerics.drag_dt_limit) has cut time.dt_cfd: a 10 cP bed packs and steps at 0.13-0.3 ms
 /// where dt_cfd is 1 ms, so its rest costs several times the planned steps'. The DEM step is
 /// not cut; the fluid's cost per cell-step is taken as the model's.
+/// Where the packed-bed limit is on and a packed bed's stable step (checks::packed_bed_stable_dt_s)
+/// lies below the step the rest is costed at, the same rest at that step is its upper end: the
+/// step falls towards it as a bed packs (the inclined 10 cP points from 1 ms to 0.3 ms within
+/// their first 1.3 s), and stays where no bed forms.
 struct Rest {
   double reached_s = 0.0;
   double fluid_step_s = 0.0;  ///< the step the rest is costed at, s
   CaseWork work;
+  double packed_step_s = 0.0;  ///< > 0: the packed bed's stable step, below fluid_step_s
+  CaseWork packed_work;        ///< the rest at packed_step_s
 };
 Rest rest_of(const fs::path& runs_root, const StudyCase& c) {
   Rest r;
@@ -79,6 +86,12 @@ Rest rest_of(const fs::path& runs_root, const StudyCase& c) {
   if (now_s > 0.0 && now_s < r.fluid_step_s) {
     r.work.fluid_cell_steps *= r.fluid_step_s / now_s;
     r.fluid_step_s = now_s;
+  }
+  const double packed_s = c.params.numerics.drag_dt_limit ? checks::packed_bed_stable_dt_s(c.params) : 0.0;
+  if (packed_s > 0.0 && packed_s < r.fluid_step_s && r.work.fluid_cell_steps > 0.0) {
+    r.packed_step_s = packed_s;
+    r.packed_work = r.work;
+    r.packed_work.fluid_cell_steps *= r.fluid_step_s / packed_s;
   }
   return r;
 }
@@ -123,8 +136,9 @@ namespace {
 struct PlanRows {
   nlohmann::json rows = nlohmann::json::array();
   report::TextTable table;
-  std::vector<double> pending_costs;  ///< core-seconds of each case still to run
-  double total_core_s = 0.0;          ///< of every case, done or not
+  std::vector<double> pending_costs;        ///< core-seconds of each case still to run
+  std::vector<double> pending_costs_upper;  ///< the same, each at its packed bed's step where lower
+  double total_core_s = 0.0;                ///< of every case, done or not
 };
 
 PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<std::string, CaseState>& states,
@@ -133,8 +147,11 @@ PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<st
   for (const auto& m : finished) measured_by_id[m.case_id] = &m;
   std::vector<std::string> header{"group", "varied", "case", "state", "core time"};
   if (opt.check_model) header.emplace_back("leave one out");
-  PlanRows out{
-      nlohmann::json::array(), report::TextTable(header, {false, false, false, false, true, false}), {}, 0.0};
+  PlanRows out{nlohmann::json::array(),
+               report::TextTable(header, {false, false, false, false, true, false}),
+               {},
+               {},
+               0.0};
   const fs::path root = opt.db_path.empty() ? fs::path() : fs::path(runs_root(opt.db_path));
   for (const auto& c : study.cases) {
     const auto it = states.find(c.id);
@@ -145,7 +162,11 @@ PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<st
     const Rest rest = st == CaseStatus::kDone ? Rest{} : rest_of(root, c);
     const double reached = rest.reached_s;
     const double left = st == CaseStatus::kDone ? 0.0 : reached > 0.0 ? model.core_s(rest.work) : est;
-    if (st != CaseStatus::kDone) out.pending_costs.push_back(left);
+    const double upper = rest.packed_step_s > 0.0 ? model.core_s(rest.packed_work) : left;
+    if (st != CaseStatus::kDone) {
+      out.pending_costs.push_back(left);
+      out.pending_costs_upper.push_back(upper);
+    }
     // The step the rest is costed at, where the run's own step is below time.dt_cfd.
     const bool cut_step = reached > 0.0 && rest.fluid_step_s < c.params.time.dt_cfd_s;
     nlohmann::json row = {
@@ -153,6 +174,14 @@ PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<st
         {"state", to_string(st)},   {"estimated_core_s", est}, {"reached_s", reached},
         {"remaining_core_s", left}, {"scene", c.params.scene}, {"cost_basis", model.basis(c.params.scene)}};
     if (cut_step) row["remaining_fluid_step_s"] = rest.fluid_step_s;
+    if (rest.packed_step_s > 0.0) {
+      row["remaining_core_s_packed_bed"] = upper;
+      row["packed_bed_step_s"] = rest.packed_step_s;
+    }
+    const std::string packed_text =
+        rest.packed_step_s > 0.0 ? fmt::format("; up to {} should a packed bed cut its step to {:.3g} ms",
+                                               duration(upper), 1e3 * rest.packed_step_s)
+                                 : std::string();
     const auto m = measured_by_id.find(c.id);
     if (m != measured_by_id.end()) row["measured_core_s"] = m->second->core_s;
     if (opt.check_model && m != measured_by_id.end()) {
@@ -165,10 +194,12 @@ PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<st
     std::vector<std::string> cells{
         c.group, swept_text(c), c.id, to_string(st),
         reached > 0.0
-            ? fmt::format("{} ({} left from t = {:g} s{})", duration(est), duration(left), reached,
+            ? fmt::format("{} ({} left from t = {:g} s{}{})", duration(est), duration(left), reached,
                           cut_step ? fmt::format(" at its step of {:.3g} ms", 1e3 * rest.fluid_step_s)
-                                   : std::string())
-            : duration(est)};
+                                   : std::string(),
+                          packed_text)
+        : packed_text.empty() ? duration(est)
+                              : fmt::format("{} ({})", duration(est), packed_text.substr(2))};
     if (opt.check_model)
       cells.push_back(row.contains("predicted_by_others_core_s")
                           ? fmt::format("measured {}, from the others {}", duration(m->second->core_s),
@@ -191,6 +222,8 @@ std::string plan_csv(const nlohmann::json& rows) {
                         "reached_s",
                         "remaining_core_s",
                         "remaining_fluid_step_s",
+                        "remaining_core_s_packed_bed",
+                        "packed_bed_step_s",
                         "measured_core_s",
                         "predicted_by_others_core_s",
                         "cost_basis"};
@@ -310,6 +343,7 @@ int study_plan(const PlanOptions& opt) {
   const CostModel model(finished);
   const PlanRows plan = plan_rows(study, opt, states, finished, model);
   const double wall = study_wall_s(plan.pending_costs, opt.jobs, opt.ranks);
+  const double wall_packed = study_wall_s(plan.pending_costs_upper, opt.jobs, opt.ranks);
   const RefineBudget refine = refine_budget(study, model, opt.jobs, opt.ranks);
   if (format == ListingFormat::kCsv) {
     std::fputs(plan_csv(plan.rows).c_str(), stdout);
@@ -322,6 +356,7 @@ int study_plan(const PlanOptions& opt) {
                      {"ranks", opt.ranks},
                      {"remaining_cases", plan.pending_costs.size()},
                      {"estimated_wall_s", wall},
+                     {"estimated_wall_s_packed_beds", wall_packed},
                      {"estimated_core_s_all_cases", plan.total_core_s}};
     if (study.refine)
       j["refinement"] = {{"max_cases", refine.cases},
@@ -338,9 +373,14 @@ int study_plan(const PlanOptions& opt) {
     std::printf("%s", plan.table.str().c_str());
   else
     std::fputs(plan_per_group(study, plan.rows).c_str(), stdout);
-  std::printf("estimated wall time of the cases to run: %s on %s x %s (parallel efficiency %.2f)\n",
+  std::printf("estimated wall time of the cases to run: %s on %s x %s (parallel efficiency %.2f)%s\n",
               duration(wall).c_str(), count_of(opt.jobs, "job").c_str(), count_of(opt.ranks, "rank").c_str(),
-              ranks_efficiency(opt.ranks));
+              ranks_efficiency(opt.ranks),
+              wall_packed > wall ? fmt::format("; up to {} should the beds that the packed-bed limit steps "
+                                               "for pack (numerics.drag_dt_limit)",
+                                               duration(wall_packed))
+                                       .c_str()
+                                 : "");
   if (study.refine) {
     std::printf(
         "[refine] may add at most %s to its curves (max_points %d a curve, each point with its replicas), "

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -205,15 +206,9 @@ double check_settling_scales(const CaseParams& p, Preflight& r) {
   return wt;
 }
 
-/// The exchange of a packed bed (random close packing, alpha_f 0.36, slip -> 0): the step its
-/// particles allow (coupling/drag_stability.hpp) against time.dt_cfd.
+/// The exchange of a packed bed (slip -> 0): the step its particles allow against time.dt_cfd.
 void check_packed_exchange(const CaseParams& p, Preflight& r) {
-  constexpr double kPackedAlphaF = 0.36;
-  const double d = p.particles.diameter_m, rho_f = p.fluid.density_kg_m3, mu = p.fluid.viscosity_pa_s;
-  const double beta = coupling::visit_drag_law(
-      p.forces.drag, [&](const auto& law) { return law.beta(kPackedAlphaF, 0.0, d, rho_f, mu); });
-  const double m_added = p.forces.added_mass ? 0.5 * rho_f * p.particle_volume_m3() : 0.0;
-  const double bound = coupling::drag_stable_dt_s(kPackedAlphaF, (p.particle_mass_kg() + m_added) / beta);
+  const double bound = packed_bed_stable_dt_s(p);
   add_item(r, "packed_bed_stable_dt", bound, "s",
            "largest dt_cfd of a stable exchange in a packed bed (alpha_f 0.36)");
   if (bound >= p.time.dt_cfd_s) return;
@@ -279,6 +274,18 @@ void check_likely_slips(const CaseParams& p, bool fluid, Preflight& r) {
 }
 
 }  // namespace
+
+double packed_bed_stable_dt_s(const CaseParams& p) {
+  const SceneSpec& sc = scene_spec(p.scene);
+  if (!sc.has_fluid || !sc.particles_move || p.forces.drag == "none" || p.particles.count < 1)
+    return std::numeric_limits<double>::infinity();
+  constexpr double kPackedAlphaF = 0.36;
+  const double d = p.particles.diameter_m, rho_f = p.fluid.density_kg_m3, mu = p.fluid.viscosity_pa_s;
+  const double beta = coupling::visit_drag_law(
+      p.forces.drag, [&](const auto& law) { return law.beta(kPackedAlphaF, 0.0, d, rho_f, mu); });
+  const double m_added = p.forces.added_mass ? 0.5 * rho_f * p.particle_volume_m3() : 0.0;
+  return coupling::drag_stable_dt_s(kPackedAlphaF, (p.particle_mass_kg() + m_added) / beta);
+}
 
 Preflight preflight(const CaseParams& p, int ranks) {
   Preflight r;

@@ -44,6 +44,12 @@ double machine_memory_bytes();
 /// arrays, neighbour list, linear solver work vectors, and the checkpoint gathered on rank 0.
 double memory_estimate_bytes(const CaseParams& p, int ranks);
 
+/// The largest fluid step (s) at which a packed bed's particle-fluid exchange is stable (random
+/// close packing, alpha_f 0.36; coupling/drag_stability.hpp): where numerics.drag_dt_limit is on,
+/// what the step falls towards as a bed packs. Infinite for a scene without fluid or drag, or
+/// particles that do not move.
+double packed_bed_stable_dt_s(const CaseParams& p);
+
 /// Binary collision time of the linear spring-dashpot for two equal spheres with restitution e
 /// (s): pi / (omega_0 sqrt(1 - zeta^2)), omega_0 = sqrt(k / m_eff), m_eff = m / 2.
 double collision_time_s(double mass_kg, double stiffness_n_m, double restitution);

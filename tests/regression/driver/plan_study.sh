@@ -3,7 +3,8 @@
 # study ran, each finished case's cost (its CPU time) predicted by the model fitted to the other
 # five (leave one out) is within 30 % of its measured cost in at least one of two identical
 # studies; a case that has run part of its time counts only the rest (all of it in a scene that
-# keeps no checkpoints: its rerun starts over), at the fluid step it takes now; swept numbers are shown as
+# keeps no checkpoints: its rerun starts over), at the fluid step it takes now, and up to its cost at a
+# packed bed's stable step where the packed-bed limit is on; swept numbers are shown as
 # written; bad --jobs exits 2; `study run` prints
 # the plan line before it starts and writes the tree of readable names beside the run folders.
 #   plan_study.sh BOYCOTT_BIN STUDY.toml
@@ -62,6 +63,29 @@ assert r2["remaining_fluid_step_s"] == 0.0005, r2
 # At dt_cfd / 2 one more rest's worth of fluid stepping, at dt_cfd / 3 two more.
 fluid = r2["remaining_core_s"] - r1["remaining_core_s"]
 assert fluid > 0 and abs((r3["remaining_core_s"] - r1["remaining_core_s"]) / fluid - 2.0) < 1e-6, (r1, r2, r3)
+PY
+# Where the packed-bed limit is on and a packed bed's stable step (0.13 ms at 10 cP) is below the
+# step the rest is costed at, the plan gives the rest at that step as its upper end (the fluid
+# cell-steps grow as step / packed step, at the model's cost per cell-step); with it off, none.
+printf 'name = "plan_packed"\n[base]\nscene = "inclined_settling"\n[base.fluid]\nviscosity = 1.0e-2\n[base.domain]\nlength_x = 0.02\nwidth_y = 0.006\nheight_z = 0.02\ncells = [20, 6, 20]\n[base.time]\nend = 0.3\naverage_from = 0.05\n[matrix]\n"numerics.drag_dt_limit" = [true, false]\n' \
+  > "$work/packed.toml"
+"$bin" study plan "$work/packed.toml" --db "$work/packed.db" --format json > "$work/packed.json"
+"$bin" study plan "$work/packed.toml" --db "$work/packed.db" > "$work/packed.txt"
+grep -q 'up to .* should a packed bed cut its step to 0.1[0-9]* ms)' "$work/packed.txt" || { cat "$work/packed.txt"; exit 1; }
+grep -q 'should the beds that the packed-bed limit steps for pack' "$work/packed.txt" || { cat "$work/packed.txt"; exit 1; }
+python3 - "$work/packed.json" <<'PY'
+import json, sys
+p = json.load(open(sys.argv[1]))
+on, off = p["cases"]
+assert "remaining_core_s_packed_bed" not in off, off
+assert on["remaining_core_s"] == off["remaining_core_s"] == on["estimated_core_s"], (on, off)
+step = on["packed_bed_step_s"]
+assert 1e-4 < step < 2e-4, step
+# The default model's 1.35 us per fluid cell-step over 2 400 cells and 0.3 s at 1 ms.
+fluid = 1.35e-6 * 2400 * 300
+extra = on["remaining_core_s_packed_bed"] - on["remaining_core_s"]
+assert abs(extra / (fluid * (1e-3 / step - 1)) - 1) < 1e-9, (on, extra)
+assert p["estimated_wall_s_packed_beds"] > p["estimated_wall_s"], p
 PY
 rm -rf "$db.runs"
 # A scene that keeps no checkpoints (dem_only) starts over: its time series does not count.
