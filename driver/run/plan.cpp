@@ -109,21 +109,26 @@ PlanEstimate plan_estimate(Database& db, const Study& study, const std::vector<s
   const CostModel model(measured(db));
   std::map<std::string, const StudyCase*> by_id;
   for (const auto& c : study.cases) by_id[c.id] = &c;
-  std::vector<double> costs;
+  std::vector<double> costs, packed;
   std::map<std::string, bool> scenes;
   for (const auto& id : to_run_ids)
     if (const auto it = by_id.find(id); it != by_id.end()) {
-      costs.push_back(model.core_s(rest_of(runs_root, *it->second).work));
+      const Rest rest = rest_of(runs_root, *it->second);
+      costs.push_back(model.core_s(rest.work));
+      packed.push_back(rest.packed_step_s > 0.0 ? model.core_s(rest.packed_work) : costs.back());
       scenes[it->second->params.scene] = true;
     }
   std::string basis;
   for (const auto& [scene, _] : scenes)
     basis += (basis.empty() ? "" : ", ") + scene + ": " + model.basis(scene);
+  const double wall = study_wall_s(costs, jobs, ranks), wall_packed = study_wall_s(packed, jobs, ranks);
   PlanEstimate e;
-  e.line = fmt::format("plan: {} to run, estimated {} on {} x {} (cost model {})",
-                       count_of(static_cast<long long>(costs.size()), "case"),
-                       duration(study_wall_s(costs, jobs, ranks)), count_of(jobs, "job"),
-                       count_of(ranks, "rank"), basis.empty() ? "-" : basis);
+  e.line = fmt::format("plan: {} to run, estimated {}{} on {} x {} (cost model {})",
+                       count_of(static_cast<long long>(costs.size()), "case"), duration(wall),
+                       wall_packed > wall ? fmt::format(" (up to {} should packed beds cut the fluid step)",
+                                                        duration(wall_packed))
+                                          : std::string(),
+                       count_of(jobs, "job"), count_of(ranks, "rank"), basis.empty() ? "-" : basis);
   double sum = 0.0;
   for (double c : costs) sum += study_wall_s({c}, 1, ranks);
   e.mean_case_wall_s = costs.empty() ? 0.0 : sum / static_cast<double>(costs.size());
