@@ -45,6 +45,10 @@ Command setup_study_run(CLI::App* parent) {
                   "seconds between progress lines when stderr is not a terminal")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  cmd->add_option(
+         "--stop-after", a->opt.stop_after_s,
+         "seconds after which every running case checkpoints and stops (exit 75: run again to resume)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--quiet", a->quiet, "no progress output");
   // For tests and for other solver builds: the command that runs one case.
   cmd->add_option("--solver-command", a->opt.solver_command, "")->group("");

@@ -1,5 +1,6 @@
 #include "driver/run/runner.hpp"
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -72,7 +73,12 @@ void print_study_results(Database& db, const Study& study, int done) {
 
 }  // namespace
 
-int study_run(const StudyRunOptions& opt) {
+int study_run(const StudyRunOptions& options) {
+  StudyRunOptions opt = options;
+  if (opt.stop_after_s > 0.0)
+    opt.stop_at =
+        std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                               std::chrono::duration<double>(opt.stop_after_s));
   if (opt.jobs < 1) throw InputError(fmt::format("--jobs = {} must be >= 1", opt.jobs));
   if (opt.retries < 0) throw InputError(fmt::format("--retries = {} must be >= 0", opt.retries));
   if (opt.ranks < 1) throw InputError(fmt::format("--ranks = {} must be >= 1", opt.ranks));
@@ -139,8 +145,10 @@ int study_run(const StudyRunOptions& opt) {
     failed += s.status == CaseStatus::kFailed;
   }
   if (stopped) {
-    std::printf("study %s stopped by signal %d: %d of %s done; run the same command to resume\n",
-                study.name.c_str(), stop_signal(), done, count_of(n_total, "case").c_str());
+    const std::string by = stop_signal() ? fmt::format("by signal {}", stop_signal())
+                                         : fmt::format("after --stop-after {:g} s", opt.stop_after_s);
+    std::printf("study %s stopped %s: %d of %s done; run the same command to resume\n", study.name.c_str(),
+                by.c_str(), done, count_of(n_total, "case").c_str());
     return kExitInterrupted;
   }
   std::printf("study %s: %d of %s done, %d failed\n", study.name.c_str(), done,

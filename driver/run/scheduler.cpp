@@ -71,7 +71,8 @@ bool Scheduler::run() {
   std::set<const StudyCase*> told_locked;
   while (!queue_.empty() || !running_.empty() || !backing_off_.empty()) {
     bool lock_wait = false;
-    if (stop_signal() && !stopping_) stop_all();
+    const bool out_of_time = opt_.stop_at && Clock::now() >= *opt_.stop_at;
+    if ((stop_signal() || out_of_time) && !stopping_) stop_all();
     if (stopping_) backing_off_.clear();  // they stay pending in the database
     // Back in the queue once their back-off has passed.
     const auto now = Clock::now();

@@ -10,6 +10,7 @@
 #include <deque>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -32,6 +33,12 @@ struct StudyRunOptions {
   std::string solver_command;
   bool progress_live = false;      ///< redrawn in place (stderr is a terminal)
   double progress_every_s = 30.0;  ///< otherwise a plain block this often (<= 0: none)
+  /// > 0: this many wall seconds after `study run` started, every running case is asked to
+  /// checkpoint and stop, as by a SIGTERM to the driver, and no case starts (a session or a
+  /// machine booked until a given hour: nothing run is lost, the same command resumes).
+  double stop_after_s = 0.0;
+  /// When stop_after_s runs out: set by study_run at its start (steady clock).
+  std::optional<std::chrono::steady_clock::time_point> stop_at;
 };
 
 class Scheduler {
@@ -41,8 +48,9 @@ class Scheduler {
   Scheduler(Database& db, const Study& study, const std::vector<CaseState>& states,
             const StudyRunOptions& opt, std::filesystem::path runs_root, std::vector<std::string> solver);
 
-  /// Runs cases until the queue is empty, or after a stop signal (or too many storage errors in
-  /// a row) until the running cases have checkpointed and exited; true when a stop ended it.
+  /// Runs cases until the queue is empty, or after a stop signal or opt.stop_at (or too many
+  /// storage errors in a row) until the running cases have checkpointed and exited; true when a
+  /// stop ended it.
   bool run();
   /// Why the study stopped for storage errors; empty when it did not.
   const std::string& storage_stop() const { return storage_stop_; }

@@ -275,6 +275,35 @@ TEST(StudyStatus, ARunFinishedAtAnEndSinceRaisedIsNotListedAsUncollected) {
   EXPECT_EQ(r.out.find("not recorded yet"), std::string::npos) << r.out;
 }
 
+// `study run --stop-after S`: after S wall seconds every running case checkpoints and stops as on
+// a SIGTERM to the driver (exit 75, the case interrupted, not failed), and the same command
+// resumes it. The fake's 1 000 steps of 0.05 s of wall time each cannot finish in the 1 s given,
+// on any machine: nothing here depends on how fast it runs.
+TEST(StudyRun, StopAfterCheckpointsTheRunningCasesAndTheSameCommandResumes) {
+  TempDir d;
+  std::string study = kOneCase;
+  study.replace(study.find("end = 0.8"), 9, "end = 100.0");
+  write(d.path / "s.toml", study);
+  const auto db = d.path / "s.db";
+  auto args = study_run(d.path / "s.toml", db);
+  args.insert(args.end(), {"--stop-after", "1"});
+  const std::map<std::string, std::string> env{{"FAKE_STEP_WALL_S", "0.05"}};
+  for (int attempt = 1; attempt <= 2; ++attempt) {
+    const auto r = run(args, d.path, env);
+    EXPECT_EQ(r.rc, 75) << r.out << r.err;
+    EXPECT_NE(r.out.find("stopped after --stop-after 1 s: 0 of 1 case done; run the same command to resume"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 75"), attempt);
+    EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status <> 75"), 0);
+  }
+  const auto st = run({"study", "status", (d.path / "s.toml").string(), "--db", db.string()}, d.path);
+  EXPECT_NE(st.out.find("0 failed, 1 interrupted"), std::string::npos) << st.out;
+  const auto bad =
+      run({"study", "run", (d.path / "s.toml").string(), "--db", db.string(), "--stop-after", "0"}, d.path);
+  EXPECT_EQ(bad.rc, 2) << bad.err;
+}
+
 // Two angles bracket no peak: `query peak` shows the higher point, says why, and gives its angle
 // no interval (a zero-width one would read as a peak known exactly).
 TEST(Queries, APeakOfTwoPointsIsNotEstimatedAndSaysSo) {
