@@ -267,9 +267,9 @@ std::string plan_per_group(const Study& study, const nlohmann::json& rows) {
 }
 
 /// The most a study's [refine] may still add: per curve of three points or more, the points
-/// max_points leaves, each with
-/// as many replicas as its group may run, at the cost of the curve's first case with refine's set
-/// applied; the rounds run one after another, the curves of a round side by side.
+/// max_points leaves, each with as many replicas as its group may run, at the cost of the curve's
+/// first case with refine's set applied (at a packed bed's stable step where the packed-bed limit
+/// is on); the rounds run one after another, the curves of a round side by side.
 struct RefineBudget {
   long long cases = 0;
   double core_s = 0.0, wall_s = 0.0;
@@ -292,8 +292,9 @@ RefineBudget refine_budget(const Study& study, const CostModel& model, int jobs,
     const int left = points < stats::kBracketPoints ? 0 : std::max(0, study.refine->max_points - added);
     const auto plan = study.replica_plans.find(curve.group);
     const int replicas = plan == study.replica_plans.end() ? 1 : plan->second.max;
-    const double point_s =
-        model.core_s(work_of(refined_case(study, curve, curve.first->params.gravity.angle_deg, 0)));
+    // At most: where the packed-bed limit is on, at a packed bed's stable step.
+    const Rest point = rest_of({}, refined_case(study, curve, curve.first->params.gravity.angle_deg, 0));
+    const double point_s = model.core_s(point.packed_step_s > 0.0 ? point.packed_work : point.work);
     const long long cases = static_cast<long long>(left) * replicas;
     b.cases += cases;
     b.core_s += static_cast<double>(cases) * point_s;

@@ -87,6 +87,16 @@ extra = on["remaining_core_s_packed_bed"] - on["remaining_core_s"]
 assert abs(extra / (fluid * (1e-3 / step - 1)) - 1) < 1e-9, (on, extra)
 assert p["estimated_wall_s_packed_beds"] > p["estimated_wall_s"], p
 PY
+# [refine]'s "at most" prices an added point of such a curve at the packed bed's step as well.
+printf 'name = "plan_packed_refine"\n[base]\nscene = "inclined_settling"\n[base.fluid]\nviscosity = 1.0e-2\n[base.numerics]\ndrag_dt_limit = true\n[base.domain]\nlength_x = 0.02\nwidth_y = 0.006\nheight_z = 0.02\ncells = [20, 6, 20]\n[base.time]\nend = 0.3\naverage_from = 0.05\n[matrix]\n"gravity.angle_deg" = [30, 60, 90]\n[refine]\nkey = "gravity.angle_deg"\nresolution = 5.0\nmax_points = 1\n' \
+  > "$work/packed_refine.toml"
+"$bin" study plan "$work/packed_refine.toml" --db "$work/packed.db" --format json > "$work/packed_refine.json"
+python3 - "$work/packed_refine.json" <<'PY'
+import json, sys
+p = json.load(open(sys.argv[1]))
+curve, case = p["refinement"]["curves"][0], p["cases"][0]
+assert curve["max_cases"] == 1 and curve["max_core_s"] == case["remaining_core_s_packed_bed"], (curve, case)
+PY
 rm -rf "$db.runs"
 # A scene that keeps no checkpoints (dem_only) starts over: its time series does not count.
 printf 'name = "plan_restart"\n[base]\nscene = "dem_only"\n[base.domain]\nlength_x = 0.01\nheight_z = 0.01\n[base.time]\nend = 0.3\naverage_from = 0.05\n' \
