@@ -76,6 +76,8 @@ struct Rest {
   CaseWork work;
   double packed_step_s = 0.0;  ///< > 0: the packed bed's stable step, below fluid_step_s
   CaseWork packed_work;        ///< the rest at packed_step_s
+  /// The rest at its upper end: at the packed bed's step where there is one.
+  const CaseWork& upper_work() const { return packed_step_s > 0.0 ? packed_work : work; }
 };
 Rest rest_of(const fs::path& runs_root, const StudyCase& c) {
   Rest r;
@@ -115,7 +117,7 @@ PlanEstimate plan_estimate(Database& db, const Study& study, const std::vector<s
     if (const auto it = by_id.find(id); it != by_id.end()) {
       const Rest rest = rest_of(runs_root, *it->second);
       costs.push_back(model.core_s(rest.work));
-      packed.push_back(rest.packed_step_s > 0.0 ? model.core_s(rest.packed_work) : costs.back());
+      packed.push_back(model.core_s(rest.upper_work()));
       scenes[it->second->params.scene] = true;
     }
   std::string basis;
@@ -184,7 +186,7 @@ PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<st
       row["packed_bed_step_s"] = rest.packed_step_s;
     }
     const std::string packed_text =
-        rest.packed_step_s > 0.0 ? fmt::format("; up to {} should a packed bed cut its step to {:.3g} ms",
+        rest.packed_step_s > 0.0 ? fmt::format("up to {} should a packed bed cut its step to {:.3g} ms",
                                                duration(upper), 1e3 * rest.packed_step_s)
                                  : std::string();
     const auto m = measured_by_id.find(c.id);
@@ -202,9 +204,9 @@ PlanRows plan_rows(const Study& study, const PlanOptions& opt, const std::map<st
             ? fmt::format("{} ({} left from t = {:g} s{}{})", duration(est), duration(left), reached,
                           cut_step ? fmt::format(" at its step of {:.3g} ms", 1e3 * rest.fluid_step_s)
                                    : std::string(),
-                          packed_text)
+                          packed_text.empty() ? std::string() : "; " + packed_text)
         : packed_text.empty() ? duration(est)
-                              : fmt::format("{} ({})", duration(est), packed_text.substr(2))};
+                              : fmt::format("{} ({})", duration(est), packed_text)};
     if (opt.check_model)
       cells.push_back(row.contains("predicted_by_others_core_s")
                           ? fmt::format("measured {}, from the others {}", duration(m->second->core_s),
@@ -294,7 +296,7 @@ RefineBudget refine_budget(const Study& study, const CostModel& model, int jobs,
     const int replicas = plan == study.replica_plans.end() ? 1 : plan->second.max;
     // At most: where the packed-bed limit is on, at a packed bed's stable step.
     const Rest point = rest_of({}, refined_case(study, curve, curve.first->params.gravity.angle_deg, 0));
-    const double point_s = model.core_s(point.packed_step_s > 0.0 ? point.packed_work : point.work);
+    const double point_s = model.core_s(point.upper_work());
     const long long cases = static_cast<long long>(left) * replicas;
     b.cases += cases;
     b.core_s += static_cast<double>(cases) * point_s;
