@@ -18,6 +18,9 @@ Command setup_case_run(CLI::App* parent, int argc, char** argv, std::vector<std:
                   "seconds between progress lines when stderr is not a terminal")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--stop-after", opt->stop_after_s,
+                  "seconds after which the run checkpoints and stops (exit 75: run again to resume)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--from", opt->from_dir,
                   "branch: start from this run folder's newest kept checkpoint (with this case's parameters)")
       ->check(CLI::ExistingDirectory);

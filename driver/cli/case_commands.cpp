@@ -1,6 +1,7 @@
 #include "driver/cli/case_commands.hpp"
 
 #include <mpi.h>
+#include <sys/time.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -48,6 +49,20 @@ void catch_stop_signals() {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
   sigaction(SIGUSR1, &sa, nullptr);  // a Slurm task's wall-time warning (study submit)
+}
+
+/// --stop-after: the same stop, asked by a timer after `seconds` of wall time (every rank sets its
+/// own; the run agrees on the step to stop at as for a signal, RunContext::should_stop).
+void stop_after(double seconds) {
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGALRM, &sa, nullptr);
+  itimerval t{};
+  t.it_value.tv_sec = static_cast<time_t>(seconds);
+  t.it_value.tv_usec = static_cast<suseconds_t>(1e6 * (seconds - static_cast<double>(t.it_value.tv_sec)));
+  if (t.it_value.tv_sec == 0 && t.it_value.tv_usec == 0) t.it_value.tv_usec = 1;
+  setitimer(ITIMER_REAL, &t, nullptr);
 }
 
 /// One line at the end of a run: its status, how far, how long, and its main result.
@@ -137,6 +152,7 @@ int case_run(const CaseRunOptions& opt, int argc, char** argv) {
   char** pargv = argv;
   fluid::PetscSession petsc(&pargc, &pargv, petsc_opts);
   catch_stop_signals();
+  if (opt.stop_after_s > 0.0) stop_after(opt.stop_after_s);
   scenes::RunContext ctx;
   ctx.out_dir = opt.out_dir;
   ctx.stop_requested = &g_stop;

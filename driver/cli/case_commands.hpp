@@ -15,6 +15,7 @@ struct CaseRunOptions {
   double progress_every_s = 30.0;  ///< between plain progress lines (stderr not a terminal)
   std::string from_dir;            ///< branch from this run folder's checkpoint (empty: none)
   double at_s = -1.0;              ///< ... the newest at or before this time, s (< 0: the newest)
+  double stop_after_s = 0.0;       ///< > 0: checkpoint and stop (exit 75) after this wall time, s
 };
 
 /// `boycott case run`: exit code as README.md, "Running a case", lists them.
