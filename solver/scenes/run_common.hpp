@@ -43,7 +43,8 @@ nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const Mod
 
 /// Appends rows to a CSV file with a fixed header; creates it (with the header) when absent.
 /// Appending to a file with fewer columns (of an earlier build), it writes only those.
-/// Only the output rank writes. A row that could not be written (disk full, I/O error) is a
+/// Only the output rank writes, each row through to the file at once (readers follow a running
+/// case by its last row). A row that could not be written (disk full, I/O error) is a
 /// StorageError at the next flush(), naming the file and the cause.
 class CsvWriter {
  public:

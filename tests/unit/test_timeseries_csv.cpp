@@ -43,3 +43,19 @@ TEST(TimeSeriesCsv, AResumeKeepsTheColumnsOfAnEarlierBuildsFile) {
   EXPECT_EQ(read(path), "time_s,a,b\n0.1,1,10\n");
   std::filesystem::remove_all(dir);
 }
+
+// A running case is followed by its file's last row (`study run`'s progress, `study status`):
+// every row is in the file once row() returns, not when a buffer fills or the writer closes.
+TEST(TimeSeriesCsv, EachRowIsInTheFileAsSoonAsItIsWritten) {
+  const auto dir = std::filesystem::temp_directory_path() / "boycott_timeseries_csv_rows";
+  std::filesystem::create_directories(dir);
+  const auto path = dir / "timeseries.csv";
+  {
+    scenes::CsvWriter w(path, {"time_s", "a"}, false);
+    w.row({0.1, 1.0});
+    EXPECT_EQ(read(path), "time_s,a\n0.1,1\n");
+    w.row({0.2, 2.0});
+    EXPECT_EQ(read(path), "time_s,a\n0.1,1\n0.2,2\n");
+  }
+  std::filesystem::remove_all(dir);
+}
