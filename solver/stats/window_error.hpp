@@ -22,7 +22,7 @@ namespace boycott::stats {
 /// k is as many batches of kCorrelationTimesPerBatch correlation times as the conservative count
 /// (AutocorrelationError::batch_count: of tau_int, or of correlation spans where those are fewer,
 /// as in an oscillation whose lobes cancel in tau_int) allows, two at least and kMaxBatches at most: the two
-/// halves of the series (basis two_halves, 1 degree of freedom, t = 1.84) in runs of fewer than 60
+/// halves of the series (basis two_halves, 1 degree of freedom, t = 1.84) in runs of fewer than 120
 /// counted correlation times, where no count could be made, and always in short series.
 ///
 /// Why at most 8 batches: the count comes from Sokal's tau_int, which a slow part of small weight
@@ -36,6 +36,15 @@ namespace boycott::stats {
 /// batches grow with the window, so that whatever the data hide, the correlation of neighbours
 /// falls as 1 / N; its price is small: t_7 times the scatter of an 8-batch error is 1.04 true
 /// standard errors on average, against 1.00 with many batches (docs/validation.md, "One run").
+///
+/// Why 40 counted correlation times a batch, not 20: the same slow part that fools the count makes
+/// neighbouring batches of 20 correlate, so the batches agree more than independent ones would. At
+/// 20 the two-scale family covered 0.658 at 50 slowest times, and after an automatic cut that
+/// missed a decay worth 1 standard error 0.630 (two scales) and 0.642 (oscillation); at 40 they
+/// cover 0.672, 0.655 and 0.669, and every family figure lies in 0.65-0.71 (docs/validation.md,
+/// "Series that are not AR(1)"). The price falls on series with one time scale, which 20 already
+/// served: AR(1) keeps the two halves up to 120 counted times, and its mean half-width is 1.47 true
+/// standard errors at 100 correlation times (1.30 at 20 a batch) and 1.30 at 200 (1.08).
 ///
 /// Why not Sokal's error itself: in a short series tau_int is estimated low exactly where the
 /// mean has wandered (the autocovariances are taken about the wandered mean), so its error covers
@@ -53,7 +62,7 @@ struct MeanError {
   double dof = 0.0;             ///< degrees of freedom of stderr_of_mean, k - 1
   double covering_error = 0.0;  ///< stderr_of_mean * t_dof, covering ~68 %
   static constexpr double kGapFraction = 0.1;
-  static constexpr double kCorrelationTimesPerBatch = 20.0;
+  static constexpr double kCorrelationTimesPerBatch = 40.0;
   static constexpr int kMaxBatches = 8;
 };
 /// `e` is autocorrelation_error(x); at most max_batches batches (the first stage of a precision

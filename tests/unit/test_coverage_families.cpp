@@ -70,11 +70,14 @@ TEST(FamilyCoverage, OneRunErrorCoversTwoThirdsFrom10SlowestTimesOnEveryFamily) 
     const char* family;
     double window, settled;
   };
-  const Figure figures[] = {{"ar1", 10, 0.6661},         {"ar1", 50, 0.6847},
-                            {"ar1", 200, 0.6800},        {"two_scales", 10, 0.6713},
-                            {"two_scales", 20, 0.6732},  {"two_scales", 50, 0.6578},
-                            {"two_scales", 200, 0.6764}, {"oscillation", 10, 0.6922},
-                            {"oscillation", 50, 0.6913}, {"oscillation", 200, 0.6861}};
+  // Settled with batches of 40 counted correlation times (window_error.hpp); with 20 the two-scale
+  // figures read 0.6713 / 0.6732 / 0.6578 / 0.6764 (the one at 50 slowest times 1.8 binomial
+  // errors above the promise's floor, its neighbouring batches correlating through the slow part).
+  const Figure figures[] = {{"ar1", 10, 0.6661},         {"ar1", 50, 0.6848},
+                            {"ar1", 200, 0.6763},        {"two_scales", 10, 0.6739},
+                            {"two_scales", 20, 0.6796},  {"two_scales", 50, 0.6719},
+                            {"two_scales", 200, 0.6748}, {"oscillation", 10, 0.6906},
+                            {"oscillation", 50, 0.6827}, {"oscillation", 200, 0.6864}};
   std::uint64_t seed = 61000;
   for (const auto& f : figures)
     expect_figure(one_run_coverage(f.family, f.window, ++seed), f.settled,
@@ -85,8 +88,8 @@ TEST(FamilyCoverage, AnErrorFivePerCentTooNarrowFallsOutsideTheBand) {
   // The planted defect: the same figure with every half-width 5 % narrower, which moves a
   // coverage near 0.68 by up to 2 phi(1) 0.05 ~ 0.024 (less where few degrees of freedom flatten
   // the distribution at the bar's end); the band must not let it through.
-  const double settled = 0.6800;  // ar1, 200 correlation times, seed as above
-  const double defective = one_run_coverage("ar1", 200, 61003, 0.95);
+  const double settled = 0.6763;  // ar1, 200 correlation times, seed as above
+  const double defective = one_run_coverage("ar1", 200, 61003, 0.95);  // 0.6580
   EXPECT_GT(std::abs(defective - settled), kBand);
 }
 
@@ -153,18 +156,20 @@ TEST(EarlyStopCoverage, TheErrorAtTheStopCoversTwoThirdsOnAr1AtThreeTargets) {
   }
 }
 
-// Settled on 10 000 series per family under the tau_int trigger and 4 batches at the first stage
-// (the test was disabled after 2 000 series gave 0.653 / 0.646 on two scales / oscillation at an
-// earlier state of the rules; on the merged rules 2 000 series give 0.653 / 0.679). Every series
-// counts: 0.8 / 2.0 / 6.4 % never stop within 12x the goal and report their end's fixed-window
-// error, which covers 0.618 / 0.618 / 0.686 of them; over the stopped ones alone the figures were
-// 0.6761 / 0.6547 / 0.6834. Two scales sits 1 binomial error above the promise's 0.65.
+// Settled on 10 000 series per family under the tau_int trigger, 4 batches at most at the first
+// stage and batches of 40 counted correlation times (the test was disabled after 2 000 series gave
+// 0.653 / 0.646 on two scales / oscillation at an earlier state of the rules). Every series
+// counts: 1.9 / 2.8 / 6.7 % never stop within 12x the goal and report their end's fixed-window
+// error, which covers 0.589 / 0.638 / 0.689 of them; over the stopped ones alone the figures are
+// 0.6696 / 0.6535 / 0.6821. With batches of 20: 0.6757 / 0.6540 / 0.6835, 0.8 / 2.0 / 6.4 %
+// unstopped (the first stage's conservative count now often makes 3 batches, not 4, so its plan
+// scatters more). Two scales sits within 1 binomial error above the promise's 0.65.
 TEST(FamilyCoverage, ARunTheTargetStopsCoversTwoThirdsOnEveryFamily) {
   struct Figure {
     const char* family;
     double goal, settled;
   };
-  const Figure figures[] = {{"ar1", 300, 0.6757}, {"two_scales", 300, 0.6540}, {"oscillation", 300, 0.6835}};
+  const Figure figures[] = {{"ar1", 300, 0.6681}, {"two_scales", 300, 0.6531}, {"oscillation", 300, 0.6826}};
   std::uint64_t seed = 62000;
   for (const auto& f : figures)
     expect_figure(target_coverage(f.family, f.goal, ++seed).coverage, f.settled, f.family);
@@ -214,7 +219,7 @@ TEST(FamilyCoverage, AnAutomaticWindowCutsFewStationarySeriesAndItsErrorCovers) 
     const char* family;
     double settled;
   };
-  const Figure figures[] = {{"ar1", 0.6810}, {"two_scales", 0.6529}, {"oscillation", 0.6915}};
+  const Figure figures[] = {{"ar1", 0.6815}, {"two_scales", 0.6635}, {"oscillation", 0.6873}};
   std::uint64_t seed = 63000;
   for (const auto& f : figures) {
     const AutoFigures a = auto_window_figures(f.family, 50.0, 0.0, ++seed);
@@ -234,7 +239,7 @@ TEST(FamilyCoverage, AnAutomaticWindowCutsAStrongTransientToBelowHalfAStandardEr
   // alone the oscillation's transient went unseen in 6.7 % of series (0.904 unbiased, 0.672
   // covered), now in 1.1 %.
   const Figure figures[] = {
-      {"ar1", 0.6926, 0.9994}, {"two_scales", 0.6569, 0.9847}, {"oscillation", 0.6847, 0.9603}};
+      {"ar1", 0.6926, 0.9994}, {"two_scales", 0.6633, 0.9847}, {"oscillation", 0.6818, 0.9603}};
   std::uint64_t seed = 64000;
   for (const auto& f : figures) {
     const AutoFigures a = auto_window_figures(f.family, 50.0, 3.0, ++seed);
@@ -253,19 +258,21 @@ TEST(FamilyCoverage, AnAutomaticWindowCutsAStrongTransientToBelowHalfAStandardEr
 // product's rule cuts); the bound reaches 0.9 only from a bias of 1.07 / 1.14 / 1.29 standard
 // errors. The product's rule, which knows neither, leaves the settled figures below unbiased
 // (0.71 / 0.62 / 0.35 of the bound at its own rates; 0.58 / 0.47 / 0.27 when only a single
-// segment's failure detected a transient) and covers 0.63-0.68 (docs/validation.md).
+// segment's failure detected a transient). What it leaves its error still covers, 0.655-0.678:
+// the two halves' width, which batches of 40 counted correlation times keep at 50 slowest times,
+// takes in part of the bias (with batches of 20: 0.630 / 0.642 on two scales / oscillation).
 TEST(FamilyCoverage, AWeakTransientIsSeenNoMoreOftenThanTheBestTestAllows) {
   struct Figure {
     const char* family;
     double coverage, unbiased, bound;
   };
-  const Figure figures[] = {{"ar1", 0.6783, 0.6085, 0.866},
-                            {"two_scales", 0.6299, 0.4856, 0.831},
-                            {"oscillation", 0.6423, 0.2116, 0.759}};
+  const Figure figures[] = {{"ar1", 0.6784, 0.6085, 0.866},
+                            {"two_scales", 0.6552, 0.4856, 0.831},
+                            {"oscillation", 0.6692, 0.2116, 0.759}};
   std::uint64_t seed = 66000;
   for (const auto& f : figures) {
     const AutoFigures a = auto_window_figures(f.family, 50.0, 1.0, ++seed);
-    EXPECT_NEAR(a.coverage, f.coverage, kBand) << f.family;
+    expect_figure(a.coverage, f.coverage, f.family);
     EXPECT_NEAR(a.unbiased, f.unbiased, kBand) << f.family;
     EXPECT_LE(a.unbiased, f.bound + kBand) << f.family;
   }
@@ -306,7 +313,7 @@ TEST(FamilyCoverage, BlockBootstrapOfThe75DegreeRunsFluctuationsIsCovered) {
   struct Figure {
     double window, settled;
   };
-  for (const Figure f : {Figure{50.0, 0.6870}, Figure{100.0, 0.6829}}) {
+  for (const Figure f : {Figure{50.0, 0.6870}, Figure{100.0, 0.6767}}) {
     std::mt19937_64 rng(65000 + static_cast<int>(f.window));
     std::uniform_int_distribution<std::size_t> start(0, x.size() - 1);
     const auto n = static_cast<std::size_t>(f.window * e.tau_int);

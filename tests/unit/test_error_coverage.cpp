@@ -251,8 +251,8 @@ std::vector<SingleRunCoverage> single_run_coverage(double tau, double window, st
 }  // namespace
 
 TEST(ErrorCoverage, SingleRunErrorCoversTwoThirdsFrom10To200CorrelationTimes) {
-  // One run's covering error: batch means with t at k - 1 degrees of freedom, one batch per 20
-  // correlation times counted conservatively and two at least (the two halves below 60), a
+  // One run's covering error: batch means with t at k - 1 degrees of freedom, one batch per 40
+  // correlation times counted conservatively and two at least (the two halves below 120), a
   // correlation time left out at each border. Every run reports one. Sokal's estimate, reported
   // above 20 counted correlation times until the batches replaced it, over-covered at 40-100
   // (0.70-0.715 over seeds: the runs whose tau_int was estimated low clear the bar first and
