@@ -4,9 +4,10 @@
 # `study collect` records them in a scratch database, and `query curve` writes the CSV and the plots.
 #   scripts/results_from_summaries.sh [BOYCOTT_BIN]
 # Writes docs/results/paper_base_full.csv, each group's peak (query peak) to
-# docs/results/paper_base_full_peaks.csv, one row per committed run (its window, error basis,
-# correlation times, wall time and core-hours: wall time x ranks) to
-# docs/results/paper_base_full_runs.csv, and docs/plots/paper_base_full.{png,pdf}.
+# docs/results/paper_base_full_peaks.csv, one row per finished run (query runs: its window, error
+# basis, correlation times, wall time and core-hours) to docs/results/paper_base_full_runs.csv, and
+# docs/plots/paper_base_full.{png,pdf}. A committed run that stops short of the end its case now
+# asks (raised later) is on neither the curve nor the runs list until a run reaches that end.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${1:-$root/build/driver/boycott}
@@ -21,36 +22,9 @@ done
 "$bin" query curve --db "$work/full.db" --study paper_base_full --format csv > "$root/docs/results/paper_base_full.csv"
 "$bin" query peak --db "$work/full.db" --study paper_base_full --format csv \
   > "$root/docs/results/paper_base_full_peaks.csv"
-"$bin" study status "$root/studies/paper_base_full.toml" --db "$work/full.db" --format csv > "$work/status.csv"
-python3 - "$root/docs/results" "$work/status.csv" <<'PY'
-import csv, glob, json, os, sys
-results = sys.argv[1]
-cases = {r["case"]: r for r in csv.DictReader(open(sys.argv[2]))}
-cols = ["case_id", "group", "angle_deg", "n_particles", "end_s", "average_from_s",
-        "mean_settling_velocity_m_s", "error_m_s", "error_method", "error_dof", "correlation_time_s",
-        "window_correlation_times", "wall_time_s", "mpi_ranks", "core_hours"]
-rows = []
-for f in sorted(glob.glob(os.path.join(results, "runs", "*", "summary.json"))):
-    s = json.load(open(f))
-    c = cases[s["case_id"]]
-    rows.append({"case_id": s["case_id"], "group": c["group"], "angle_deg": c["angle_deg"],
-                 "n_particles": s.get("particle_count"),
-                 "end_s": round(s["simulated_time_s"], 6), "average_from_s": s.get("average_from_s"),
-                 "mean_settling_velocity_m_s": s.get("mean_settling_velocity_m_s"),
-                 "error_m_s": s.get("settling_velocity_error_m_s"),
-                 "error_method": s.get("settling_velocity_error_method"),
-                 "error_dof": s.get("settling_velocity_error_dof"),
-                 "correlation_time_s": s.get("settling_velocity_correlation_time_s"),
-                 "window_correlation_times": s.get("settling_velocity_window_correlation_times"),
-                 "wall_time_s": s.get("wall_time_s"), "mpi_ranks": s.get("mpi_ranks"),
-                 "core_hours": round(s["wall_time_s"] * s.get("mpi_ranks", 1) / 3600.0, 3)})
-rows.sort(key=lambda r: (r["group"], float(r["angle_deg"] or 0)))
-with open(os.path.join(results, "paper_base_full_runs.csv"), "w", newline="") as out:
-    w = csv.DictWriter(out, fieldnames=cols)
-    w.writeheader()
-    w.writerows(rows)
-print(f"{len(rows)} committed runs, {sum(r['core_hours'] for r in rows):.1f} core-hours (wall time x ranks)")
-PY
+"$bin" query runs --db "$work/full.db" --study paper_base_full --format csv \
+  > "$root/docs/results/paper_base_full_runs.csv"
+"$bin" query runs --db "$work/full.db" --study paper_base_full | tail -n 1
 for ext in png pdf; do
   "$bin" query curve --db "$work/full.db" --study paper_base_full --overlay-paper \
     --plot "$root/docs/plots/paper_base_full.$ext" > /dev/null

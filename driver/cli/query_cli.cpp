@@ -13,6 +13,7 @@
 #include "driver/report/listing_format.hpp"
 #include "driver/report/peak.hpp"
 #include "driver/report/peak_query.hpp"
+#include "driver/report/runs_query.hpp"
 #include "driver/report/validation_query.hpp"
 #include "driver/report/work_precision.hpp"
 #include "driver/run/runner.hpp"
@@ -152,6 +153,21 @@ Command setup_query_work_precision(CLI::App* parent) {
   return {cmd, [a] { return run_query_work_precision(*a); }};
 }
 
+Command setup_query_runs(CLI::App* parent) {
+  auto a = std::make_shared<QueryArgs>();
+  auto* cmd = parent->add_subcommand(
+      "runs", "per finished run: its window, error basis, correlation times, wall time and core-hours");
+  add_db(cmd, *a);
+  cmd->add_option("--study", a->study, "study name")->required();
+  add_format(cmd, a->format);
+  return {cmd, [a] {
+            const auto format = parse_listing_format(a->format);
+            auto db = open_for_query(a->db);
+            std::fputs(format_runs(query_runs(db, a->study), format).c_str(), stdout);
+            return 0;
+          }};
+}
+
 Command setup_query_cases(CLI::App* parent) {
   auto a = std::make_shared<QueryArgs>();
   auto* cmd = parent->add_subcommand("cases", "list cases and their status");
@@ -169,8 +185,8 @@ Command setup_query_cases(CLI::App* parent) {
 std::vector<Command> setup_query_commands(CLI::App& app) {
   auto* group = app.add_subcommand("query", "read results from a study database");
   group->require_subcommand(1);
-  return {setup_query_curve(group), setup_query_peak(group), setup_query_validation(group),
-          setup_query_work_precision(group), setup_query_cases(group)};
+  return {setup_query_curve(group),          setup_query_peak(group), setup_query_validation(group),
+          setup_query_work_precision(group), setup_query_runs(group), setup_query_cases(group)};
 }
 
 }  // namespace boycott::driver::cli

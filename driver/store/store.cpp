@@ -414,6 +414,47 @@ std::vector<SettlingResult> settling_results(Database& db, const std::string& st
   return out;
 }
 
+std::vector<RunRecord> run_records(Database& db, const std::string& study) {
+  auto st = db.prepare(
+      "SELECT sc.group_name, c.id, c.angle_deg, MIN(sc.position) AS pos, "
+      " json_extract(r.summary_json, '$.particle_count'), r.average_from_s, r.average_to_s, "
+      " r.mean_settling_velocity_m_s, json_extract(r.summary_json, '$.settling_velocity_error_m_s'), "
+      " json_extract(r.summary_json, '$.settling_velocity_error_method'), "
+      " json_extract(r.summary_json, '$.settling_velocity_error_dof'), "
+      " json_extract(r.summary_json, '$.settling_velocity_correlation_time_s'), "
+      " json_extract(r.summary_json, '$.settling_velocity_window_correlation_times'), r.wall_time_s, "
+      " json_extract(r.summary_json, '$.mpi_ranks') "
+      "FROM study_cases sc JOIN cases c ON c.id = sc.case_id JOIN results r ON r.case_id = c.id "
+      "WHERE sc.study = ?1 GROUP BY sc.group_name, c.id ORDER BY pos, c.id");
+  st.bind(1, study);
+  std::vector<RunRecord> out;
+  const auto real = [&](int col) {
+    return st.is_null(col) ? std::nullopt : std::optional<double>(st.real(col));
+  };
+  const auto integer = [&](int col) {
+    return st.is_null(col) ? std::nullopt : std::optional<std::int64_t>(st.integer(col));
+  };
+  while (st.step()) {
+    RunRecord r;
+    r.group = st.text(0);
+    r.case_id = st.text(1);
+    r.angle_deg = st.real(2);
+    r.n_particles = integer(4);
+    r.average_from_s = real(5);
+    r.end_s = real(6);
+    r.w_m_s = real(7);
+    r.error_m_s = real(8);
+    if (!st.is_null(9)) r.error_method = st.text(9);
+    r.error_dof = real(10);
+    r.correlation_time_s = real(11);
+    r.window_correlation_times = real(12);
+    r.wall_time_s = real(13);
+    r.ranks = integer(14);
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
 std::vector<FinishedCost> finished_costs(Database& db) {
   std::vector<FinishedCost> out;
   auto st = db.prepare(

@@ -121,6 +121,24 @@ struct SettlingResult {
 /// The study's cases with a recorded <<w_p>>, once per group they belong to, in study order.
 std::vector<SettlingResult> settling_results(Database& db, const std::string& study);
 
+/// A finished run as `query runs` lists it: its window, its error's basis and its cost, from the
+/// summary it recorded (summary.json's keys; unset where a run of an older build wrote none).
+struct RunRecord {
+  std::string group, case_id;
+  double angle_deg = 0;
+  std::optional<std::int64_t> n_particles;  ///< particle_count
+  std::optional<double> average_from_s, end_s;
+  std::optional<double> w_m_s, error_m_s;  ///< <<w_p>> and its covering half-width
+  std::optional<std::string> error_method;
+  std::optional<double> error_dof, correlation_time_s, window_correlation_times;
+  /// Over all its attempts (a resumed run carries its earlier attempts' time in its checkpoint).
+  std::optional<double> wall_time_s;
+  std::optional<std::int64_t> ranks;  ///< mpi_ranks of the attempt that finished it
+};
+
+/// The study's finished cases, once per group they belong to, in study order.
+std::vector<RunRecord> run_records(Database& db, const std::string& study);
+
 /// A finished result's cost, for the cost model of `study plan`: every study's results count.
 struct FinishedCost {
   std::string case_id;

@@ -14,6 +14,7 @@
 #include "driver/report/curve.hpp"
 #include "driver/report/curve_query.hpp"
 #include "driver/report/plot_cairo.hpp"
+#include "driver/report/runs_query.hpp"
 #include "driver/report/terminal_text.hpp"
 #include "driver/report/validation_query.hpp"
 #include "driver/report/work_precision.hpp"
@@ -525,6 +526,64 @@ TEST(ValidationQuery, OnlyFinishedCasesOfTheNamedStudyAreListed) {
   EXPECT_NE(bd::format_validation(rows, bd::ListingFormat::kTable).find("  -\n"), std::string::npos);
   EXPECT_EQ(bd::query_validation(db).size(), 2u);
   EXPECT_NE(what_of([&] { bd::query_validation(db, "nope"); }).find("no study 'nope'"), std::string::npos);
+}
+
+// The per-run listing behind docs/results.md's cost table: what each point rests on and what it
+// cost, read back from the summaries the runs recorded.
+TEST(RunsQuery, EachFinishedRunListsItsWindowErrorBasisCorrelationTimesAndCoreHours) {
+  TempDir d;
+  bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
+  const auto study = bd::expand_study_string(kWorkPrecisionStudy);
+  bd::register_study(db, study);
+  const auto& c65 = study.cases[0];  // reference, 65 deg
+  auto s = summary_of(c65, {-0.1, 0.001, 7200});
+  s["average_from_s"] = 1.0;
+  s["particle_count"] = 120000;
+  s["settling_velocity_error_m_s"] = 0.00184;
+  s["settling_velocity_error_method"] = "two_halves";
+  s["settling_velocity_error_dof"] = 1.0;
+  s["settling_velocity_correlation_time_s"] = 0.1;
+  s["settling_velocity_window_correlation_times"] = 10.0;
+  s["mpi_ranks"] = 2;
+  bd::record_result(db, bd::begin_attempt(db, c65.id, 2, "x"), c65.id, s);
+  // A run of an older build: no error basis, no rank count.
+  const auto& c90 = study.cases[1];  // reference, 90 deg
+  bd::record_result(db, bd::begin_attempt(db, c90.id, 1, "x"), c90.id, summary_of(c90, {-0.08, 0.001, 3600}));
+  bd::begin_attempt(db, study.cases[2].id, 1, "x");  // running: not a run yet
+
+  const auto rows = bd::query_runs(db, "wp");
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].case_id, c65.id);  // study order
+  EXPECT_EQ(rows[0].group, "reference");
+  EXPECT_DOUBLE_EQ(rows[0].angle_deg, 65.0);
+  EXPECT_EQ(*rows[0].n_particles, 120000);
+  EXPECT_DOUBLE_EQ(*rows[0].average_from_s, 1.0);
+  EXPECT_DOUBLE_EQ(*rows[0].end_s, 2.0);
+  EXPECT_DOUBLE_EQ(*rows[0].error_m_s, 0.00184);
+  EXPECT_EQ(*rows[0].error_method, "two_halves");
+  EXPECT_DOUBLE_EQ(*rows[0].window_correlation_times, 10.0);
+  EXPECT_DOUBLE_EQ(*bd::core_hours(rows[0]), 4.0);  // 2 h of wall time on 2 ranks
+  EXPECT_FALSE(rows[1].error_method.has_value());
+  EXPECT_FALSE(bd::core_hours(rows[1]).has_value());
+
+  const auto table = bd::format_runs(rows, bd::ListingFormat::kTable);
+  EXPECT_NE(table.find("-100.00 ± 1.84"), std::string::npos) << table;
+  EXPECT_NE(table.find("two_halves (1 dof)"), std::string::npos) << table;
+  EXPECT_NE(table.find("1-2"), std::string::npos) << table;  // the window, s
+  EXPECT_NE(table.find("2 runs, 4.0 core-hours"), std::string::npos) << table;
+  EXPECT_NE(table.find("1 without a wall time or rank count"), std::string::npos) << table;
+  const auto csv = bd::format_runs(rows, bd::ListingFormat::kCsv);
+  EXPECT_EQ(
+      csv.substr(0, csv.find('\n')),
+      "case_id,group,angle_deg,n_particles,end_s,average_from_s,mean_settling_velocity_m_s,error_m_s,"
+      "error_method,error_dof,correlation_time_s,window_correlation_times,wall_time_s,mpi_ranks,core_hours");
+  EXPECT_NE(csv.find(c65.id + ",reference,65,120000,2,1,-0.1,0.00184,two_halves,1,0.1,10,7200,2,4\n"),
+            std::string::npos)
+      << csv;
+  const auto json = nlohmann::json::parse(bd::format_runs(rows, bd::ListingFormat::kJson));
+  EXPECT_DOUBLE_EQ(json[0]["core_hours"].get<double>(), 4.0);
+  EXPECT_TRUE(json[1]["core_hours"].is_null());
+  EXPECT_NE(what_of([&] { bd::query_runs(db, "nope"); }).find("no study 'nope'"), std::string::npos);
 }
 
 TEST(CurveQuery, GroupSweepingMoreThanTheAngleGetsOneCurvePerSetting) {
