@@ -31,6 +31,7 @@ def main():
         case = json.loads(bytes(np.asarray(f["case_json"][()], dtype=np.uint8)).decode())  # stored as integers
         arr = [np.asarray(f[f"dem.array{k:02d}"][()]) for k in range(6)]
         radius = np.asarray(f["dem.array15"][()])
+        time_s = float(np.asarray(f["run.time_s"][()]).ravel()[0])
     dom = case["domain"]
     L = np.array([dom["length_x"], dom["width_y"], dom["height_z"]])
     dt = a.dt_dem or case["time"]["dt_dem"]
@@ -62,9 +63,11 @@ def main():
         tw = np.where(g <= 0, 0.0, (np.sqrt(sp * sp + 2 * aw * np.maximum(g, 0)) - sp) / aw)
         t = np.minimum(t, tw)
     t = np.minimum(t, horizon * 1.0001)  # beyond the search's horizon: free for the whole step
-    print(f"{a.checkpoint}: {n} particles, {len(pairs)} pairs within {1e3 * (2 * R + reach):.2f} mm, "
+    print(f"{a.checkpoint}: t = {time_s:.3f} s, {n} particles, {len(pairs)} pairs within {1e3 * (2 * R + reach):.2f} mm, "
           f"dt_dem {dt * 1e6:g} us, relative acceleration bound {a.accel:g} m/s^2")
     print(f"touching now (a particle or a wall): {np.mean(t == 0):.3f}")
+    half = np.mean(p[:, 2] < L[2] / 2)
+    print(f"share of the particles in the lower z half (where 2 ranks split the slabs): {half:.3f}")
     print("sub-steps k | share free for k | share of particle-sub-steps a chunk of k could skip")
     for k in (1, 2, 5, 10, 25, 50):
         free = np.mean(t > k * dt)
