@@ -93,6 +93,16 @@ nlohmann::json value_json(const SweptValue& v) {
   return v.value_num ? nlohmann::json(*v.value_num) : nlohmann::json(v.value);
 }
 
+std::string csv_number(const std::optional<double>& v) {
+  return v && !std::isnan(*v) ? fmt::format("{:.9g}", *v) : std::string();
+}
+std::string csv_count(const std::optional<std::int64_t>& v) {
+  return v ? fmt::format("{}", *v) : std::string();
+}
+nlohmann::json json_number(const std::optional<double>& v) {
+  return v && !std::isnan(*v) ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
 std::string percent(double rel) {
   const double p = rel * 100.0;
   // Below 1e-12 a relative error is rounding in the ratio itself (e.g. r_acc of a setting that

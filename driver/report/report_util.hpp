@@ -1,6 +1,7 @@
 #pragma once
 // Small pieces shared by the query reports (curve, validation, work-precision): axis ticks and
 // series styles for the plots (drawn by driver/report/plot_cairo.hpp), CSV quoting and aligned text tables.
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,6 +24,14 @@ const char* marker_kind(std::size_t i);
 std::string csv_field(const std::string& s);
 /// One CSV line of the cells (each through csv_field), ending in a newline.
 std::string csv_line(const std::vector<std::string>& cells);
+
+/// A stored number as a CSV cell at full precision (9 significant digits); empty where there is
+/// none (absent, or NaN: a figure that could not be computed).
+std::string csv_number(const std::optional<double>& v);
+/// A stored count as a CSV cell; empty where there is none.
+std::string csv_count(const std::optional<std::int64_t>& v);
+/// A stored number as JSON: null where there is none (absent or NaN).
+nlohmann::json json_number(const std::optional<double>& v);
 
 /// "key=value; key=value" of swept values, "-" when there are none.
 std::string join_values(const std::vector<SweptValue>& v);

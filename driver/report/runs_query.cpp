@@ -8,13 +8,6 @@ namespace boycott::driver {
 
 namespace {
 
-std::string raw(const std::optional<double>& v) {
-  return v ? fmt::format("{:.9g}", *v) : std::string();
-}
-std::string raw(const std::optional<std::int64_t>& v) {
-  return v ? fmt::format("{}", *v) : std::string();
-}
-
 std::string window_text(const RunRecord& r) {
   if (!r.average_from_s || !r.end_s) return "-";
   return fmt::format("{:.4g}-{:.4g}", *r.average_from_s, *r.end_s);  // 10.0001: a last step past 10 s
@@ -51,10 +44,12 @@ std::string format_runs(const std::vector<RunRecord>& rows, ListingFormat f) {
          "window_correlation_times", "wall_time_s", "mpi_ranks", "core_hours"},
         {false, false, true, true, true, true, true, true, false, true, true, true, true, true, true});
     for (const auto& r : rows)
-      t.add({r.case_id, r.group, fmt::format("{:g}", r.angle_deg), raw(r.n_particles), raw(r.end_s),
-             raw(r.average_from_s), raw(r.w_m_s), raw(r.error_m_s), r.error_method.value_or(""),
-             raw(r.error_dof), raw(r.correlation_time_s), raw(r.window_correlation_times), raw(r.wall_time_s),
-             raw(r.ranks), raw(core_hours(r))});
+      t.add({r.case_id, r.group, fmt::format("{:g}", r.angle_deg), report::csv_count(r.n_particles),
+             report::csv_number(r.end_s), report::csv_number(r.average_from_s), report::csv_number(r.w_m_s),
+             report::csv_number(r.error_m_s), r.error_method.value_or(""), report::csv_number(r.error_dof),
+             report::csv_number(r.correlation_time_s), report::csv_number(r.window_correlation_times),
+             report::csv_number(r.wall_time_s), report::csv_count(r.ranks),
+             report::csv_number(core_hours(r))});
     return f == ListingFormat::kCsv ? t.csv() : t.json().dump(2) + "\n";
   }
   if (rows.empty()) return "(no finished runs)\n";
@@ -66,11 +61,11 @@ std::string format_runs(const std::vector<RunRecord>& rows, ListingFormat f) {
   for (const auto& r : rows) {
     const auto ch = core_hours(r);
     if (ch) total += *ch, ++priced;
-    t.add({r.group, r.case_id, fmt::format("{:g}", r.angle_deg), raw(r.n_particles), window_text(r),
-           point_text(r), basis_text(r),
+    t.add({r.group, r.case_id, fmt::format("{:g}", r.angle_deg), report::csv_count(r.n_particles),
+           window_text(r), point_text(r), basis_text(r),
            r.correlation_time_s ? fmt::format("{:.3g}", *r.correlation_time_s) : "-",
            r.window_correlation_times ? fmt::format("{:.1f}", *r.window_correlation_times) : "-",
-           r.wall_time_s ? fmt::format("{:.2f}", *r.wall_time_s / 3600.0) : "-", raw(r.ranks),
+           r.wall_time_s ? fmt::format("{:.2f}", *r.wall_time_s / 3600.0) : "-", report::csv_count(r.ranks),
            ch ? fmt::format("{:.2f}", *ch) : "-"});
   }
   std::string s = t.str();

@@ -37,13 +37,6 @@ std::string csv_text(const nlohmann::json& v) {
   return v.dump();
 }
 
-std::string opt_csv(const std::optional<double>& v) {
-  return v ? fmt::format("{:.9g}", *v) : std::string();
-}
-nlohmann::json opt_json(const std::optional<double>& v) {
-  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
-}
-
 /// The tolerance the scene holds this error to, or null.
 const SceneSpec::Tolerance* tolerance_of(const std::string& scene, const std::string& key) {
   for (const auto& spec : scene_specs())
@@ -108,8 +101,8 @@ std::string format_validation(const std::vector<ValidationRow>& rows, ListingFor
                    {"values", values},
                    {"errors", errors},
                    {"checks", checks},
-                   {"mean_settling_velocity_m_s", opt_json(r.w_m_s)},
-                   {"wall_time_s", opt_json(r.wall_time_s)}});
+                   {"mean_settling_velocity_m_s", report::json_number(r.w_m_s)},
+                   {"wall_time_s", report::json_number(r.wall_time_s)}});
     }
     return j.dump(2) + "\n";
   }
@@ -126,7 +119,7 @@ std::string format_validation(const std::vector<ValidationRow>& rows, ListingFor
       s += fmt::format("{},{},{},{},{},{},{}", report::csv_field(r.study), report::csv_field(r.group),
                        r.case_id, report::csv_field(r.scene),
                        report::csv_field(r.values.empty() ? "" : report::join_values(r.values)),
-                       opt_csv(r.w_m_s), opt_csv(r.wall_time_s));
+                       report::csv_number(r.w_m_s), report::csv_number(r.wall_time_s));
       for (const auto& k : keys) {
         std::string cell;
         for (const auto& [ek, v] : r.errors)

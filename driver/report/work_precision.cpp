@@ -96,13 +96,6 @@ std::string percent_pm(double e, double u) {
                      up >= 0.01 || up == 0.0 ? fmt::format("{:.2f} %", up) : fmt::format("{:.2g} %", up));
 }
 
-std::string opt_csv(const std::optional<double>& v) {
-  return v && !std::isnan(*v) ? fmt::format("{:.9g}", *v) : std::string();
-}
-nlohmann::json opt_json(const std::optional<double>& v) {
-  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
-}
-
 }  // namespace
 
 WorkPrecision query_work_precision(Database& db, const std::string& study,
@@ -190,7 +183,7 @@ std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
                       {"angle_deg", r.angle_deg},
                       {"mean_settling_velocity_m_s", r.w_m_s},
                       {"stderr_m_s", r.w_err_m_s},
-                      {"wall_time_s", opt_json(r.wall_time_s)},
+                      {"wall_time_s", report::json_number(r.wall_time_s)},
                       {"n_replicas", r.n_replicas}});
     for (const auto& r : wp.rows) {
       nlohmann::json setting = nlohmann::json::object();
@@ -199,7 +192,7 @@ std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
           {{"group", r.group},
            {"setting", setting},
            {"angle_deg", r.angle_deg},
-           {"wall_time_s", opt_json(r.wall_time_s)},
+           {"wall_time_s", report::json_number(r.wall_time_s)},
            {"particle_steps", r.particle_steps ? nlohmann::json(*r.particle_steps) : nlohmann::json(nullptr)},
            {"mean_settling_velocity_m_s", r.w_m_s},
            {"stderr_m_s", r.w_err_m_s},
@@ -207,9 +200,9 @@ std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
            {"reference_stderr_m_s", r.w_ref_err_m_s},
            {"rel_error_w", r.rel_error_w},
            {"rel_error_w_uncertainty", r.rel_error_w_unc},
-           {"rel_error_w_error", opt_json(r.rel_error_w_err)},
-           {"rel_error_r_acc", opt_json(r.rel_error_r_acc)},
-           {"rel_error_r_acc_uncertainty", opt_json(r.rel_error_r_acc_unc)},
+           {"rel_error_w_error", report::json_number(r.rel_error_w_err)},
+           {"rel_error_r_acc", report::json_number(r.rel_error_r_acc)},
+           {"rel_error_r_acc_uncertainty", report::json_number(r.rel_error_r_acc_unc)},
            {"case_id", r.case_id},
            {"reference_case_id", r.ref_case_id},
            {"n_replicas", r.n_replicas},
@@ -229,10 +222,11 @@ std::string format_work_precision(const WorkPrecision& wp, ListingFormat f) {
     for (const auto& r : wp.rows)
       s += fmt::format(
           "{},{},{:g},{},{},{:.9g},{},{:.9g},{},{:.9g},{},{},{},{},{},{},{},{}\n", report::csv_field(r.group),
-          report::csv_field(report::join_values(r.setting)), r.angle_deg, opt_csv(r.wall_time_s),
-          r.particle_steps ? std::to_string(*r.particle_steps) : "", r.w_m_s, opt_csv(r.w_err_m_s),
-          r.w_ref_m_s, opt_csv(r.w_ref_err_m_s), r.rel_error_w, opt_csv(r.rel_error_w_unc),
-          opt_csv(r.rel_error_w_err), opt_csv(r.rel_error_r_acc), opt_csv(r.rel_error_r_acc_unc), r.case_id,
+          report::csv_field(report::join_values(r.setting)), r.angle_deg, report::csv_number(r.wall_time_s),
+          r.particle_steps ? std::to_string(*r.particle_steps) : "", r.w_m_s, report::csv_number(r.w_err_m_s),
+          r.w_ref_m_s, report::csv_number(r.w_ref_err_m_s), r.rel_error_w,
+          report::csv_number(r.rel_error_w_unc), report::csv_number(r.rel_error_w_err),
+          report::csv_number(r.rel_error_r_acc), report::csv_number(r.rel_error_r_acc_unc), r.case_id,
           r.ref_case_id, r.n_replicas, r.ref_n_replicas);
     return s;
   }
