@@ -10,8 +10,17 @@ t = (sqrt(s^2 + 2 a g) - s) / a, where a bounds how fast their relative velocity
 twice (g (1 - rho_f / rho_p) + |u_f - v| / tau_p) for 0.6 mm sand in water slipping at 0.2 m/s).
 A wall is at rest and one particle moves: a / 2. A particle's reach time is its smallest over its
 neighbours and the two walls at y = 0 and W (the inclined channel is periodic in x and z); it is
-free for k sub-steps when that time exceeds k dt_dem. Needs python3-h5py, -numpy and -scipy
-(Debian packages); reads the 38-array checkpoints of DemSystem (particle_store.hpp order).
+free for k sub-steps when that time exceeds k dt_dem.
+
+It also prices a second, thinner list inside the neighbour list (a "near list" of the pairs
+whose gap is below m < the skin S, filtered from the list and renewed when a particle could have
+moved m / 2): the contact search would test the near pairs every step and all list pairs once per
+renewal. A list lasts --list-steps DEM steps (a rebuild when a particle could have moved S / 2);
+over these few steps the particles move ballistically, so a near list lasts about m / S of that.
+Pair tests per step against the list's: near / list + (list / near list's life) / list.
+
+Needs python3-h5py, -numpy and -scipy (Debian packages); reads the 38-array checkpoints of
+DemSystem (particle_store.hpp order).
 """
 import argparse
 import json
@@ -26,6 +35,8 @@ def main():
     ap.add_argument("checkpoint")
     ap.add_argument("--dt-dem", type=float, default=None, help="s (default: the case's time.dt_dem)")
     ap.add_argument("--accel", type=float, default=20.0, help="bound on the relative acceleration, m/s^2")
+    ap.add_argument("--list-steps", type=float, default=15.0,
+                    help="DEM steps a neighbour list lasts (the full case: 15-18, summary.json)")
     a = ap.parse_args()
     with h5py.File(a.checkpoint, "r") as f:
         case = json.loads(bytes(np.asarray(f["case_json"][()], dtype=np.uint8)).decode())  # stored as integers
@@ -35,12 +46,13 @@ def main():
     dom = case["domain"]
     L = np.array([dom["length_x"], dom["width_y"], dom["height_z"]])
     dt = a.dt_dem or case["time"]["dt_dem"]
+    skin = case["numerics"]["neighbor_skin"]
     x = np.stack(arr[0:3], axis=1)
     v = np.stack(arr[3:6], axis=1)
     R = radius.max()
     # The longest reach a fluid step of 50 sub-steps could need, with margin: 2 |v|max t + a t^2.
     horizon = 50 * dt
-    reach = 2 * np.abs(v).max() * np.sqrt(3) * horizon + a.accel * horizon**2 + 1e-4
+    reach = max(2 * np.abs(v).max() * np.sqrt(3) * horizon + a.accel * horizon**2 + 1e-4, skin)
     box = np.array([L[0], 1e3, L[2]])  # y is walled: a box far larger than the gap
     p = x.copy()
     p[:, 0] %= L[0]
@@ -72,6 +84,14 @@ def main():
     for k in (1, 2, 5, 10, 25, 50):
         free = np.mean(t > k * dt)
         print(f"{k:11d} | {free:16.3f} | {free * (1 - 1 / k):.3f}")
+    listed = np.count_nonzero(gap < skin)
+    print(f"neighbour list (skin {skin * 1e3:g} mm): {listed / n:.2f} pairs per particle, "
+          f"{np.count_nonzero(gap < 0) / n:.2f} of them in contact; a list lasts {a.list_steps:g} steps")
+    print("near skin (mm) | near pairs per particle | its life (steps) | pair tests per step / the list's")
+    for m in (0.025, 0.05, 0.1, 0.15, 0.2):
+        near = np.count_nonzero(gap < m * 1e-3)
+        life = max(1.0, a.list_steps * m * 1e-3 / skin)
+        print(f"{m:14g} | {near / n:23.2f} | {life:16.1f} | {near / listed + 1 / life:.3f}")
 
 
 if __name__ == "__main__":
