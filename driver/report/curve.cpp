@@ -138,13 +138,17 @@ class CurveFigure {
           if (paper_groups_.find(v.group) == std::string::npos)
             paper_groups_ += (paper_groups_.empty() ? "" : ", ") + v.group;
         }
+    lay_out_legend();
   }
+
+  /// The page's height (px): the panels, one legend row per kLegendRow, the caption.
+  double height() const { return 470.0 + kLegendRow * static_cast<double>(legend_rows_.size() - 1); }
 
   void draw(plot::Canvas& c, const std::string& title) const {
     c.text(500, 22, title, plot::Anchor::kMiddle, 15);
     for (int panel = 0; panel < 2; ++panel) draw_panel(c, panel);
     draw_legend(c);
-    c.text(500, 462, caption(), plot::Anchor::kMiddle, 11, "#555");
+    c.text(500, height() - 8.0, caption(), plot::Anchor::kMiddle, 11, "#555");
   }
 
  private:
@@ -279,22 +283,54 @@ class CurveFigure {
     }
   }
 
-  /// The legend: one row under the panels, centred, where it covers no data.
-  void draw_legend(plot::Canvas& c) const {
-    std::vector<std::pair<std::string, std::string>> entries;  // marker kind (or "paper"), text
-    for (std::size_t g = 0; g < series_.size(); ++g) entries.emplace_back(report::marker_kind(g), series_[g]);
+  /// A legend entry: its marker kind ("paper": the paper's diamond), colour index and text.
+  struct LegendEntry {
+    std::string marker;
+    std::size_t color = 0;
+    std::string text;
+    double width = 0.0;  ///< marker, text and the gap after it (px)
+  };
+  static constexpr double kLegendRow = 18.0;     ///< px between legend rows
+  static constexpr double kLegendWidth = 960.0;  ///< px a row may fill (the page less margins)
+
+  /// The entries in rows under the panels, each row as wide as fits the page: a study with many
+  /// groups, or the paper's long entry, wraps instead of running off the page.
+  void lay_out_legend() {
+    std::vector<LegendEntry> entries;
+    for (std::size_t g = 0; g < series_.size(); ++g)
+      entries.push_back({report::marker_kind(g), g, series_[g]});
     if (!overlay_.empty())
-      entries.emplace_back("paper", "Zeng et al. 2021, group " + paper_groups_ +
-                                        ": stated values (dashed: a peak whose angle is not stated)");
-    double width = 0.0;
-    for (const auto& e : entries) width += 16.0 + c.text_width(e.second) + 24.0;
-    double x = 500.0 - (width - 24.0) / 2.0;
-    for (std::size_t k = 0; k < entries.size(); ++k) {
-      const bool is_paper = entries[k].first == "paper";
-      c.marker(is_paper ? "diamond" : entries[k].first.c_str(), x + 5, 436 - 4,
-               is_paper ? "#333" : report::color(k), is_paper);
-      c.text(x + 16, 436, entries[k].second, plot::Anchor::kStart, 13, "#000", false, "legend");
-      x += 16.0 + c.text_width(entries[k].second) + 24.0;
+      entries.push_back({"paper", 0,
+                         "Zeng et al. 2021, group " + paper_groups_ +
+                             ": stated values (dashed: a peak whose angle is not stated)"});
+    legend_rows_.assign(1, {});
+    double used = 0.0;
+    for (auto& e : entries) {
+      e.width = 16.0 + plot::text_width(e.text) + 24.0;
+      if (!legend_rows_.back().empty() && used + e.width - 24.0 > kLegendWidth) {
+        legend_rows_.emplace_back();
+        used = 0.0;
+      }
+      used += e.width;
+      legend_rows_.back().push_back(std::move(e));
+    }
+  }
+
+  /// The legend: rows under the panels, each centred, where they cover no data.
+  void draw_legend(plot::Canvas& c) const {
+    double y = 436.0;
+    for (const auto& row : legend_rows_) {
+      double width = 0.0;
+      for (const auto& e : row) width += e.width;
+      double x = 500.0 - (width - 24.0) / 2.0;
+      for (const auto& e : row) {
+        const bool is_paper = e.marker == "paper";
+        c.marker(is_paper ? "diamond" : e.marker.c_str(), x + 5, y - 4,
+                 is_paper ? "#333" : report::color(e.color), is_paper);
+        c.text(x + 16, y, e.text, plot::Anchor::kStart, 13, "#000", false, "legend");
+        x += e.width;
+      }
+      y += kLegendRow;
     }
   }
 
@@ -316,6 +352,7 @@ class CurveFigure {
   std::vector<std::string> series_;
   std::vector<PaperValue> overlay_;
   std::string paper_groups_;
+  std::vector<std::vector<LegendEntry>> legend_rows_;
 };
 
 }  // namespace
@@ -324,7 +361,7 @@ plot::Plot curve_plot(const std::vector<CurvePoint>& pts, const std::string& tit
                       const std::vector<PaperValue>* paper, plot::Format format,
                       const std::vector<PeakRow>* peaks) {
   const CurveFigure figure(pts, paper, peaks);
-  return plot::render(1000, 470, format, [&](plot::Canvas& c) { figure.draw(c, title); });
+  return plot::render(1000, figure.height(), format, [&](plot::Canvas& c) { figure.draw(c, title); });
 }
 
 std::string format_cases(const std::vector<CaseState>& cases, ListingFormat f) {

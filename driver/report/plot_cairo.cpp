@@ -224,6 +224,16 @@ cairo_status_t append(void* closure, const unsigned char* data, unsigned int len
 
 }  // namespace
 
+double text_width(const std::string& s, double size) {
+  cairo_surface_t* surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, 1, 1);
+  cairo_t* cr = cairo_create(surface);
+  Plot scratch;
+  const double w = Canvas(cr, scratch).text_width(s, size);
+  cairo_destroy(cr);
+  cairo_surface_destroy(surface);
+  return w;
+}
+
 Plot render(double width, double height, Format format, const std::function<void(Canvas&)>& draw) {
   Plot plot;
   cairo_surface_t* surface = nullptr;

@@ -67,6 +67,10 @@ class Canvas {
   Plot& plot_;
 };
 
+/// The advance of `s` at `size` (px) in the plots' font, measured before any canvas exists (to
+/// size a plot by its text); within a few tenths of a pixel of Canvas::text_width.
+double text_width(const std::string& s, double size = 13.0);
+
 /// Draws a width x height plot on a white page through `draw` and writes it in `format`.
 Plot render(double width, double height, Format format, const std::function<void(Canvas&)>& draw);
 

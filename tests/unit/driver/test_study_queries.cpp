@@ -461,6 +461,41 @@ TEST(CurvePlot, OverlaysOnlyTheStudysGroupsDrawsPointsWithoutAnErrorOpenAndTypes
   EXPECT_EQ(plot.data.find("w_p"), std::string::npos);
 }
 
+TEST(CurvePlot, ALegendWiderThanThePageWrapsIntoRowsAndThePageGrowsByThem) {
+  // Eight groups and the paper's entry: far more than the 960 px a legend row may fill.
+  std::vector<bd::CurvePoint> pts;
+  std::vector<std::string> names;
+  for (int g = 0; g < 8; ++g) {
+    names.push_back(fmt::format("group number {} with a long name", g));
+    for (const double angle : {65.0, 90.0}) {
+      bd::CurvePoint p;
+      p.group = names.back();
+      p.angle_deg = angle;
+      p.w_m_s = angle == 90.0 ? -0.08 : -0.15;
+      p.error.error_m_s = 0.001;
+      pts.push_back(p);
+    }
+  }
+  const std::vector<bd::PaperValue> paper = {{names[0], 65.0, "mean_settling_velocity_m_s", -0.18, "Table"}};
+  const std::string paper_entry =
+      "Zeng et al. 2021, group " + names[0] + ": stated values (dashed: a peak whose angle is not stated)";
+  // The rows a greedy fill of 960 px makes: each entry a 16 px marker, its text and a 24 px gap.
+  std::vector<std::string> entries = names;
+  entries.push_back(paper_entry);
+  int rows = 1;
+  double used = 0.0;
+  for (const auto& e : entries) {
+    const double w = 16.0 + bd::plot::text_width(e) + 24.0;
+    if (used > 0.0 && used + w - 24.0 > 960.0) ++rows, used = 0.0;
+    used += w;
+  }
+  ASSERT_GE(rows, 3);
+  const auto plot = bd::curve_plot(pts, "s", &paper);
+  expect_svg(plot.data, 1000, 470 + 18 * (rows - 1));
+  EXPECT_EQ(plot.count("legend"), 9);
+  for (const auto& e : entries) EXPECT_TRUE(plot.has_text(e)) << e;
+}
+
 TEST(ValidationQuery, RowsListExactlyTheStoredErrorKeysWithTheirValues) {
   TempDir d;
   bd::Database db((d.path / "r.db").string(), bd::OpenMode::kCreate);
