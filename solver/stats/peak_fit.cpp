@@ -275,6 +275,15 @@ PeakEstimate estimate_peak(std::vector<PeakPoint> points, const PeakFitOptions& 
   const Vertex v = top_vertex(p, y, kWindow);
   e.x = v.x;
   e.y = v.y;
+  if (p.size() == 1) {
+    // One point is its own value with its own error: draws would only add their sampling noise
+    // (with 1 000 draws the 68 % quantiles of one Gaussian wander by ~5 % of its width).
+    e.y_low = e.y - p[0].error;
+    e.y_high = e.y + p[0].error;
+    e.at_edge = true;
+    e.x_low = e.x_high = std::numeric_limits<double>::quiet_NaN();
+    return e;
+  }
   draw_intervals(p, options, e);
   e.at_edge = e.x == p.front().x || e.x == p.back().x;
   if (!e.bracketed()) {

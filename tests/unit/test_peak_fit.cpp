@@ -62,6 +62,19 @@ TEST(PeakFit, TwoPointsGiveTheHigherOneAndNoIntervalForItsPosition) {
   EXPECT_EQ(s.why, "2 points: a peak needs 3 to be bracketed");
 }
 
+// One point is shown as it is: its value's interval is its own error exactly (as the curve gives
+// it), not a draws' estimate of it, and its position has none.
+TEST(PeakFit, OnePointIsShownWithItsOwnErrorAndNoIntervalForItsPosition) {
+  const PeakEstimate e = estimate_peak({{65, -0.18635, 0.00969}});
+  ASSERT_TRUE(e.valid);
+  EXPECT_FALSE(e.bracketed());
+  EXPECT_EQ(e.x, 65.0);
+  EXPECT_EQ(e.y, -0.18635);
+  EXPECT_DOUBLE_EQ(e.y_low, -0.18635 - 0.00969);
+  EXPECT_DOUBLE_EQ(e.y_high, -0.18635 + 0.00969);
+  EXPECT_TRUE(std::isnan(e.x_low) && std::isnan(e.x_high));
+}
+
 // Three points of a Gaussian peak (sigma 15 deg, maximum 1 at 70 deg) known almost exactly: the
 // parabola through them misses the maximum's value by far more than the points' errors, and
 // only the model's error (here the Gaussian through the three, which no fourth point is needed
