@@ -1,12 +1,10 @@
-// The contact forces of one DEM step: which listed pairs overlap (a branch-free first pass),
-// then each contact's force and torques through the stateless kernels of contact_kernels.hpp,
-// then the walls. Contact histories are kept by contact_history.cpp.
+// The contact forces of one DEM step: each contact's force and torques through the stateless
+// kernels of contact_kernels.hpp, then the walls. Which listed pairs overlap is found by
+// contact_search.cpp; contact histories are kept by contact_history.cpp.
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <type_traits>
-#include <utility>
 #include <vector>
 
 #include "core/timers.hpp"
@@ -18,33 +16,6 @@
 namespace boycott::particles {
 
 namespace {
-/// First pass of the force loop: appends (i, list slot) of each overlapping list pair to ci, cp
-/// and returns their number. The test runs over the flat pair arrays (pair_i, nb) so that it
-/// vectorises (gathers) into a byte per pair; the append is a second pass (flag_compress.hpp).
-/// The periodic directions are template flags so that the loop body has no branch at all; so is
-/// UR, all radii equal (their sum rsum_u then replaces two gathers per pair).
-template <bool PX, bool PY, bool PZ, bool UR>
-std::size_t find_contacts(std::size_t np, const std::uint32_t* __restrict pair_i,
-                          const std::uint32_t* __restrict nb, const double* __restrict x,
-                          const double* __restrict y, const double* __restrict z,
-                          const double* __restrict rad, double rsum_u, const std::array<double, 3>& len,
-                          std::uint8_t* __restrict flag, std::uint32_t* __restrict ci,
-                          std::uint32_t* __restrict cp) {
-  const double Lx = len[0], Ly = len[1], Lz = len[2];
-  const double iLx = 1.0 / Lx, iLy = 1.0 / Ly, iLz = 1.0 / Lz;
-  for (std::size_t p = 0; p < np; ++p) {
-    const std::uint32_t i = pair_i[p], j = nb[p];
-    double dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
-    if constexpr (PX) dx = min_image(dx, Lx, iLx);
-    if constexpr (PY) dy = min_image(dy, Ly, iLy);
-    if constexpr (PZ) dz = min_image(dz, Lz, iLz);
-    double rsum = rsum_u;
-    if constexpr (!UR) rsum = rad[i] + rad[j];
-    flag[p] = dx * dx + dy * dy + dz * dz < rsum * rsum;
-  }
-  return compress_flagged(np, flag, pair_i, ci, cp);
-}
-
 /// The particles [0, n) closer to wall W than their radius, appended to wc; returns their number.
 /// Like find_contacts: a branch-free test into a byte per particle (vectorised), then the
 /// append. A wall normal to a coordinate axis (every wall of the scenes) reads that coordinate
@@ -70,17 +41,6 @@ std::size_t find_wall_contacts(std::size_t n, const PlaneWall& W, const double* 
   }
   return compress_flagged(n, flag, nullptr, nullptr, wc);
 }
-
-using FindContactsFn = std::size_t (*)(std::size_t, const std::uint32_t*, const std::uint32_t*, const double*,
-                                       const double*, const double*, const double*, double,
-                                       const std::array<double, 3>&, std::uint8_t*, std::uint32_t*,
-                                       std::uint32_t*);
-// Indexed by periodic x | y << 1 | z << 2 | uniform radii << 3.
-constexpr auto kFindContacts = []<std::size_t... B>(std::index_sequence<B...>) {
-  return std::array<FindContactsFn, sizeof...(B)>{
-      find_contacts<(B & 1) != 0, (B & 2) != 0, (B & 4) != 0, (B & 8) != 0>...};
-}
-(std::make_index_sequence<16>{});
 
 /// Contacts per block of the pair loop: its per-contact results (9 doubles each) stay in L1.
 constexpr std::size_t kContactBlock = 256;
@@ -302,26 +262,6 @@ void DemSystem::zero_unspent_forces() {
   fused_.local_forces_zeroed = false;
   for (auto* a : {&s_.fx, &s_.fy, &s_.fz, &s_.tx, &s_.ty, &s_.tz})
     std::fill(a->begin() + static_cast<std::ptrdiff_t>(zero_from), a->end(), 0.0);
-}
-
-std::size_t DemSystem::find_pair_contacts() {
-  // Pass 1: which list pairs overlap. In a suspension most list pairs (8 in 9 on the LIGGGHTS
-  // bench) are apart, so this is a short branch-free loop that only appends the pair to the
-  // contact list; the contact work then runs without mispredicted branches.
-  const std::size_t np = verlet_.list.pair_count();
-  pairs_.row.resize(np);
-  pairs_.slot.resize(np);
-  pairs_.flag.resize(np);
-  // Equal radii (and moments of inertia): the usual monodisperse case, where the loops take
-  // them as constants (the same values, so the same bits) instead of gathering them per pair.
-  const double Ru = uniform_.radius_m;
-  const auto& per = cfg_.box.periodic;
-  const int variant = (per[0] ? 1 : 0) | (per[1] ? 2 : 0) | (per[2] ? 4 : 0) | (Ru > 0.0 ? 8 : 0);
-  const std::size_t nc = kFindContacts[variant](
-      np, verlet_.row_of_slot.data(), verlet_.list.neighbors.data(), s_.x.data(), s_.y.data(), s_.z.data(),
-      s_.radius.data(), Ru + Ru, cfg_.box.len, pairs_.flag.data(), pairs_.row.data(), pairs_.slot.data());
-  pairs_.springs.carry_to_contacts(pairs_.slot.data(), nc);
-  return nc;
 }
 
 template <class Rolling>

@@ -35,6 +35,10 @@ struct DemConfig {
   /// all zero, so the kicks need not read them (a DEM step is memory-bound: 21 streams instead
   /// of 36). Only the implicit drag beta toward rest remains. initialize() checks the zeros.
   bool dry = false;
+  /// The contact search tests only the list pairs that were within skin / 3 of touching when
+  /// last filtered (DemSystem's near pairs); off, it tests the whole list every step. The
+  /// contacts and every result are the same bits either way: a switch for tests and benchmarks.
+  bool near_pairs = true;
 
   /// Channel of the case: periodic x and z, walls at y = 0 and y = W unless periodic_y.
   static DemConfig from_case(const CaseParams& p);

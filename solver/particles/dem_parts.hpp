@@ -27,6 +27,19 @@ struct VerletState {
   }
 };
 
+/// A thinner list inside the Verlet list, for the contact search (contact_search.cpp): the list
+/// pairs whose surfaces were less than margin_m apart at its last renewal, in list order, as
+/// particle (row), partner and list slot. Exact while every particle (ghost copies included) is
+/// within margin_m / 2 of a common displacement since then; renewed from the list when not, and
+/// after every rebuild or change of radii (fresh = false).
+struct NearPairs {
+  double margin_m = 0.0;  ///< 0: off (the search tests the whole list)
+  bool fresh = false;
+  std::vector<std::uint32_t> row, partner, slot;
+  std::vector<double> ref_x, ref_y, ref_z;  ///< positions at the renewal, m
+  std::int64_t renewals = 0;
+};
+
 /// The radius (m) and moment of inertia (kg m^2) every particle has (the usual monodisperse
 /// case), else 0: the contact loops then take both as constants instead of gathering them. The
 /// mass (kg) likewise, on its own.

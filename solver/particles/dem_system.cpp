@@ -20,6 +20,9 @@ namespace boycott::particles {
 DemSystem::DemSystem(const DemConfig& cfg)
     : cfg_(cfg), dd_(SlabDecomposition::serial(cfg.box.lo[2], cfg.box.lo[2] + cfg.box.len[2])) {
   walls_.set_wall_count(cfg_.walls.size());
+  // A third of the skin: over the campaign's flows the fewest pair tests per step, renewals
+  // included (bench/substep_reach.py, docs/performance.md).
+  near_.margin_m = cfg_.near_pairs ? cfg_.skin_m / 3.0 : 0.0;
 }
 
 void DemSystem::initialize() {
@@ -159,6 +162,7 @@ void DemSystem::rebuild() {
 
 void DemSystem::finish_rebuild(std::chrono::steady_clock::time_point t0) {
   restore_histories(carry_.springs.a, carry_.springs.b, carry_.springs.h);
+  near_.fresh = false;  // a new list
   walls_.rescan();
   verlet_.set_reference(s_);
   ++counters_.rebuilds;

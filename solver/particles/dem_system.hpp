@@ -53,7 +53,10 @@ class DemSystem {
   /// After writing radius, mass or inertia into particles() directly (a packing that grows the
   /// particles step by step): the contact loops stop taking one radius for all particles until
   /// the next initialize() or import_state() finds them equal again.
-  void particle_sizes_changed() { uniform_.radius_m = 0.0; }
+  void particle_sizes_changed() {
+    uniform_.radius_m = 0.0;
+    near_.fresh = false;
+  }
   /// Whether the contact loops take one radius and moment of inertia for all particles.
   bool equal_radii() const { return uniform_.radius_m > 0.0; }
   /// Adds a particle (before `initialize`, or followed by `force_rebuild`).
@@ -94,6 +97,8 @@ class DemSystem {
   double time_s() const { return counters_.time_s; }
   std::int64_t steps() const { return counters_.steps; }
   std::int64_t rebuilds() const { return counters_.rebuilds; }
+  /// How often the contact search's near pairs were filtered from the list (0 when they are off).
+  std::int64_t near_pair_renewals() const { return near_.renewals; }
   /// Pairs in overlap at the last force evaluation (particle-particle and particle-wall).
   std::int64_t contact_count() const { return counters_.contacts; }
   const NeighborList& neighbor_list() const { return verlet_.list; }
@@ -133,8 +138,13 @@ class DemSystem {
   void compute_forces_impl(const Rolling& rolling);
   /// Zeroes the forces and torques that a fused kick has not already zeroed.
   void zero_unspent_forces();
+  // The contact search (contact_search.cpp).
   /// The overlapping list pairs into pairs_ (row, slot), their springs carried over; their number.
   std::size_t find_pair_contacts();
+  /// Whether no pair outside near_ can touch yet.
+  bool near_pairs_exact() const;
+  /// near_ from the list's np pairs, pairs_.flag holding which are within the margin.
+  void renew_near_pairs(std::size_t np);
   template <class Rolling>
   void add_pair_forces(const Rolling& rolling, std::size_t nc);
   /// Returns the number of wall contacts.
@@ -204,6 +214,7 @@ class DemSystem {
   VerletState verlet_;
   UniformProperties uniform_;
   PairContacts pairs_;
+  NearPairs near_;
   WallContacts walls_;
   HistoryCarry carry_;
   FusedPass fused_;

@@ -192,6 +192,31 @@ TEST(ParallelDem, ALayerSlidingAcrossTheCutsBetweenRebuildsRunsAsOnOne) {
   EXPECT_LT(diff, 1e-10);
 }
 
+// The sliding layer again with the contact search's near pairs on several ranks (each rank
+// renews its own from its particles and ghost copies) against one rank testing the whole list.
+TEST(ParallelDem, NearPairsOnSeveralRanksRunAsTheWholeListOnOne) {
+  const double L = 16 * kD;
+  auto cfg = make_config(L, true, 0.5, 0.5, 0.1, 2e-5);
+  auto whole = cfg;
+  whole.near_pairs = false;
+  auto add = [&](DemSystem& dem) {
+    add_random(dem, 700, L, 23);
+    auto& s = dem.particles();
+    for (std::size_t i = 0; i < s.size(); ++i)
+      if (s.y[i] < 0.5 * L) s.vz[i] += 0.6;
+  };
+  const auto par = run(cfg, add, 2000, true), ser = run(whole, add, 2000, false);
+  const auto par_whole = run(whole, add, 2000, true);
+  const double diff = max_position_difference(par, ser, L);
+  std::printf(
+      "[ report ] sliding layer, near pairs on %d ranks against the whole list on one: largest position "
+      "difference %.3g m\n",
+      rank_count(), diff);
+  EXPECT_LT(diff, 1e-10);
+  // on the same ranks, the same bits
+  EXPECT_EQ(max_position_difference(par, par_whole, L), 0.0);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
