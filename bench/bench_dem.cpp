@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
   // Whole runs through advance(), as the dem_only scene makes them (kicks fused between steps).
   dem.advance(static_cast<int>(nsettle));
   dem.seconds_force = dem.seconds_neighbor = dem.seconds_integrate = 0.0;
-  const auto rebuilds0 = dem.rebuilds();
+  const auto rebuilds0 = dem.rebuilds(), renewals0 = dem.near_pair_renewals();
   const auto t0 = std::chrono::steady_clock::now();
   dem.advance(static_cast<int>(nrun));
   const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -40,9 +40,10 @@ int main(int argc, char** argv) {
   std::printf(
       "boycott: %zu particles, %ld steps, %.2f s (force %.2f, neighbour %.2f in %lld rebuilds, integrate "
       "%.2f), "
-      "contacts %lld, list pairs %zu, ns_per_particle_step=%.1f\n",
+      "contacts %lld, list pairs %zu, near pairs %zu in %lld renewals, ns_per_particle_step=%.1f\n",
       s.n_local, nrun, t, dem.seconds_force, dem.seconds_neighbor,
       static_cast<long long>(dem.rebuilds() - rebuilds0), dem.seconds_integrate,
-      static_cast<long long>(dem.contact_count()), dem.neighbor_list().pair_count(), t / ps * 1e9);
+      static_cast<long long>(dem.contact_count()), dem.neighbor_list().pair_count(), dem.near_pair_count(),
+      static_cast<long long>(dem.near_pair_renewals() - renewals0), t / ps * 1e9);
   return 0;
 }

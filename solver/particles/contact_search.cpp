@@ -74,7 +74,9 @@ std::size_t DemSystem::find_pair_contacts() {
   const std::uint32_t* row_of_slot = verlet_.row_of_slot.data();
   std::size_t nc = 0;
   if (near_.margin_m > 0.0) {
-    if (!near_pairs_exact()) {
+    const bool exact = near_pairs_exact();
+    fused_.near_box_fresh = false;  // read; a renewal moves the references
+    if (!exact) {
       test(np, row_of_slot, verlet_.list.neighbors.data(), near_.margin_m);
       renew_near_pairs(np);
     }
@@ -98,10 +100,14 @@ bool DemSystem::near_pairs_exact() const {
   // distance has shrunk by the margin, which needs some particle to have moved half the margin
   // from a common displacement (displacement_bound.hpp; the box's centre is the one tested).
   // Ghost copies count too: their positions are refreshed every step.
+  // The local particles' box comes from the fused kick that drifted them when it is fresh.
   if (!near_.fresh) return false;
-  const DisplacementSpread sp = displacement_box(s_.size(), s_.x.data(), s_.y.data(), s_.z.data(),
-                                                 near_.ref_x.data(), near_.ref_y.data(), near_.ref_z.data());
-  return box_within_half_skin(sp, near_.margin_m);
+  DisplacementBox box;
+  std::size_t from = 0;
+  if (fused_.near_box_fresh) box = fused_.near_box, from = s_.n_local;
+  box.add(from, s_.size(), s_.x.data(), s_.y.data(), s_.z.data(), near_.ref_x.data(), near_.ref_y.data(),
+          near_.ref_z.data());
+  return box_within_half_skin(box.result(), near_.margin_m);
 }
 
 void DemSystem::renew_near_pairs(std::size_t np) {

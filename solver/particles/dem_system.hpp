@@ -99,6 +99,8 @@ class DemSystem {
   std::int64_t rebuilds() const { return counters_.rebuilds; }
   /// How often the contact search's near pairs were filtered from the list (0 when they are off).
   std::int64_t near_pair_renewals() const { return near_.renewals; }
+  /// The near pairs the contact search tests now (0 when they are off).
+  std::size_t near_pair_count() const { return near_.slot.size(); }
   /// Pairs in overlap at the last force evaluation (particle-particle and particle-wall).
   std::int64_t contact_count() const { return counters_.contacts; }
   const NeighborList& neighbor_list() const { return verlet_.list; }

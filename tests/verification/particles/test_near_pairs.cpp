@@ -21,22 +21,23 @@ namespace {
 
 struct Outcome {
   std::vector<double> state;           ///< every particle's position, velocity and spin, in id order
-  std::vector<std::int64_t> contacts;  ///< contact count after each step
+  std::vector<std::int64_t> contacts;  ///< contact count after each call of advance
   std::int64_t rebuilds = 0, renewals = 0;
 };
 
-/// Runs `steps` steps of the particles `add` places (then `between`, before each step) with the
-/// near pairs on or off.
-Outcome run(DemConfig cfg, bool near, const std::function<void(DemSystem&)>& add, int steps,
+/// Runs `calls` x `chunk` steps of the particles `add` places with the near pairs on or off, in
+/// calls of advance(chunk) (with chunk > 1 the fused kicks test the near pairs' displacements
+/// as they drift the particles), `between` before each call.
+Outcome run(DemConfig cfg, bool near, const std::function<void(DemSystem&)>& add, int calls, int chunk,
             const std::function<void(DemSystem&, int)>& between = {}) {
   cfg.near_pairs = near;
   DemSystem dem(cfg);
   add(dem);
   dem.initialize();
   Outcome o;
-  for (int k = 0; k < steps; ++k) {
+  for (int k = 0; k < calls; ++k) {
     if (between) between(dem, k);
-    dem.step();
+    dem.advance(chunk);
     o.contacts.push_back(dem.contact_count());
   }
   const auto& s = dem.particles();
@@ -63,7 +64,8 @@ void expect_same_bits(const Outcome& near, const Outcome& whole) {
 }  // namespace
 
 // 700 spheres between two walls under gravity, the upper half thrown along z at 0.6 m/s over the
-// lower: a sheared, packed layer where pairs close and open every few steps.
+// lower: a sheared, packed layer where pairs close and open every few steps (200 calls of 10
+// fused steps; the contact counts compared after each call).
 TEST(NearPairs, ALayerShearedOverABedBetweenWallsRunsBitForBitAsTheWholeList) {
   const double L = 16 * kD;
   auto cfg = make_config(L, true, 0.5, 0.5, 0.1, 2e-5);
@@ -74,7 +76,7 @@ TEST(NearPairs, ALayerShearedOverABedBetweenWallsRunsBitForBitAsTheWholeList) {
     for (std::size_t i = 0; i < s.size(); ++i)
       if (s.y[i] > 0.5 * L) s.vz[i] += 0.6;
   };
-  const Outcome near = run(cfg, true, add, 2000), whole = run(cfg, false, add, 2000);
+  const Outcome near = run(cfg, true, add, 200, 10), whole = run(cfg, false, add, 200, 10);
   std::printf(
       "[ report ] sheared layer: %lld list rebuilds, %lld near-pair renewals, %lld contacts at the end\n",
       static_cast<long long>(near.rebuilds), static_cast<long long>(near.renewals),
@@ -99,7 +101,7 @@ TEST(NearPairs, SpheresClosingFromBeyondTheMarginCollideAsWithTheWholeList) {
     auto& s = dem.particles();
     s.vz[0] = 0.5, s.vz[1] = -0.5;
   };
-  const Outcome near = run(cfg, true, add, 400), whole = run(cfg, false, add, 400);
+  const Outcome near = run(cfg, true, add, 400, 1), whole = run(cfg, false, add, 400, 1);
   expect_same_bits(near, whole);
   std::int64_t touching_steps = 0;
   for (auto c : near.contacts) touching_steps += c > 0;
@@ -128,7 +130,7 @@ TEST(NearPairs, SpheresGrowingIntoContactWithoutMovingAreFound) {
     for (std::size_t i = 0; i < s.size(); ++i) s.radius[i] = r, s.mass[i] = m, s.inertia[i] = 0.4 * m * r * r;
     dem.particle_sizes_changed();
   };
-  const Outcome near = run(cfg, true, add, 40, between), whole = run(cfg, false, add, 40, between);
+  const Outcome near = run(cfg, true, add, 40, 1, between), whole = run(cfg, false, add, 40, 1, between);
   expect_same_bits(near, whole);
   EXPECT_EQ(near.contacts[5], 0);
   EXPECT_GT(near.contacts[12], 0);

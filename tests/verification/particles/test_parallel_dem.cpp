@@ -41,14 +41,15 @@ SlabDecomposition uniform_slabs(double L) {
 }
 
 /// Runs `steps` DEM steps of the particles `add` places, on all ranks (parallel) or on this one
-/// (serial), and returns every particle's state by id (on every rank).
+/// (serial), in calls of advance(chunk) (fused kicks between the steps of a call), and returns
+/// every particle's state by id (on every rank).
 std::map<std::int64_t, State> run(const DemConfig& cfg, const std::function<void(DemSystem&)>& add, int steps,
-                                  bool parallel, std::int64_t* migrations = nullptr) {
+                                  bool parallel, std::int64_t* migrations = nullptr, int chunk = 1) {
   DemSystem dem(cfg);
   add(dem);
   if (parallel) dem.decompose(uniform_slabs(cfg.box.len[2]));
   dem.initialize();
-  for (int k = 0; k < steps; ++k) dem.step();
+  for (int k = 0; k < steps; k += chunk) dem.advance(chunk);
   const auto& s = dem.particles();
   std::vector<double> mine;
   for (std::size_t i = 0; i < s.n_local; ++i)
@@ -193,7 +194,8 @@ TEST(ParallelDem, ALayerSlidingAcrossTheCutsBetweenRebuildsRunsAsOnOne) {
 }
 
 // The sliding layer again with the contact search's near pairs on several ranks (each rank
-// renews its own from its particles and ghost copies) against one rank testing the whole list.
+// renews its own from its particles and ghost copies, the local ones' displacements taken in the
+// fused kicks of advance(10)) against one rank testing the whole list.
 TEST(ParallelDem, NearPairsOnSeveralRanksRunAsTheWholeListOnOne) {
   const double L = 16 * kD;
   auto cfg = make_config(L, true, 0.5, 0.5, 0.1, 2e-5);
@@ -205,8 +207,8 @@ TEST(ParallelDem, NearPairsOnSeveralRanksRunAsTheWholeListOnOne) {
     for (std::size_t i = 0; i < s.size(); ++i)
       if (s.y[i] < 0.5 * L) s.vz[i] += 0.6;
   };
-  const auto par = run(cfg, add, 2000, true), ser = run(whole, add, 2000, false);
-  const auto par_whole = run(whole, add, 2000, true);
+  const auto par = run(cfg, add, 2000, true, nullptr, 10), ser = run(whole, add, 2000, false, nullptr, 10);
+  const auto par_whole = run(whole, add, 2000, true, nullptr, 10);
   const double diff = max_position_difference(par, ser, L);
   std::printf(
       "[ report ] sliding layer, near pairs on %d ranks against the whole list on one: largest position "
@@ -215,6 +217,38 @@ TEST(ParallelDem, NearPairsOnSeveralRanksRunAsTheWholeListOnOne) {
   EXPECT_LT(diff, 1e-10);
   // on the same ranks, the same bits
   EXPECT_EQ(max_position_difference(par, par_whole, L), 0.0);
+}
+
+// Two layers of spheres facing each other across the first slab face, 0.12 mm apart (beyond
+// the 0.1 mm margin), the upper one closing at 0.5 m/s: they touch after 12 steps, before the
+// list's rebuild at 15. Each rank's own particles move as one (the box of their displacements
+// has no extent), so only the ghost copies' displacements can renew its near pairs in time.
+TEST(ParallelDem, NearPairsFollowGhostsClosingOnARankAtRest) {
+  const double L = 16 * kD, gap = 0.12e-3, cut = L / rank_count();
+  auto cfg = make_config(L, true, 0.5, 0.5, 0.1, 2e-5);
+  auto whole = cfg;
+  whole.near_pairs = false;
+  auto add = [&](DemSystem& dem) {
+    std::int64_t id = 0;
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b) {
+        const double x = (a + 0.5) * L / 8, y = (b + 0.5) * L / 8;
+        dem.add_particle(id++, x, y, cut - kR - 0.5 * gap, kR, kRho);
+        dem.add_particle(id++, x, y, cut + kR + 0.5 * gap, kR, kRho);
+      }
+    auto& s = dem.particles();
+    for (std::size_t i = 0; i < s.size(); ++i) s.vz[i] = s.z[i] > cut ? -0.5 : 0.0;
+  };
+  // one call of advance(40): every step after the first has its displacements from a fused kick
+  const auto par = run(cfg, add, 40, true, nullptr, 40), par_whole = run(whole, add, 40, true, nullptr, 40);
+  const auto ser = run(whole, add, 40, false, nullptr, 40);
+  EXPECT_LT(max_position_difference(par, ser, L), 1e-10);
+  EXPECT_EQ(max_position_difference(par, par_whole, L), 0.0);
+  // the layers met: the resting one was pushed down
+  double lowest = L;
+  for (const auto& [id, st] : par)
+    if (id % 2 == 0) lowest = std::min(lowest, st.z);
+  EXPECT_LT(lowest, cut - kR - 0.5 * gap);
 }
 
 }  // namespace
