@@ -74,9 +74,7 @@ std::size_t DemSystem::find_pair_contacts() {
   const std::uint32_t* row_of_slot = verlet_.row_of_slot.data();
   std::size_t nc = 0;
   if (near_.margin_m > 0.0) {
-    const bool exact = near_pairs_exact();
-    fused_.near_box_fresh = false;  // read; a renewal moves the references
-    if (!exact) {
+    if (!near_pairs_exact()) {
       test(np, row_of_slot, verlet_.list.neighbors.data(), near_.margin_m);
       renew_near_pairs(np);
     }
@@ -99,15 +97,14 @@ bool DemSystem::near_pairs_exact() const {
   // A pair left out was at least the margin apart at the renewal; it can touch only after its
   // distance has shrunk by the margin, which needs some particle to have moved half the margin
   // from a common displacement (displacement_bound.hpp; the box's centre is the one tested).
-  // Ghost copies count too: their positions are refreshed every step.
-  // The local particles' box comes from the fused kick that drifted them when it is fresh.
+  // Ghost copies count too: their positions are refreshed every step. A pass of its own: taken
+  // inside the fused kick instead (while the drifted block is in L1, as the rebuild test's box),
+  // the kick's share of a bench_dem run at 120 000 particles grew by more (3.8 % of the run) than
+  // this pass takes (2.5 %; perf, docs/performance.md).
   if (!near_.fresh) return false;
-  DisplacementBox box;
-  std::size_t from = 0;
-  if (fused_.near_box_fresh) box = fused_.near_box, from = s_.n_local;
-  box.add(from, s_.size(), s_.x.data(), s_.y.data(), s_.z.data(), near_.ref_x.data(), near_.ref_y.data(),
-          near_.ref_z.data());
-  return box_within_half_skin(box.result(), near_.margin_m);
+  const DisplacementSpread sp = displacement_box(s_.size(), s_.x.data(), s_.y.data(), s_.z.data(),
+                                                 near_.ref_x.data(), near_.ref_y.data(), near_.ref_z.data());
+  return box_within_half_skin(sp, near_.margin_m);
 }
 
 void DemSystem::renew_near_pairs(std::size_t np) {

@@ -127,10 +127,6 @@ struct FusedPass {
   /// that follows it (fresh until that test has read it).
   DisplacementSpread drift_box;
   bool drift_box_fresh = false;
-  /// The same against the near pairs' reference positions (local particles [0, n_local)), for
-  /// the near pairs' test of the force evaluation that follows (fresh until it has read it).
-  DisplacementBox near_box;
-  bool near_box_fresh = false;
 };
 
 /// The run's clock and event counts.

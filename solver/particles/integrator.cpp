@@ -126,13 +126,11 @@ void kick_spin(std::size_t n, double h, const double* __restrict I, double* __re
   }
 }
 
-/// Fused: also the displacement box of the drifted positions against ref (x, y, z), into box, and
-/// with near_box, against near_ref (the near pairs' reference positions) into near_box.
+/// Fused: also the displacement box of the drifted positions against ref (x, y, z), into box.
 template <bool Predict, bool Track, bool Wet, bool Fused = false, bool Record = false>
 void kick_all(std::size_t n, double h, double dt, const std::array<double, 3>& g, ParticleStore& s,
               std::vector<double>* pred, double* rz = nullptr, DisplacementBox* box = nullptr,
-              const double* const* ref = nullptr, DisplacementBox* near_box = nullptr,
-              const double* const* near_ref = nullptr) {
+              const double* const* ref = nullptr) {
   double* p[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
   if constexpr (Predict)
     for (int c = 0; c < 6; ++c) p[c] = pred[c].data();
@@ -152,8 +150,6 @@ void kick_all(std::size_t n, double h, double dt, const std::array<double, 3>& g
       const std::size_t e = std::min(n, b + kBlock);
       run(b, e);
       box->add(b, e, s.x.data(), s.y.data(), s.z.data(), ref[0], ref[1], ref[2]);
-      if (near_box)
-        near_box->add(b, e, s.x.data(), s.y.data(), s.z.data(), near_ref[0], near_ref[1], near_ref[2]);
     }
   } else {
     run(0, n);
@@ -212,20 +208,16 @@ void DemSystem::kick_kick_drift(double h, double* vz_sum) {
   const bool wet = !cfg_.dry || track;
   auto& g = cfg_.gravity_m_s2;
   const double dt = cfg_.dt_s;
-  DisplacementBox box, near_box;
+  DisplacementBox box;
   const double* ref[3] = {verlet_.ref_x.data(), verlet_.ref_y.data(), verlet_.ref_z.data()};
-  // The near pairs' test too, while the drifted positions are in L1 (contact_search.cpp).
-  const bool near = near_.fresh && near_.ref_x.size() >= n;
-  const double* near_ref[3] = {near_.ref_x.data(), near_.ref_y.data(), near_.ref_z.data()};
-  DisplacementBox* nb = near ? &near_box : nullptr;
   auto pass = [&](auto record, double* rz) {
     constexpr bool R = decltype(record)::value;
     if (track)
-      kick_all<true, true, true, true, R>(n, h, dt, g, s_, pred_, rz, &box, ref, nb, near_ref);
+      kick_all<true, true, true, true, R>(n, h, dt, g, s_, pred_, rz, &box, ref);
     else if (wet)
-      kick_all<true, false, true, true, R>(n, h, dt, g, s_, pred_, rz, &box, ref, nb, near_ref);
+      kick_all<true, false, true, true, R>(n, h, dt, g, s_, pred_, rz, &box, ref);
     else
-      kick_all<true, false, false, true, R>(n, h, dt, g, s_, pred_, rz, &box, ref, nb, near_ref);
+      kick_all<true, false, false, true, R>(n, h, dt, g, s_, pred_, rz, &box, ref);
   };
   if (vz_sum) {
     // v_z at the end of the step exists only inside the pass: it is written out and summed after
@@ -238,8 +230,6 @@ void DemSystem::kick_kick_drift(double h, double* vz_sum) {
   }
   fused_.drift_box = box.result();
   fused_.drift_box_fresh = true;
-  fused_.near_box = near_box;
-  fused_.near_box_fresh = near;
   fused_.local_forces_zeroed = true;
   copy_ghost_predictions();
 }

@@ -26,8 +26,8 @@ struct Outcome {
 };
 
 /// Runs `calls` x `chunk` steps of the particles `add` places with the near pairs on or off, in
-/// calls of advance(chunk) (with chunk > 1 the fused kicks test the near pairs' displacements
-/// as they drift the particles), `between` before each call.
+/// calls of advance(chunk) (with chunk > 1 the steps of a call drift in fused kick passes, as
+/// the coupled sub-cycle runs them), `between` before each call.
 Outcome run(DemConfig cfg, bool near, const std::function<void(DemSystem&)>& add, int calls, int chunk,
             const std::function<void(DemSystem&, int)>& between = {}) {
   cfg.near_pairs = near;

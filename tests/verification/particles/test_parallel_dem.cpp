@@ -194,8 +194,8 @@ TEST(ParallelDem, ALayerSlidingAcrossTheCutsBetweenRebuildsRunsAsOnOne) {
 }
 
 // The sliding layer again with the contact search's near pairs on several ranks (each rank
-// renews its own from its particles and ghost copies, the local ones' displacements taken in the
-// fused kicks of advance(10)) against one rank testing the whole list.
+// renews its own from its particles and ghost copies; calls of advance(10), whose steps drift in
+// fused kick passes) against one rank testing the whole list.
 TEST(ParallelDem, NearPairsOnSeveralRanksRunAsTheWholeListOnOne) {
   const double L = 16 * kD;
   auto cfg = make_config(L, true, 0.5, 0.5, 0.1, 2e-5);
@@ -239,7 +239,7 @@ TEST(ParallelDem, NearPairsFollowGhostsClosingOnARankAtRest) {
     auto& s = dem.particles();
     for (std::size_t i = 0; i < s.size(); ++i) s.vz[i] = s.z[i] > cut ? -0.5 : 0.0;
   };
-  // one call of advance(40): every step after the first has its displacements from a fused kick
+  // one call of advance(40), as the coupled sub-cycle makes them
   const auto par = run(cfg, add, 40, true, nullptr, 40), par_whole = run(whole, add, 40, true, nullptr, 40);
   const auto ser = run(whole, add, 40, false, nullptr, 40);
   EXPECT_LT(max_position_difference(par, ser, L), 1e-10);
