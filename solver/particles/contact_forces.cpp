@@ -17,10 +17,10 @@ namespace boycott::particles {
 
 namespace {
 /// The particles [0, n) closer to wall W than their radius, appended to wc; returns their number.
-/// Like find_contacts: a branch-free test into a byte per particle (vectorised), then the
-/// append. A wall normal to a coordinate axis (every wall of the scenes) reads that coordinate
-/// only: (x - px) 0 + (y - py) ny + (z - pz) 0 is (y - py) ny for finite coordinates, up to the
-/// sign of a zero, which neither the test nor the overlap r - dist sees.
+/// Like the pair search (contact_search.cpp): a branch-free test into a byte per particle (vectorised), then
+/// the append. A wall normal to a coordinate axis (every wall of the scenes) reads that coordinate only: (x -
+/// px) 0 + (y - py) ny + (z - pz) 0 is (y - py) ny for finite coordinates, up to the sign of a zero, which
+/// neither the test nor the overlap r - dist sees.
 std::size_t find_wall_contacts(std::size_t n, const PlaneWall& W, const double* __restrict x,
                                const double* __restrict y, const double* __restrict z,
                                const double* __restrict rad, std::uint8_t* __restrict flag,

@@ -4,9 +4,10 @@
 // NearPairs): the list pairs whose surfaces were within a margin when they were last filtered,
 // renewed when some particle may have moved half the margin. In a suspension most list pairs are
 // apart (8 in 9 on the LIGGGHTS bench; 2.5 list pairs per particle and 0.8 near at 0.1 mm in the
-// vertical channel, docs/performance.md), so the test reads a third to a half of the list per
-// step. The near pairs keep the list's order and every pair that can touch, so the contacts, their
-// order and every result are the bits of a test over the whole list.
+// vertical channel, half of the list in a settled bed, docs/performance.md), so with the renewals
+// the test reads about two fifths to three fifths of the list per step. The near pairs keep the list's order
+// and every pair that can touch, so the contacts, their order and every result are the bits of a test over
+// the whole list.
 #include <array>
 #include <cstddef>
 #include <cstdint>
