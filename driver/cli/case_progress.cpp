@@ -9,11 +9,6 @@
 
 namespace boycott::driver {
 
-namespace {
-// The recent rate spans at least this much wall time, or this fraction of the run so far.
-constexpr double kRecentMinS = 10.0, kRecentFraction = 0.25, kSampleEveryS = 0.5;
-}  // namespace
-
 CaseProgress::CaseProgress(double end_s, bool live, double every_s)
     : CaseProgress(end_s, live, every_s, Io{}) {}
 
@@ -35,9 +30,8 @@ std::string CaseProgress::line(double t_s, bool finished) const {
   if (sim_s > 0 && finished) {
     s += fmt::format(", {:.3g} wall s per simulated s, {} wall", wall_s / sim_s, eta_text(wall_s));
   } else if (sim_s > 0) {
-    const auto& [w_old, t_old] = recent_.front();
-    const double recent_sim = t_s - t_old, recent_wall = seconds(w_old, now_);
-    const double rate = recent_sim > 0 && recent_wall > 0 ? recent_wall / recent_sim : wall_s / sim_s;
+    const double recent = recent_.wall_s_per_sim_s(now_, t_s);
+    const double rate = std::isfinite(recent) ? recent : wall_s / sim_s;
     s += fmt::format(", {:.3g} wall s per simulated s, ETA {}", rate, eta_text(rate * (end_s_ - t_s)));
   }
   if (!note_.empty()) s += ", " + note_;
@@ -51,12 +45,11 @@ void CaseProgress::at(double t_s) {
     started_ = true;
     t0_s_ = t_s;
     wall0_ = last_print_ = now_;
-    recent_.assign(1, {now_, t_s});
+    recent_ = RecentRate{};
+    recent_.add(now_, t_s);
     return;
   }
-  if (seconds(recent_.back().first, now_) >= kSampleEveryS) recent_.emplace_back(now_, t_s);
-  const double keep = std::max(kRecentMinS, kRecentFraction * seconds(wall0_, now_));
-  while (recent_.size() > 2 && seconds(recent_[1].first, now_) >= keep) recent_.pop_front();
+  recent_.add(now_, t_s);
   const double since = seconds(last_print_, now_);
   if (live_ && since >= 0.5) {
     write(fmt::format("\r{}\033[K", line(t_s, false)));

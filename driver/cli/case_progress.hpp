@@ -3,10 +3,10 @@
 // quantity so far; one line redrawn in place on a terminal, otherwise a plain line every
 // `--progress-every` seconds, so that a Slurm log or `nohup` shows a long run is alive.
 #include <chrono>
-#include <deque>
 #include <functional>
 #include <string>
-#include <utility>
+
+#include "driver/run/progress.hpp"
 
 namespace boycott::driver {
 
@@ -43,9 +43,8 @@ class CaseProgress {
   bool started_ = false, on_line_ = false;
   double t0_s_ = 0.0, t_last_s_ = 0.0;
   Clock::time_point wall0_, last_print_, now_;
-  /// (wall, simulated time) every few seconds: the ETA extrapolates the recent rate, not the
-  /// whole run's (the first steps of a settling run are the cheapest).
-  std::deque<std::pair<Clock::time_point, double>> recent_;
+  /// The ETA extrapolates the recent rate, not the whole run's.
+  RecentRate recent_;
 };
 
 }  // namespace boycott::driver

@@ -75,6 +75,27 @@ double last_row_value(const fs::path& run_dir, const std::string& column) {
   return stop == cells[index].c_str() || *stop != '\0' ? nan : v;
 }
 
+void RecentRate::add(Clock::time_point now, double t_s) {
+  const auto seconds = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double>(b - a).count();
+  };
+  if (samples_.empty()) {
+    first_ = now;
+    samples_.emplace_back(now, t_s);
+    return;
+  }
+  if (seconds(samples_.back().first, now) >= kSampleEveryS) samples_.emplace_back(now, t_s);
+  const double keep = std::max(kRecentMinS, kRecentFraction * seconds(first_, now));
+  while (samples_.size() > 2 && seconds(samples_[1].first, now) >= keep) samples_.pop_front();
+}
+
+double RecentRate::wall_s_per_sim_s(Clock::time_point now, double t_s) const {
+  if (samples_.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto& [w_old, t_old] = samples_.front();
+  const double sim = t_s - t_old, wall = std::chrono::duration<double>(now - w_old).count();
+  return sim > 0 && wall > 0 ? wall / sim : std::numeric_limits<double>::quiet_NaN();
+}
+
 ProgressDisplay::ProgressDisplay(std::string study, int jobs, bool live, double plain_every_s)
     : study_(std::move(study)),
       jobs_(jobs),
@@ -91,7 +112,8 @@ void ProgressDisplay::redraw_if_due(const ProgressCounts& counts, const std::vec
   }
 }
 
-void ProgressDisplay::draw(const ProgressCounts& counts, const std::vector<RunningCase>& running) {
+void ProgressDisplay::draw_at(const ProgressCounts& counts, const std::vector<RunningCase>& running,
+                              Clock::time_point now) {
   if (!live_ && plain_every_s_ <= 0) return;
   std::string s;
   if (live_) {
@@ -101,10 +123,17 @@ void ProgressDisplay::draw(const ProgressCounts& counts, const std::vector<Runni
   double remaining_s = 0, estimated_case_s = 0;
   int estimated = 0, unknown = 0;  // unknown: running cases without a sim_s_per_s yet
   std::string rows;
+  std::map<std::string, RecentRate> rates;
   for (const auto& j : running) {
     const double t_s = simulated_time_s(j.dir);
-    const double wall_s = std::chrono::duration<double>(Clock::now() - j.started).count();
-    const double sim_s_per_s = wall_s > 0 ? (t_s - j.t_start_s) / wall_s : 0;
+    const double wall_s = std::chrono::duration<double>(now - j.started).count();
+    // The recent rate, from the samples of this case's earlier draws (the first at its start).
+    RecentRate& rate = rates[j.dir.string()] = std::move(rates_[j.dir.string()]);
+    if (rate.empty()) rate.add(j.started, j.t_start_s);
+    rate.add(now, t_s);
+    const double recent = rate.wall_s_per_sim_s(now, t_s);
+    const double sim_s_per_s =
+        std::isfinite(recent) ? 1.0 / recent : (wall_s > 0 ? (t_s - j.t_start_s) / wall_s : 0);
     const double end_s = j.c->params.time.end_s;
     remaining_s += sim_s_per_s > 0 ? (end_s - t_s) / sim_s_per_s : 0.0;
     unknown += sim_s_per_s > 0 ? 0 : 1;
@@ -128,6 +157,7 @@ void ProgressDisplay::draw(const ProgressCounts& counts, const std::vector<Runni
                    running.size(), counts.failed, counts.pending, eta_text(eta_s),
                    counts.stopping ? " (stopping)" : "");
   s += rows;
+  rates_ = std::move(rates);  // a case that stopped running drops its samples
   printed_lines_ = 1 + static_cast<int>(running.size());
   std::fputs(s.c_str(), stderr);
   std::fflush(stderr);

@@ -4,9 +4,12 @@
 // plain lines every `--progress-every` seconds (a Slurm log, `nohup`, `| tee`).
 #include <chrono>
 #include <cstddef>
+#include <deque>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "driver/run/solver_process.hpp"
@@ -24,6 +27,27 @@ double simulated_time_s(const std::filesystem::path& run_dir);
 /// The value in the column named `column` of the last line of <run_dir>/timeseries.csv (its
 /// header names the columns); NaN where the file, the column or a number there is missing.
 double last_row_value(const std::filesystem::path& run_dir, const std::string& column);
+
+/// A run's rate over its recent past: (wall time, simulated time) samples at least
+/// kSampleEveryS apart, kept back to the last one older than max(kRecentMinS, kRecentFraction x
+/// the wall time since the first sample), so that the rate is the recent one, not the whole
+/// run's: the first steps of a settling run are the cheapest, and a run paused for a while (a
+/// campaign stopped for a benchmark) counts the pause only until it leaves that window.
+class RecentRate {
+ public:
+  using Clock = std::chrono::steady_clock;
+  static constexpr double kRecentMinS = 10.0, kRecentFraction = 0.25, kSampleEveryS = 0.5;
+  /// The run is at simulated time t_s (s) at `now`.
+  void add(Clock::time_point now, double t_s);
+  /// Wall seconds per simulated second from the oldest kept sample to (now, t_s); NaN while
+  /// that spans no simulated time.
+  double wall_s_per_sim_s(Clock::time_point now, double t_s) const;
+  bool empty() const { return samples_.empty(); }
+
+ private:
+  std::deque<std::pair<Clock::time_point, double>> samples_;
+  Clock::time_point first_;
+};
 
 /// What the counts line shows.
 struct ProgressCounts {
@@ -46,7 +70,13 @@ class ProgressDisplay {
   void set_planned_case_wall_s(double wall_s) { planned_case_wall_s_ = wall_s; }
 
   /// Replaces the lines drawn last.
-  void draw(const ProgressCounts& counts, const std::vector<RunningCase>& running);
+  void draw(const ProgressCounts& counts, const std::vector<RunningCase>& running) {
+    draw_at(counts, running, std::chrono::steady_clock::now());
+  }
+  /// draw() at the time `now` (a test passes its own: no test may judge wall time). A running
+  /// case's rate is its recent one (RecentRate, sampled at each draw from its start).
+  void draw_at(const ProgressCounts& counts, const std::vector<RunningCase>& running,
+               std::chrono::steady_clock::time_point now);
   /// draw(), at most twice a second live, else every plain_every_s.
   void redraw_if_due(const ProgressCounts& counts, const std::vector<RunningCase>& running);
 
@@ -59,6 +89,7 @@ class ProgressDisplay {
   double planned_case_wall_s_ = std::numeric_limits<double>::quiet_NaN();
   int printed_lines_ = 0;
   std::chrono::steady_clock::time_point last_draw_;
+  std::map<std::string, RecentRate> rates_;  ///< by run folder, of the cases running now
 };
 
 }  // namespace boycott::driver
