@@ -14,8 +14,8 @@ free for k sub-steps when that time exceeds k dt_dem.
 
 It also prices a second, thinner list inside the neighbour list (a "near list" of the pairs
 whose gap is below m < the skin S, filtered from the list and renewed when a particle could have
-moved m / 2): the contact search would test the near pairs every step and all list pairs once per
-renewal. A list lasts --list-steps DEM steps (a rebuild when a particle could have moved S / 2);
+moved m / 2): the contact search tests the near pairs every step and all list pairs once per
+renewal (DemSystem's near pairs, m = S / 3; bench_dem prints their count and renewals). A list lasts --list-steps DEM steps (a rebuild when a particle could have moved S / 2);
 over these few steps the particles move ballistically, so a near list lasts about m / S of that.
 Pair tests per step against the list's: near / list + (list / near list's life) / list.
 

@@ -49,7 +49,7 @@ std::map<std::int64_t, State> run(const DemConfig& cfg, const std::function<void
   add(dem);
   if (parallel) dem.decompose(uniform_slabs(cfg.box.len[2]));
   dem.initialize();
-  for (int k = 0; k < steps; k += chunk) dem.advance(chunk);
+  for (int k = 0; k < steps; k += chunk) dem.advance(std::min(chunk, steps - k));
   const auto& s = dem.particles();
   std::vector<double> mine;
   for (std::size_t i = 0; i < s.n_local; ++i)
