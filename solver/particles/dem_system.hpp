@@ -51,10 +51,11 @@ class DemSystem {
   /// with smaller or lighter particles). Collective.
   void set_particle_properties(double radius_m, double density_kg_m3);
   /// After writing radius, mass or inertia into particles() directly (a packing that grows the
-  /// particles step by step): the contact loops stop taking one radius for all particles until
-  /// the next initialize() or import_state() finds them equal again.
+  /// particles step by step): the contact loops stop taking one radius, mass and moment of
+  /// inertia for all particles (the dashpots' damping is chosen from the pair's masses) until the
+  /// next initialize() or import_state() finds them equal again.
   void particle_sizes_changed() {
-    uniform_.radius_m = 0.0;
+    uniform_ = UniformProperties{};
     near_.fresh = false;
   }
   /// Whether the contact loops take one radius and moment of inertia for all particles.

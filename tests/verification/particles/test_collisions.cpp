@@ -12,8 +12,17 @@ using namespace boycott::particles::testing;
 
 namespace {
 
+/// After initialize(), every particle's mass and moment of inertia times `mass_factor`, written
+/// into the store as a packing run writes them (particle_sizes_changed()).
+void scale_masses(DemSystem& dem, double mass_factor) {
+  if (mass_factor == 1.0) return;
+  auto& s = dem.particles();
+  for (std::size_t i = 0; i < s.size(); ++i) s.mass[i] *= mass_factor, s.inertia[i] *= mass_factor;
+  dem.particle_sizes_changed();
+}
+
 /// Normal restitution of a head-on particle-particle collision at approach speed 2 v0.
-double pair_restitution(double e, double dt, bool clip, double phase = 0.0) {
+double pair_restitution(double e, double dt, bool clip, double phase = 0.0, double mass_factor = 1.0) {
   DemSystem dem(make_config(20 * kD, false, e, 0.0, 0.0, dt, clip));
   dem.add_particle(0, 5 * kD, 5 * kD, 5 * kD, kR, kRho);
   dem.add_particle(1, 5 * kD + 2 * kR + 1e-6 + phase * 0.1 * dt, 5 * kD, 5 * kD, kR, kRho);
@@ -22,6 +31,7 @@ double pair_restitution(double e, double dt, bool clip, double phase = 0.0) {
   s.vx[0] = v0;
   s.vx[1] = -v0;
   dem.initialize();
+  scale_masses(dem, mass_factor);
   bool touched = false;
   for (int n = 0; n < 2000000; ++n) {
     dem.step();
@@ -34,13 +44,14 @@ double pair_restitution(double e, double dt, bool clip, double phase = 0.0) {
 }
 
 /// Normal restitution of a particle hitting the wall y = 0.
-double wall_restitution(double e, double dt, bool clip, double phase = 0.0) {
+double wall_restitution(double e, double dt, bool clip, double phase = 0.0, double mass_factor = 1.0) {
   DemSystem dem(make_config(20 * kD, true, e, 0.0, 0.0, dt, clip));
   dem.add_particle(0, 5 * kD, kR + 1e-6 + phase * 0.05 * dt, 5 * kD, kR, kRho);
   auto& s = dem.particles();
   const double v0 = 0.05;
   s.vy[0] = -v0;
   dem.initialize();
+  scale_masses(dem, mass_factor);
   bool touched = false;
   for (int n = 0; n < 2000000; ++n) {
     dem.step();
@@ -123,6 +134,23 @@ TEST_P(RestitutionTest, ClippedNormalForceReboundsWithItsAnalyticRestitution) {
   EXPECT_GT(expect, e);  // clipping always returns more energy than the target e
   EXPECT_NEAR(got, expect, 0.01 * expect);
   std::printf("[ report ] clipped pair e = %.2f: analytic %.5f, simulated %.5f\n", e, expect, got);
+}
+
+// A packing run grows the particles, writing their radii and masses, and says so with
+// particle_sizes_changed(): the dashpots must then damp with the masses the particles have, not
+// with the one they had when the list was built (the spring-dashpot's gamma is chosen from the
+// pair's reduced mass so that the rebound is e whatever the mass). At twice the mass, a gamma kept
+// from the old mass would rebound at e = 0.62 for the 0.5 asked.
+TEST_P(RestitutionTest, ReboundAfterTheMassesChangeTakesTheNewMasses) {
+  const double e = GetParam(), factor = 2.0;
+  const double tc_pair = LinearSpringDashpot::collision_time(0.5 * factor * particle_mass(), kKn, e);
+  const double tc_wall = LinearSpringDashpot::collision_time(factor * particle_mass(), kKn, e);
+  for (int ph = 0; ph < 3; ++ph) {
+    EXPECT_NEAR(pair_restitution(e, tc_pair / steps_per_contact(e), false, ph, factor), e, 0.01 * e)
+        << "pair, phase " << ph;
+    EXPECT_NEAR(wall_restitution(e, tc_wall / steps_per_contact(e), false, ph, factor), e, 0.01 * e)
+        << "wall, phase " << ph;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(BinaryCollision, RestitutionTest, ::testing::Values(0.1, 0.5, 0.9));
