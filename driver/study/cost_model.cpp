@@ -6,6 +6,9 @@
 #include <functional>
 #include <queue>
 
+#include <fmt/format.h>
+
+#include "core/constants.hpp"
 #include "core/scene_specs.hpp"
 
 namespace boycott::driver {
@@ -16,8 +19,11 @@ double num(const nlohmann::json& j, const char* section, const char* key, double
   return j[section][key].get<double>();
 }
 
-/// Solves the n x n system a x = b (n <= 3) by Gaussian elimination; false when singular.
-bool solve(std::array<std::array<double, 3>, 3> a, std::array<double, 3> b, int n, std::array<double, 3>& x) {
+constexpr int kTerms = 4;  ///< start, particle-steps, cell-steps, bed particle-steps
+using Row = std::array<double, kTerms>;
+
+/// Solves the n x n system a x = b (n <= kTerms) by Gaussian elimination; false when singular.
+bool solve(std::array<Row, kTerms> a, Row b, int n, Row& x) {
   for (int c = 0; c < n; ++c) {
     int piv = c;
     for (int r = c + 1; r < n; ++r)
@@ -47,6 +53,10 @@ CaseWork case_work(const nlohmann::json& p, double from_s, double to_s) {
   const double count = num(p, "particles", "count", 0.0);
   const double dt_dem = num(p, "time", "dt_dem", 0.0), dt_cfd = num(p, "time", "dt_cfd", 0.0);
   if (count > 0 && dt_dem > 0) w.particle_steps = count * span / dt_dem;
+  if (p.contains("gravity") && p["gravity"].contains("angle_deg") && p["gravity"]["angle_deg"].is_number()) {
+    const double theta = p["gravity"]["angle_deg"].get<double>() * kPi / 180.0;
+    if (std::abs(std::cos(theta)) > kBedGravityShare) w.bed_particle_steps = w.particle_steps;
+  }
   // A scene without fluid (or one this program does not know) has no fluid cells to pay for.
   const auto& specs = scene_specs();
   const bool fluid = std::any_of(specs.begin(), specs.end(),
@@ -112,22 +122,27 @@ CostModel::CostModel(const std::vector<MeasuredCost>& finished) {
       lo = lo > 0 ? std::min(lo, r) : r, hi = std::max(hi, r);
     }
     c.one_proportion = lo > 0 && hi < kSeparatingSpread * lo;
-    const auto features = [&](const CaseWork& w) -> std::array<double, 3> {
+    // The bed term only where the runs have beds and runs without: otherwise it is the particle
+    // term again and cannot be told apart from it.
+    bool beds = false, no_beds = false;
+    for (const auto* m : ms) (m->work.bed_particle_steps > 0 ? beds : no_beds) = true;
+    const auto features = [&](const CaseWork& w) -> Row {
       if (c.one_proportion)
-        return {1.0, kParticleStepS * w.particle_steps + kCellStepS * w.fluid_cell_steps, 0.0};
-      return {1.0, w.particle_steps, w.fluid_cell_steps};
+        return {1.0, kParticleStepS * w.particle_steps + kCellStepS * w.fluid_cell_steps, 0.0,
+                kParticleStepS * w.bed_particle_steps};
+      return {1.0, w.particle_steps, w.fluid_cell_steps, w.bed_particle_steps};
     };
-    std::array<bool, 3> use = {true, true, !c.one_proportion};
+    std::array<bool, kTerms> use = {true, true, !c.one_proportion, beds && no_beds};
     bool fitted = false;
-    for (int tries = 0; tries < 3 && ms.size() >= 3 && !fitted; ++tries) {
+    for (int tries = 0; tries < kTerms && ms.size() >= 3 && !fitted; ++tries) {
       std::vector<int> idx;
-      for (int k = 0; k < 3; ++k)
+      for (int k = 0; k < kTerms; ++k)
         if (use[k]) idx.push_back(k);
       const int n = static_cast<int>(idx.size());
-      std::array<std::array<double, 3>, 3> a{};
-      std::array<double, 3> b{}, x{};
+      std::array<Row, kTerms> a{};
+      Row b{}, x{};
       for (const auto* m : ms) {
-        const std::array<double, 3> f = features(m->work);
+        const Row f = features(m->work);
         const double w = 1.0 / (m->core_s * m->core_s);
         for (int r = 0; r < n; ++r) {
           for (int q = 0; q < n; ++q) a[r][q] += w * f[idx[r]] * f[idx[q]];
@@ -149,11 +164,13 @@ CostModel::CostModel(const std::vector<MeasuredCost>& finished) {
         use[negative] = false;
         continue;
       }
-      std::array<double, 3> coef = {0.0, 0.0, 0.0};
+      Row coef{};
       for (int r = 0; r < n; ++r) coef[idx[r]] = x[r];
-      c.start_s = coef[0], c.particle_step_s = coef[1], c.cell_step_s = coef[2];
+      c.start_s = coef[0], c.particle_step_s = coef[1], c.cell_step_s = coef[2],
+      c.bed_particle_step_s = coef[3];
       if (c.one_proportion)
-        c.particle_step_s = coef[1] * kParticleStepS, c.cell_step_s = coef[1] * kCellStepS;
+        c.particle_step_s = coef[1] * kParticleStepS, c.cell_step_s = coef[1] * kCellStepS,
+        c.bed_particle_step_s = coef[3] * kParticleStepS;
       fitted = true;
     }
     if (!fitted) {
@@ -171,16 +188,21 @@ CostModel::CostModel(const std::vector<MeasuredCost>& finished) {
 double CostModel::core_s(const CaseWork& w) const {
   const auto it = by_scene_.find(w.scene);
   const Coefficients c = it == by_scene_.end() ? Coefficients{} : it->second;
-  return c.start_s + c.particle_step_s * w.particle_steps + c.cell_step_s * w.fluid_cell_steps;
+  return c.start_s + c.particle_step_s * w.particle_steps + c.cell_step_s * w.fluid_cell_steps +
+         c.bed_particle_step_s * w.bed_particle_steps;
 }
 
 std::string CostModel::basis(const std::string& scene) const {
   const auto it = by_scene_.find(scene);
   if (it == by_scene_.end()) return "default";
-  return (it->second.fitted ? "fit to " : "default scaled by ") + std::to_string(it->second.runs) + " runs" +
-         (it->second.fitted && it->second.one_proportion
-              ? " (their particle and fluid work in one proportion: split as the defaults)"
-              : "");
+  const Coefficients& c = it->second;
+  std::string s = (c.fitted ? "fit to " : "default scaled by ") + std::to_string(c.runs) + " runs";
+  if (c.fitted && c.one_proportion)
+    s += " (their particle and fluid work in one proportion: split as the defaults)";
+  if (c.bed_particle_step_s > 0 && c.particle_step_s > 0)
+    s += fmt::format("; a bed on a wall makes a particle-step {:.2f}x as dear",
+                     1.0 + c.bed_particle_step_s / c.particle_step_s);
+  return s;
 }
 
 double ranks_efficiency(int ranks) {

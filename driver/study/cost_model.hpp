@@ -1,10 +1,10 @@
 #pragma once
 // What a case costs, for `study plan` and the estimate `study run` prints before it starts. Per
-// scene, core-seconds = a + b * particle-steps + c * fluid cell-steps, fitted to the finished runs
-// of the database (relative least squares, terms that would be negative dropped; runs whose two
-// kinds of work stand in one proportion fit a and one scale of the defaults' b : c); with fewer than
-// three finished runs of a scene, the default coefficients below, scaled by the mean ratio of
-// the measured to the predicted cost of those there are.
+// scene, core-seconds = a + b * particle-steps + c * fluid cell-steps + d * bed particle-steps,
+// fitted to the finished runs of the database (relative least squares, terms that would be
+// negative dropped; runs whose two kinds of work stand in one proportion fit a and one scale of the
+// defaults' b : c); with fewer than three finished runs of a scene, the default coefficients
+// below, scaled by the mean ratio of the measured to the predicted cost of those there are.
 #include <map>
 #include <string>
 #include <vector>
@@ -18,7 +18,17 @@ struct CaseWork {
   std::string scene;
   double particle_steps = 0.0;    ///< particles x DEM steps
   double fluid_cell_steps = 0.0;  ///< fluid cells x CFD steps (at dt_cfd, the CFL limit aside)
+  /// The particle-steps again where gravity has a component onto a wall (an inclined channel:
+  /// the particles gather into a bed on the lower wall, and a particle in the bed touches about
+  /// two others and the wall, where one in a vertical channel touches a third of one): the
+  /// contact work's extra cost, fitted where a scene's runs have both kinds. 0 otherwise.
+  double bed_particle_steps = 0.0;
 };
+/// A wall-normal share of gravity, |cos theta| (g = (0, -g cos theta, -g sin theta)), above this
+/// counts as making a bed: at 87 deg the paper's 0.6 mm sand (0.09 m/s alone) drifts onto the
+/// lower wall at ~5 mm/s and crosses its 6 mm channel in ~1.3 s of a 10-20 s run; closer to the
+/// vertical the bed forms late and the case counts as vertical.
+inline constexpr double kBedGravityShare = 0.05;
 CaseWork case_work(const nlohmann::json& params, double from_s, double to_s);
 
 /// One finished run: its work (its fluid cell-steps at the steps it took, `cfd_steps`) and what
@@ -56,6 +66,7 @@ class CostModel {
  private:
   struct Coefficients {
     double start_s = kStartS, particle_step_s = kParticleStepS, cell_step_s = kCellStepS;
+    double bed_particle_step_s = 0.0;
     int runs = 0;
     bool fitted = false;
     bool one_proportion = false;  ///< fitted as one scale on the defaults' split
