@@ -18,9 +18,12 @@ std::vector<RunRecord> query_runs(Database& db, const std::string& study);
 /// Core-hours of a run: its wall time over all attempts times the ranks of the attempt that
 /// finished it (a run resumed on another rank count is priced at the last one); unset without both.
 std::optional<double> core_hours(const RunRecord& r);
+/// CPU core-hours of a run over all its attempts (what it used, where core_hours is what it held:
+/// a pause or a machine shared with other work counts there, not here); unset where not recorded.
+std::optional<double> cpu_core_hours(const RunRecord& r);
 
-/// Table: one line per run in mm/s, hours and counts, then the total core-hours. CSV and JSON: the
-/// raw values in SI units, one row per run (core_hours included), no total.
+/// Table: one line per run in mm/s, hours and counts, then the totals. CSV and JSON: the raw
+/// values in SI units, one row per run (core_hours and cpu_core_hours included), no total.
 std::string format_runs(const std::vector<RunRecord>& rows, ListingFormat f);
 
 }  // namespace boycott::driver

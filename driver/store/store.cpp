@@ -423,7 +423,7 @@ std::vector<RunRecord> run_records(Database& db, const std::string& study) {
       " json_extract(r.summary_json, '$.settling_velocity_error_dof'), "
       " json_extract(r.summary_json, '$.settling_velocity_correlation_time_s'), "
       " json_extract(r.summary_json, '$.settling_velocity_window_correlation_times'), r.wall_time_s, "
-      " json_extract(r.summary_json, '$.mpi_ranks') "
+      " json_extract(r.summary_json, '$.mpi_ranks'), json_extract(r.summary_json, '$.cpu_time_s') "
       "FROM study_cases sc JOIN cases c ON c.id = sc.case_id JOIN results r ON r.case_id = c.id "
       "WHERE sc.study = ?1 GROUP BY sc.group_name, c.id ORDER BY pos, c.id");
   st.bind(1, study);
@@ -450,6 +450,7 @@ std::vector<RunRecord> run_records(Database& db, const std::string& study) {
     r.window_correlation_times = real(12);
     r.wall_time_s = real(13);
     r.ranks = integer(14);
+    r.cpu_time_s = real(15);
     out.push_back(std::move(r));
   }
   return out;

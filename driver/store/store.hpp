@@ -134,6 +134,8 @@ struct RunRecord {
   /// Over all its attempts (a resumed run carries its earlier attempts' time in its checkpoint).
   std::optional<double> wall_time_s;
   std::optional<std::int64_t> ranks;  ///< mpi_ranks of the attempt that finished it
+  /// CPU core-seconds over all its attempts (cpu_time_s; unset from builds that recorded none).
+  std::optional<double> cpu_time_s;
 };
 
 /// The study's finished cases, once per group they belong to, in study order.

@@ -86,12 +86,14 @@ MeasuredCost measured_cost(const std::string& case_id, const std::string& params
     // done, not the work planned (a branch's count includes its parent's steps: planned there).
     const double dt_cfd = num(p, "time", "dt_cfd", 0.0), steps = s.value("cfd_steps", 0.0);
     if (!s.contains("parent") && dt_cfd > 0 && steps > 0) m.work.fluid_cell_steps *= steps / (t / dt_cfd);
-    // One attempt from the start: its CPU time (steadier on a shared machine); a resumed run's
-    // earlier attempts are only in its wall time.
+    // Its CPU time over all attempts (steadier on a shared machine, and blind to a pause); from
+    // a build that recorded only the last attempt's, that where the run was done in one, else
+    // its wall time (earlier attempts are only there).
     const bool one_attempt = !s.value("resumed_from_checkpoint", false);
-    m.core_s = one_attempt && s.contains("attempt_cpu_time_s") && s["attempt_cpu_time_s"].is_number()
-                   ? s["attempt_cpu_time_s"].get<double>()
-                   : wall * std::max(1, s.value("mpi_ranks", 1));
+    const auto number = [&](const char* key) { return s.contains(key) && s[key].is_number(); };
+    m.core_s = number("cpu_time_s")                          ? s["cpu_time_s"].get<double>()
+               : one_attempt && number("attempt_cpu_time_s") ? s["attempt_cpu_time_s"].get<double>()
+                                                             : wall * std::max(1, s.value("mpi_ranks", 1));
     *ok = true;
   } catch (const std::exception&) {
     // An unreadable row does not calibrate anything.

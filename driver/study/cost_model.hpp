@@ -32,7 +32,8 @@ inline constexpr double kBedGravityShare = 0.05;
 CaseWork case_work(const nlohmann::json& params, double from_s, double to_s);
 
 /// One finished run: its work (its fluid cell-steps at the steps it took, `cfd_steps`) and what
-/// it cost in core-seconds (the CPU time of a run done in one attempt, else wall time x ranks).
+/// it cost in core-seconds (its CPU time over all attempts, cpu_time_s; from older builds the CPU
+/// time of a run done in one attempt, else wall time x ranks).
 struct MeasuredCost {
   std::string case_id;
   CaseWork work;

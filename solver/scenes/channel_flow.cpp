@@ -104,7 +104,7 @@ void report_flow(nlohmann::json& j, fluid::FluidSolver& solver, const CaseParams
 }  // namespace
 
 int run_channel_flow(const CaseParams& p, RunContext& ctx) {
-  WallClock clock;
+  RunClock clock;
   ModelTimers timers;
   const auto settings = fluid::FluidSettings::from_case(p);
   timers.activate("fluid", "staggered FV, QUICK, BDF2, " + settings.coupling_name());
@@ -157,7 +157,7 @@ int run_channel_flow(const CaseParams& p, RunContext& ctx) {
   SummaryBase base;
   base.status = interrupted ? kStatusInterrupted : kStatusCompleted;
   base.simulated_time_s = solver.time_s();
-  base.wall_time_s = clock.seconds();
+  base.set_spent(clock.spent());
   nlohmann::json j = make_summary(p, base, timers);
   report_flow(j, solver, p, settings.top_slip);
   j["unconverged_steps"] = unconverged;

@@ -102,7 +102,7 @@ struct CoupledCheckpoint {
   particles::DemState dem;
   fluid::FluidState fluid;
   std::vector<std::vector<double>> coupler;
-  double wall_time_s = 0.0;
+  RunSpent spent;
 };
 
 CoupledCheckpoint read_coupled(const io::CheckpointReader& r, const CaseParams& p) {
@@ -117,7 +117,13 @@ CoupledCheckpoint read_coupled(const io::CheckpointReader& r, const CaseParams& 
   io::load(r, "dem.", c.dem);
   io::load(r, "fluid.", c.fluid);
   c.coupler = io::load_arrays(r, "coupler.");
-  c.wall_time_s = r.scalar("run.wall_time_s");
+  c.spent.wall_s = r.scalar("run.wall_time_s");
+  // absent from checkpoints written before runs recorded their CPU time: unknown, not zero
+  c.spent.cpu_core_s = r.has("run.cpu_time_s") ? r.scalar("run.cpu_time_s") : kUnset;
+  if (r.has("run.cpu_time_s") && !(c.spent.cpu_core_s >= 0.0))
+    throw CheckpointError(
+        fmt::format("checkpoint {}: dataset 'run.cpu_time_s' fails the check: {} is not a time",
+                    r.path().string(), c.spent.cpu_core_s));
   const std::string file = r.path().string();
   const io::StateBounds box{{p.domain.length_x_m, p.domain.width_y_m, p.domain.height_z_m},
                             {true, p.domain.periodic_y, true}};
@@ -126,7 +132,7 @@ CoupledCheckpoint read_coupled(const io::CheckpointReader& r, const CaseParams& 
   io::check_finite(c.coupler, file, "coupler.");
   for (const auto& [name, v] : {std::pair{"run.time_s", c.counters.time_s},
                                 {"run.dt_prev_s", c.counters.dt_prev_s},
-                                {"run.wall_time_s", c.wall_time_s}})
+                                {"run.wall_time_s", c.spent.wall_s}})
     if (!std::isfinite(v))
       throw CheckpointError(
           fmt::format("checkpoint {}: dataset '{}' fails the check: {} is not finite", file, name, v));
@@ -211,16 +217,16 @@ void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run) {
   import_coupled(read_coupled(r, run.params()), run, r.path().string());
 }
 
-std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::filesystem::path& run_dir,
-                                     bool quiet,
-                                     const std::function<void(const io::CheckpointReader&)>& load_scene,
-                                     const std::filesystem::path& branch_checkpoint) {
+std::optional<RunSpent> resume_coupled(coupling::CoupledSystem& run, const std::filesystem::path& run_dir,
+                                       bool quiet,
+                                       const std::function<void(const io::CheckpointReader&)>& load_scene,
+                                       const std::filesystem::path& branch_checkpoint) {
   // Listed once, before any is set aside, so that every rank walks the same list.
   const auto candidates = io::checkpoints_newest_first(run_dir);
   if (candidates.empty()) {
     if (branch_checkpoint.empty()) return std::nullopt;
     start_from_parent(run, branch_checkpoint, quiet);
-    return 0.0;
+    return RunSpent{};
   }
   const std::string id = case_id(run.params());
   std::vector<std::string> refused;
@@ -245,7 +251,7 @@ std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::fi
     import_coupled(*state, run, ck.string());
     load_scene(*r);
     settle_after_resume(candidates, k, *r, run, run_dir, quiet);
-    return state->wall_time_s;
+    return state->spent;
   }
   std::string all;
   for (const auto& w : refused) all += (all.empty() ? "" : "; ") + w;
@@ -255,7 +261,7 @@ std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::fi
 }
 
 void checkpoint_coupled(const coupling::CoupledSystem& run, const std::filesystem::path& run_dir,
-                        double wall_time_s, const std::function<void(io::CheckpointWriter&)>& save_scene) {
+                        const RunSpent& spent, const std::function<void(io::CheckpointWriter&)>& save_scene) {
   // One file for all ranks, written by rank 0 from the gathered state.
   std::optional<io::CheckpointWriter> w;
   if (output_rank()) {
@@ -267,7 +273,8 @@ void checkpoint_coupled(const coupling::CoupledSystem& run, const std::filesyste
   save_coupled(w ? &*w : nullptr, run);
   if (!w) return;
   save_scene(*w);
-  w->put("run.wall_time_s", wall_time_s);
+  w->put("run.wall_time_s", spent.wall_s);
+  if (std::isfinite(spent.cpu_core_s)) w->put("run.cpu_time_s", spent.cpu_core_s);
   w->commit();
   io::prune_checkpoints(run_dir, static_cast<int>(run.params().output.keep_checkpoints));
 }

@@ -8,6 +8,7 @@
 
 #include "coupling/coupled_system.hpp"
 #include "io/checkpoint_file.hpp"
+#include "scenes/run_common.hpp"
 
 namespace boycott::scenes {
 
@@ -19,19 +20,20 @@ void load_coupled(const io::CheckpointReader& r, coupling::CoupledSystem& run);
 
 /// Resumes from the newest checkpoint in `run_dir`, if any: refuses one of another case
 /// (CheckpointError, the file left in place), loads this run's state, lets the scene load its
-/// own running sums, and cuts the time series back to the checkpoint's time. Returns the wall
-/// time the run had already spent (s), or nothing when there is no checkpoint to resume. A run
-/// folder without checkpoints given a branch_checkpoint (another run's) starts from that state
-/// instead: its particles (with this case's size and density), fluid and time, and fresh
-/// statistics of the scene (load_scene is not called); it returns 0 then.
-std::optional<double> resume_coupled(coupling::CoupledSystem& run, const std::filesystem::path& run_dir,
-                                     bool quiet,
-                                     const std::function<void(const io::CheckpointReader&)>& load_scene,
-                                     const std::filesystem::path& branch_checkpoint = {});
+/// own running sums, and cuts the time series back to the checkpoint's time. Returns what the
+/// run had already spent (wall time; CPU core-seconds, NaN from a checkpoint of a build that
+/// recorded none), or nothing when there is no checkpoint to resume. A run folder without
+/// checkpoints given a branch_checkpoint (another run's) starts from that state instead: its
+/// particles (with this case's size and density), fluid and time, and fresh statistics of the
+/// scene (load_scene is not called); it returns zeros then (a branch pays for its own steps).
+std::optional<RunSpent> resume_coupled(coupling::CoupledSystem& run, const std::filesystem::path& run_dir,
+                                       bool quiet,
+                                       const std::function<void(const io::CheckpointReader&)>& load_scene,
+                                       const std::filesystem::path& branch_checkpoint = {});
 /// Writes a checkpoint of this run and the scene's running sums (atomically; the newest
-/// output.keep_checkpoints are kept), recording the wall time spent so far (s). Collective;
+/// output.keep_checkpoints are kept), recording what the run has spent so far. Collective;
 /// save_scene runs on rank 0 only, so a scene reduces its per-rank sums before.
 void checkpoint_coupled(const coupling::CoupledSystem& run, const std::filesystem::path& run_dir,
-                        double wall_time_s, const std::function<void(io::CheckpointWriter&)>& save_scene);
+                        const RunSpent& spent, const std::function<void(io::CheckpointWriter&)>& save_scene);
 
 }  // namespace boycott::scenes

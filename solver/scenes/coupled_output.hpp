@@ -143,18 +143,18 @@ int run_coupled_steps(coupling::CoupledSystem& run, CoupledSceneOutput& out, Bef
 /// A scene that keeps a record (its measurements and what its checkpoints carry: load,
 /// checkpoint, next_out_s) runs its steps here, written once for inclined_settling and
 /// sediment_transport: stop requests honoured inside a step, the output with the scene's
-/// columns, checkpoints through the record, run_coupled_steps, the rows flushed. Then the
-/// summary's run totals in sb (the wall time includes wall_before_s, from before a resume).
+/// columns, checkpoints through the record (with what the run has spent, from `clock`, which
+/// carries the attempts before a resume), run_coupled_steps, the rows flushed.
 template <class Record, class BeforeStep, class Measure>
 int run_recorded_steps(coupling::CoupledSystem& run, RunContext& ctx, ModelTimers& timers, Record& record,
-                       std::vector<std::string> columns, bool resumed, const WallClock& clock,
-                       double wall_before_s, BeforeStep&& before_step, Measure&& measure, SummaryBase& sb) {
+                       std::vector<std::string> columns, bool resumed, const RunClock& clock,
+                       BeforeStep&& before_step, Measure&& measure, SummaryBase& sb) {
   // A stop request is honoured inside a long fluid step too (thousands of particle sub-steps).
   run.set_interrupt([&ctx] { return ctx.should_stop(); });
   CoupledSceneOutput out(run, ctx, timers, std::move(columns), resumed, record.next_out_s());
   const auto write_checkpoint = [&] {
     ModelTimers::Scope sc(timers, "checkpoints");
-    record.checkpoint(run, ctx.out_dir, wall_before_s + clock.seconds(), out.next_out_s());
+    record.checkpoint(run, ctx.out_dir, clock.spent(), out.next_out_s());
   };
   const int exit_code = run_coupled_steps(run, out, before_step, measure, write_checkpoint, sb);
   out.flush();
@@ -162,9 +162,9 @@ int run_recorded_steps(coupling::CoupledSystem& run, RunContext& ctx, ModelTimer
 }
 
 /// The run totals every coupled scene's summary carries.
-inline void set_run_totals(SummaryBase& sb, const coupling::CoupledSystem& run, double wall_s) {
+inline void set_run_totals(SummaryBase& sb, const coupling::CoupledSystem& run, const RunSpent& spent) {
   sb.simulated_time_s = run.time_s();
-  sb.wall_time_s = wall_s;
+  sb.set_spent(spent);
   sb.particle_steps = static_cast<double>(run.dem().global_count()) * static_cast<double>(run.dem().steps());
 }
 

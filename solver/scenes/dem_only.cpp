@@ -72,7 +72,7 @@ nlohmann::json dem_summary(const CaseParams& p, const particles::DemSystem& dem,
 }  // namespace
 
 int run_dem_only(const CaseParams& p, RunContext& ctx) {
-  WallClock clock;
+  RunClock clock;
   ModelTimers timers;
   auto dc = particles::DemConfig::from_case(p);
   dc.dry = true;
@@ -134,7 +134,7 @@ int run_dem_only(const CaseParams& p, RunContext& ctx) {
   timers.add("neighbor_search", dem.seconds_neighbor);
   timers.add("integration", dem.seconds_integrate);
   sb.simulated_time_s = dem.time_s();
-  sb.wall_time_s = clock.seconds();
+  sb.set_spent(clock.spent());
   const auto j = dem_summary(p, dem, sb, wp_avg, timers);
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   return exit_code;

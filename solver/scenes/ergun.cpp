@@ -43,7 +43,7 @@ int run_to_steady(coupling::CoupledSystem& run, double tol, int min_steps, int m
 }  // namespace
 
 int run_ergun(const CaseParams& p, RunContext& ctx) {
-  WallClock clock;
+  RunClock clock;
   ModelTimers timers;
   CaseParams q = p;
   q.gravity.magnitude_m_s2 = 0.0;
@@ -101,7 +101,7 @@ int run_ergun(const CaseParams& p, RunContext& ctx) {
   csv.flush();
   run.report_timers(timers);
   sb.simulated_time_s = run.time_s();
-  sb.wall_time_s = clock.seconds();
+  sb.set_spent(clock.spent());
   sb.particle_steps = 0.0;
   auto j = make_summary(p, sb, timers);
   j["ranks"] = run.rank_report();

@@ -100,7 +100,7 @@ class SettlingRecord {
   void load(const io::CheckpointReader& r);
   /// A checkpoint with the record, summed over ranks first on every rank (the writer runs on
   /// rank 0 alone, and a collective inside it would wait for ranks that never enter it).
-  void checkpoint(const coupling::CoupledSystem& run, const std::filesystem::path& dir, double wall_s,
+  void checkpoint(const coupling::CoupledSystem& run, const std::filesystem::path& dir, const RunSpent& spent,
                   double next_out_s);
   /// Records the force budget from the window's start on.
   void before_step(coupling::CoupledSystem& run) {
@@ -192,7 +192,7 @@ void SettlingRecord::load(const io::CheckpointReader& r) {
 }
 
 void SettlingRecord::checkpoint(const coupling::CoupledSystem& run, const std::filesystem::path& dir,
-                                double wall_s, double next_out_s) {
+                                const RunSpent& spent, double next_out_s) {
   const stats::Histogram all_y = over_ranks(run, pdf_y_), all_w = over_ranks(run, pdf_w_);
   std::vector<stats::Histogram> all_budget;
   if (budget_)
@@ -200,7 +200,7 @@ void SettlingRecord::checkpoint(const coupling::CoupledSystem& run, const std::f
   std::vector<stats::Histogram> all_profile;
   if (profile_)
     for (const stats::Histogram* h : profile_->all()) all_profile.push_back(over_ranks(run, *h));
-  checkpoint_coupled(run, dir, wall_s, [&](io::CheckpointWriter& w) {
+  checkpoint_coupled(run, dir, spent, [&](io::CheckpointWriter& w) {
     io::save(w, "stats.wp.", wp_avg_);
     io::save(w, "stats.wf.", wf_avg_);
     io::save(w, "stats.slurry.", slurry_avg_);
@@ -399,17 +399,16 @@ void SettlingRecord::report_clustering(nlohmann::json& j, const coupling::Couple
 }  // namespace
 
 int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
-  WallClock clock;
+  RunClock clock;
   ModelTimers timers;
   coupling::CoupledSystem run(p, coupling::CoupledOptions{true, true});
   const double vt = isolated_terminal_speed(p);
   SettlingRecord record(p, run, vt);
-  double wall_before = 0.0;
   const auto resumed = resume_coupled(
       run, ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) { record.load(r); },
       ctx.branch_checkpoint);
   if (resumed) {
-    wall_before = *resumed;
+    clock.carry(*resumed);
   } else {
     insert_case_particles(run.dem(), p);
     run.start();
@@ -421,12 +420,12 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       {"time_s", "mean_wp_m_s", "mean_wf_m_s", "slurry_velocity_m_s", "mean_up_m_s", "mean_vp_m_s",
        "driving_gradient_pa_m", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j",
        "cluster_index"},
-      resumed.has_value(), clock, wall_before, [&] { record.before_step(run); },
+      resumed.has_value(), clock, [&] { record.before_step(run); },
       [&](const coupling::CoupledStep& st, bool& end_early) { return record.measure(run, st, end_early); },
       sb);
   run.report_timers(timers);
   record.write_distributions(run, ctx.out_dir);
-  set_run_totals(sb, run, wall_before + clock.seconds());
+  set_run_totals(sb, run, clock.spent());
   const auto j = record.summary(run, sb, timers, vt, resumed.has_value());
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   return exit_code;

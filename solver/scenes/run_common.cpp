@@ -73,6 +73,18 @@ nlohmann::json build_info() {
           {"cpu_model", cpu_model()}};
 }
 
+double process_cpu_core_s() {
+  int ranks = 1, initialized = 0;
+  MPI_Initialized(&initialized);
+  if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  rusage use{};
+  getrusage(RUSAGE_SELF, &use);
+  const auto secs = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+  };
+  return (secs(use.ru_utime) + secs(use.ru_stime)) * ranks;
+}
+
 nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const ModelTimers& timers) {
   nlohmann::json j;
   j["scene"] = p.scene;
@@ -90,14 +102,10 @@ nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const Mod
   MPI_Initialized(&initialized);
   if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   j["mpi_ranks"] = ranks;
-  // CPU seconds of this process since it started (user + system), times the ranks: this
-  // attempt's cost, steadier than its wall time on a shared machine (study plan's cost model).
-  rusage use{};
-  getrusage(RUSAGE_SELF, &use);
-  const auto secs = [](const timeval& t) {
-    return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
-  };
-  j["attempt_cpu_time_s"] = (secs(use.ru_utime) + secs(use.ru_stime)) * ranks;
+  // This process's CPU since it started: this attempt's cost (start-up included); cpu_time_s
+  // is the run's over all attempts, from its checkpoints.
+  j["attempt_cpu_time_s"] = process_cpu_core_s();
+  j["cpu_time_s"] = num_or_null(s.cpu_time_s);
   if (!p.branch.parent_id.empty())
     j["parent"] = {{"case_id", p.branch.parent_id}, {"time_s", num_or_null(p.branch.parent_time_s)}};
   return j;

@@ -30,14 +30,25 @@ void write_file_atomic(const std::filesystem::path& path, const std::string& tex
 /// Compiler, flags, PETSc version and CPU model of this run (summary.json "build").
 nlohmann::json build_info();
 
+/// What a run has spent (over all its attempts where it resumes from checkpoints).
+struct RunSpent {
+  double wall_s = 0.0;
+  double cpu_core_s = 0.0;  ///< NaN when an earlier attempt's was not recorded (older checkpoints)
+};
+
 /// Common summary keys. Scene-specific keys are added to the returned object by the scene.
 struct SummaryBase {
   std::string status{kStatusCompleted};  ///< core/run_status.hpp
   double simulated_time_s = 0.0;
   double wall_time_s = 0.0;
+  double cpu_time_s = kUnset;   ///< CPU core-seconds over all attempts; kUnset when one's is unknown
   double particle_steps = 0.0;  ///< particles x DEM steps
   double mean_settling_velocity_m_s = kUnset;
   double settling_velocity_stderr_m_s = kUnset;
+  void set_spent(const RunSpent& spent) {
+    wall_time_s = spent.wall_s;
+    cpu_time_s = spent.cpu_core_s;
+  }
 };
 nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const ModelTimers& timers);
 
@@ -75,6 +86,27 @@ class WallClock {
 
  private:
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+/// CPU seconds (user + system) this process has used, times the MPI ranks (every rank is taken
+/// to use what this one does): the core-seconds a run costs, steadier than its wall time on a
+/// shared machine and blind to a pause (kill -STOP).
+double process_cpu_core_s();
+
+/// What a run has spent over all its attempts: the wall time (s) and CPU core-seconds that its
+/// checkpoint carries from the earlier attempts, plus this attempt's since construction.
+class RunClock {
+ public:
+  /// Resuming: what the earlier attempts spent, from the checkpoint.
+  void carry(const RunSpent& before) { before_ = before; }
+  RunSpent spent() const {
+    return {before_.wall_s + wall_.seconds(), before_.cpu_core_s + process_cpu_core_s() - cpu0_};
+  }
+
+ private:
+  WallClock wall_;
+  double cpu0_ = process_cpu_core_s();
+  RunSpent before_;
 };
 
 /// When a time-stepping scene writes a checkpoint: on the grid k * every_s of simulated time (so

@@ -180,10 +180,10 @@ class TransportRecord {
     profiles_.load(r);
   }
   /// A checkpoint with the record (the profiles' particle sums over ranks first, on every rank).
-  void checkpoint(const coupling::CoupledSystem& run, const std::filesystem::path& dir, double wall_s,
+  void checkpoint(const coupling::CoupledSystem& run, const std::filesystem::path& dir, const RunSpent& spent,
                   double next_out_s) {
     const Profiles all_profiles = profiles_.over_ranks(run);
-    checkpoint_coupled(run, dir, wall_s, [&](io::CheckpointWriter& w) {
+    checkpoint_coupled(run, dir, spent, [&](io::CheckpointWriter& w) {
       for (auto [name, b] : averages()) io::save(w, fmt::format("stats.{}.", name), *b);
       w.put("stats.alpha_min_seen", alpha_min_seen_);
       w.put("stats.ke_max_seen", ke_max_seen_);
@@ -302,20 +302,19 @@ nlohmann::json TransportRecord::summary(const coupling::CoupledSystem& run, Summ
 
 int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
   // The geometry (theta = 0, walls in y, a bed below the top) is checked by the pre-flight.
-  WallClock clock;
+  RunClock clock;
   ModelTimers timers;
   coupling::CoupledOptions opt;
   opt.zero_slurry_flux = false;
   opt.target_mean_flux_z_m_s = p.sediment.bulk_velocity_m_s;
   coupling::CoupledSystem run(p, opt);
   TransportRecord record(p);
-  double wall_before = 0.0;
   timers.activate("bed_pouring", "dry DEM until the bed rests");
   const auto resumed = resume_coupled(
       run, ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) { record.load(r); },
       ctx.branch_checkpoint);
   if (resumed)
-    wall_before = *resumed;
+    clock.carry(*resumed);
   else
     record.set_pouring_time(pour_bed_and_start_flow(run, p, timers));
   const double h_bed = bed_height_m(p, run.particle_volume_m3());
@@ -327,11 +326,11 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
       run, ctx, timers, record,
       {"time_s", "q_m2_s", "q_star", "driving_gradient_pa_m", "mean_flux_z_m_s", "mean_up_z_m_s",
        "mean_vp_m_s", "dt_s", "simple_iterations", "min_alpha_f", "kinetic_energy_j"},
-      resumed.has_value(), clock, wall_before, [] {},
+      resumed.has_value(), clock, [] {},
       [&](const coupling::CoupledStep& st, bool&) { return record.measure(run, st); }, sb);
   record.write_profiles(run, ctx.out_dir);
   run.report_timers(timers);
-  set_run_totals(sb, run, wall_before + clock.seconds());
+  set_run_totals(sb, run, clock.spent());
   const auto j = record.summary(run, sb, timers, h_bed, resumed.has_value());
   write_file_atomic(ctx.out_dir / "summary.json", j.dump(2) + "\n");
   if (!ctx.quiet && output_rank())

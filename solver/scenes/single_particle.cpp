@@ -70,12 +70,12 @@ void report_against_isolated_sphere(nlohmann::json& j, const CaseParams& p, doub
 }  // namespace
 
 int run_single_particle(const CaseParams& p, RunContext& ctx) {
-  WallClock clock;
+  RunClock clock;
   ModelTimers timers;
   coupling::CoupledSystem run(p, coupling::CoupledOptions{true, true});
   const auto& s = run.dem().particles();
   stats::BatchMeans wp_avg;
-  double acc0 = kUnset, next_out = 0.0, wall_before = 0.0;  // next_out: the resumed output's, s
+  double acc0 = kUnset, next_out = 0.0;  // next_out: the resumed output's, s
 
   const auto resumed = resume_coupled(
       run, ctx.out_dir, ctx.quiet,
@@ -86,7 +86,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
       },
       ctx.branch_checkpoint);
   if (resumed) {
-    wall_before = *resumed;
+    clock.carry(*resumed);
   } else {
     const auto& box = run.dem().config().box;
     run.dem().add_particle(0, box.lo[0] + 0.5 * box.len[0], box.lo[1] + 0.5 * box.len[1],
@@ -104,7 +104,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
                          resumed.has_value(), next_out);
   auto write_checkpoint = [&] {
     ModelTimers::Scope sc(timers, "checkpoints");
-    checkpoint_coupled(run, ctx.out_dir, wall_before + clock.seconds(), [&](io::CheckpointWriter& w) {
+    checkpoint_coupled(run, ctx.out_dir, clock.spent(), [&](io::CheckpointWriter& w) {
       io::save(w, "stats.wp.", wp_avg);
       w.put("stats.initial_acceleration", acc0);
       w.put("stats.next_out", out.next_out_s());
@@ -138,7 +138,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
 
   const double wt = wp_avg.count() ? wp_avg.mean() : particle(s.vz);
   sb.simulated_time_s = run.time_s();
-  sb.wall_time_s = wall_before + clock.seconds();
+  sb.set_spent(clock.spent());
   sb.particle_steps = static_cast<double>(run.dem().steps());
   sb.mean_settling_velocity_m_s = wt;
   sb.settling_velocity_stderr_m_s = wp_avg.stderr_of_mean();

@@ -89,8 +89,8 @@ std::string difference(const fs::path& a, const fs::path& b) {
   auto sa = nlohmann::json::parse(slurp(a / "summary.json"));
   auto sb = nlohmann::json::parse(slurp(b / "summary.json"));
   // What belongs to one attempt (its cost, its list rebuilds), not to the result.
-  for (const char* k : {"wall_time_s", "wall_time_per_simulated_second_s", "attempt_cpu_time_s", "models",
-                        "ranks", "resumed_from_checkpoint", "neighbor_rebuilds_this_attempt"}) {
+  for (const char* k : {"wall_time_s", "wall_time_per_simulated_second_s", "attempt_cpu_time_s", "cpu_time_s",
+                        "models", "ranks", "resumed_from_checkpoint", "neighbor_rebuilds_this_attempt"}) {
     sa.erase(k);
     sb.erase(k);
   }
@@ -226,6 +226,25 @@ TEST_F(CheckpointFaults, CheckpointWrittenBeforeHashesIsResumedAsUnverifiedSaidO
   EXPECT_EQ(count(r.err, "unverified"), 1u) << r.err;
   EXPECT_EQ(count(r.err, "refused"), 0u) << r.err;
   EXPECT_EQ(difference(reference(), d), "");
+}
+
+// Checkpoints of builds before runs carried their CPU time: the run resumes bit for bit, and
+// its summary says the total is unknown (null) instead of counting only the last attempt's.
+TEST_F(CheckpointFaults, CheckpointWithoutCpuTimeResumesWithTheRunsCpuTimeUnknown) {
+  const fs::path d = copy_of_reference("no_cpu_time");
+  fs::remove(ckpt(d, 60));
+  EXPECT_GT(nlohmann::json::parse(slurp(reference() / "summary.json"))["cpu_time_s"].get<double>(), 0.0);
+  const hid_t f = open_for_edit(ckpt(d, 40));
+  ASSERT_GE(f, 0);
+  ASSERT_GE(H5Adelete(f, "sha256_footer"), 0);
+  ASSERT_GE(H5Ldelete(f, "run.cpu_time_s", H5P_DEFAULT), 0);
+  H5Fclose(f);
+  const CaseRun r = run_case(d);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(difference(reference(), d), "");
+  const auto s = nlohmann::json::parse(slurp(d / "summary.json"));
+  EXPECT_TRUE(s["cpu_time_s"].is_null());
+  EXPECT_GT(s["attempt_cpu_time_s"].get<double>(), 0.0);
 }
 
 TEST_F(CheckpointFaults, StateFailingValidationIsRefusedNamingTheCheckAndTheOlderOneIsUsed) {

@@ -212,5 +212,31 @@ TEST(CostModel, RunsInOneProportionWithBedsAndWithoutFitTheBedsShare) {
               1e-9 * cost(3e9, 6e7, false));
 }
 
+// A run's cost is its CPU time over all attempts where its summary has it (cpu_time_s: blind to
+// a pause, steadier than wall time on a shared machine); from builds that recorded only the last
+// attempt's, that where the run was done in one, else wall time x ranks.
+TEST(CostModel, AFinishedRunCostsItsCpuTimeOverAllAttempts) {
+  const std::string params = R"({"scene": "inclined_settling", "particles": {"count": 100},
+                                 "time": {"dt_cfd": 0.001, "dt_dem": 0.00002}})";
+  const auto cost = [&](const std::string& summary) {
+    bool ok = false;
+    const auto m = measured_cost("a", params, summary, &ok);
+    EXPECT_TRUE(ok) << summary;
+    return m.core_s;
+  };
+  EXPECT_EQ(
+      cost(R"({"wall_time_s": 100, "simulated_time_s": 2, "mpi_ranks": 2, "resumed_from_checkpoint": true,
+                     "attempt_cpu_time_s": 40, "cpu_time_s": 150})"),
+      150.0);
+  EXPECT_EQ(
+      cost(R"({"wall_time_s": 100, "simulated_time_s": 2, "mpi_ranks": 2, "resumed_from_checkpoint": true,
+                     "attempt_cpu_time_s": 40, "cpu_time_s": null})"),
+      200.0);
+  EXPECT_EQ(
+      cost(R"({"wall_time_s": 100, "simulated_time_s": 2, "mpi_ranks": 2, "resumed_from_checkpoint": false,
+                     "attempt_cpu_time_s": 180})"),
+      180.0);
+}
+
 }  // namespace
 }  // namespace boycott::driver

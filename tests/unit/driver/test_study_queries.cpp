@@ -580,6 +580,7 @@ TEST(RunsQuery, EachFinishedRunListsItsWindowErrorBasisCorrelationTimesAndCoreHo
   s["settling_velocity_correlation_time_s"] = 0.1;
   s["settling_velocity_window_correlation_times"] = 10.0;
   s["mpi_ranks"] = 2;
+  s["cpu_time_s"] = 5400.0;  // over all attempts: less than the 4 core-hours held
   bd::record_result(db, bd::begin_attempt(db, c65.id, 2, "x"), c65.id, s);
   // A run of an older build: no error basis, no rank count.
   const auto& c90 = study.cases[1];  // reference, 90 deg
@@ -600,6 +601,8 @@ TEST(RunsQuery, EachFinishedRunListsItsWindowErrorBasisCorrelationTimesAndCoreHo
   EXPECT_DOUBLE_EQ(*bd::core_hours(rows[0]), 4.0);  // 2 h of wall time on 2 ranks
   EXPECT_FALSE(rows[1].error_method.has_value());
   EXPECT_FALSE(bd::core_hours(rows[1]).has_value());
+  EXPECT_DOUBLE_EQ(*bd::cpu_core_hours(rows[0]), 1.5);
+  EXPECT_FALSE(bd::cpu_core_hours(rows[1]).has_value());
 
   const auto table = bd::format_runs(rows, bd::ListingFormat::kTable);
   EXPECT_NE(table.find("-100.00 ± 1.84"), std::string::npos) << table;
@@ -607,17 +610,21 @@ TEST(RunsQuery, EachFinishedRunListsItsWindowErrorBasisCorrelationTimesAndCoreHo
   EXPECT_NE(table.find("1-2"), std::string::npos) << table;  // the window, s
   EXPECT_NE(table.find("2 runs, 4.0 core-hours"), std::string::npos) << table;
   EXPECT_NE(table.find("1 without a wall time or rank count"), std::string::npos) << table;
+  EXPECT_NE(table.find("1.5 CPU core-hours in the 1 runs that record them"), std::string::npos) << table;
   const auto csv = bd::format_runs(rows, bd::ListingFormat::kCsv);
   EXPECT_EQ(
       csv.substr(0, csv.find('\n')),
       "case_id,group,angle_deg,n_particles,end_s,average_from_s,mean_settling_velocity_m_s,error_m_s,"
-      "error_method,error_dof,correlation_time_s,window_correlation_times,wall_time_s,mpi_ranks,core_hours");
-  EXPECT_NE(csv.find(c65.id + ",reference,65,120000,2,1,-0.1,0.00184,two_halves,1,0.1,10,7200,2,4\n"),
+      "error_method,error_dof,correlation_time_s,window_correlation_times,wall_time_s,mpi_ranks,core_hours,"
+      "cpu_core_hours");
+  EXPECT_NE(csv.find(c65.id + ",reference,65,120000,2,1,-0.1,0.00184,two_halves,1,0.1,10,7200,2,4,1.5\n"),
             std::string::npos)
       << csv;
   const auto json = nlohmann::json::parse(bd::format_runs(rows, bd::ListingFormat::kJson));
   EXPECT_DOUBLE_EQ(json[0]["core_hours"].get<double>(), 4.0);
   EXPECT_TRUE(json[1]["core_hours"].is_null());
+  EXPECT_DOUBLE_EQ(json[0]["cpu_core_hours"].get<double>(), 1.5);
+  EXPECT_TRUE(json[1]["cpu_core_hours"].is_null());
   EXPECT_NE(what_of([&] { bd::query_runs(db, "nope"); }).find("no study 'nope'"), std::string::npos);
 }
 

@@ -61,6 +61,11 @@ void expect_resume_is_bitwise(const CaseParams& p, const std::string& tag) {
   ASSERT_EQ(run_in(p, a), kExitOk);
   ASSERT_EQ(run_in(p, b, 0.03), kExitInterrupted);
   EXPECT_EQ(summary(b)["status"], "interrupted");
+  // The first attempt's CPU time, as its stop's checkpoint carries it.
+  const auto stopped_at = io::latest_checkpoint(b);
+  ASSERT_TRUE(stopped_at.has_value());
+  const double carried = io::CheckpointReader(*stopped_at).scalar("run.cpu_time_s");
+  EXPECT_GE(summary(b)["cpu_time_s"].get<double>(), carried);
   ASSERT_EQ(run_in(p, b), kExitOk);
   const auto sa = summary(a), sb = summary(b);
   EXPECT_EQ(sb["resumed_from_checkpoint"], true);
@@ -89,6 +94,12 @@ void expect_resume_is_bitwise(const CaseParams& p, const std::string& tag) {
   EXPECT_EQ(ra.doubles("stats.pdf_w.counts"), rb.doubles("stats.pdf_w.counts"));
   // The time series has each row once, equal to the uninterrupted one.
   EXPECT_EQ(slurp(a / "timeseries.csv"), slurp(b / "timeseries.csv"));
+  // What the run spent over both attempts (CPU core-seconds, each attempt's from its own start:
+  // several runs share this test's process): the resumed attempt starts from what the stopped
+  // one's checkpoint carried, and adds its own.
+  EXPECT_GT(carried, 0.0);
+  EXPECT_GT(sb["cpu_time_s"].get<double>(), carried);
+  EXPECT_GT(sa["cpu_time_s"].get<double>(), 0.0);
 }
 
 TEST(RestartIdentity, StoppedHalfwayAndResumedEqualsTheUninterruptedRunBitwise) {

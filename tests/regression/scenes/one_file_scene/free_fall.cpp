@@ -14,7 +14,7 @@ namespace boycott::scenes {
 namespace {
 
 int run_free_fall(const CaseParams& p, RunContext& ctx) {
-  WallClock clock;
+  RunClock clock;
   ModelTimers timers;
   const double g = p.gravity_vector()[2];  // along z, m/s^2
   double t = 0.0, v = 0.0;
@@ -24,7 +24,7 @@ int run_free_fall(const CaseParams& p, RunContext& ctx) {
   }
   SummaryBase s;
   s.simulated_time_s = t;
-  s.wall_time_s = clock.seconds();
+  s.set_spent(clock.spent());
   s.mean_settling_velocity_m_s = v;
   auto j = make_summary(p, s, timers);
   j["analytic_velocity_m_s"] = g * t;
