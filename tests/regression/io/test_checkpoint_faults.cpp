@@ -247,6 +247,29 @@ TEST_F(CheckpointFaults, CheckpointWithoutCpuTimeResumesWithTheRunsCpuTimeUnknow
   EXPECT_GT(s["attempt_cpu_time_s"].get<double>(), 0.0);
 }
 
+// The CPU time a checkpoint carries is the earlier attempts': the resumed run adds its own to
+// it. Set to 10^6 core-s on purpose (the file sealed again), the total must lie between that and
+// that plus the whole resumed process's CPU time, whatever the machine's speed.
+TEST_F(CheckpointFaults, TheCpuTimeACheckpointCarriesIsAddedToTheResumedAttempts) {
+  const fs::path d = copy_of_reference("cpu_carried");
+  fs::remove(ckpt(d, 60));
+  const double carried = 1e6;
+  const hid_t f = open_for_edit(ckpt(d, 40));
+  ASSERT_GE(f, 0);
+  const hid_t ds = H5Dopen2(f, "run.cpu_time_s", H5P_DEFAULT);
+  ASSERT_GE(ds, 0);
+  ASSERT_GE(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, &carried), 0);
+  H5Dclose(ds);
+  H5Fclose(f);
+  io::seal_file(ckpt(d, 40));
+  const CaseRun r = run_case(d);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(difference(reference(), d), "");
+  const auto s = nlohmann::json::parse(slurp(d / "summary.json"));
+  EXPECT_GE(s["cpu_time_s"].get<double>(), carried);
+  EXPECT_LE(s["cpu_time_s"].get<double>(), carried + s["attempt_cpu_time_s"].get<double>());
+}
+
 TEST_F(CheckpointFaults, StateFailingValidationIsRefusedNamingTheCheckAndTheOlderOneIsUsed) {
   // A negative particle id written on purpose, the file sealed again: its hash is right.
   const auto poison = [](const fs::path& file) {
