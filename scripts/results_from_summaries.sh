@@ -5,7 +5,7 @@
 #   scripts/results_from_summaries.sh [BOYCOTT_BIN]
 # Writes docs/results/paper_base_full.csv, each group's peak (query peak) to
 # docs/results/paper_base_full_peaks.csv, one row per finished run (query runs: its window, error
-# basis, correlation times, wall time and core-hours) to docs/results/paper_base_full_runs.csv, and
+# basis, correlation times, wall time, core-hours and CPU core-hours) to docs/results/paper_base_full_runs.csv, and
 # docs/plots/paper_base_full.{png,pdf}. A committed run that stops short of the end its case now
 # asks (raised later) is on neither the curve nor the runs list until a run reaches that end.
 set -euo pipefail
@@ -24,7 +24,7 @@ done
   > "$root/docs/results/paper_base_full_peaks.csv"
 "$bin" query runs --db "$work/full.db" --study paper_base_full --format csv \
   > "$root/docs/results/paper_base_full_runs.csv"
-"$bin" query runs --db "$work/full.db" --study paper_base_full | tail -n 1
+"$bin" query runs --db "$work/full.db" --study paper_base_full | grep "core-hours"
 for ext in png pdf; do
   "$bin" query curve --db "$work/full.db" --study paper_base_full --overlay-paper \
     --plot "$root/docs/plots/paper_base_full.$ext" > /dev/null
