@@ -19,9 +19,20 @@ class ModelTimers {
   /// Marks a model active; `detail` names the variant (e.g. drag law "difelice_paper").
   void activate(const std::string& model, const std::string& detail = "");
   void add(const std::string& model, double seconds);
+  /// This attempt's and the carried earlier attempts' wall time of a model, s.
   double seconds(const std::string& model) const;
   bool active(const std::string& model) const { return entries_.count(model) > 0; }
-  /// {"model": {"detail": ..., "wall_time_s": ...}, ...}
+  /// Resuming from a checkpoint: each model's wall time over the earlier attempts (s), counted
+  /// from simulated time from_s (s): the run's start when the checkpoint carried them all, the
+  /// resume point when it carried none (a build that recorded none), so that a summary never
+  /// presents one attempt's times as the whole run's.
+  void carry(const std::map<std::string, double>& earlier_s, double from_s);
+  /// Each model's wall time, s: the carried attempts' plus this one's (what a checkpoint records).
+  std::map<std::string, double> totals() const;
+  /// The simulated time from which the wall times count, s.
+  double counted_from_s() const { return from_s_; }
+  /// {"model": {"detail": ..., "wall_time_s": ...}, ...}, the wall times over the attempts
+  /// since counted_from_s().
   nlohmann::json to_json() const;
 
   /// RAII scope that adds its lifetime to a model's total.
@@ -47,6 +58,8 @@ class ModelTimers {
     double seconds = 0.0;
   };
   std::map<std::string, Entry> entries_;
+  std::map<std::string, double> carried_s_;
+  double from_s_ = 0.0;
 };
 
 }  // namespace boycott

@@ -328,6 +328,7 @@ CoupledCounters CoupledSystem::counters() const {
 
 void CoupledSystem::restore_counters(const CoupledCounters& c) {
   time_ = c.time_s;
+  attempt_from_s_ = c.time_s;
   dt_prev_ = c.dt_prev_s;
   steps_ = c.steps;
   unconverged_ = c.unconverged_fluid_steps;
@@ -367,6 +368,7 @@ nlohmann::json CoupledSystem::rank_report() const {
   }
   j["particles"] = {{"min", pmin}, {"mean", psum / ranks_}, {"max", pmax}};
   j["per_rank"] = per;
+  j["seconds_from_s"] = attempt_from_s_;
   return j;
 }
 

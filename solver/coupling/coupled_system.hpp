@@ -115,7 +115,8 @@ class CoupledSystem {
   /// Restores the counters of a checkpoint (the engines' states are imported separately).
   void restore_counters(const CoupledCounters& c);
 
-  /// Particles per rank (min, mean, max) and each rank's seconds per phase in this process,
+  /// Particles per rank (min, mean, max) and each rank's seconds per phase in this process (from
+  /// simulated time "seconds_from_s": a resumed run's ranks may differ from the earlier attempts'),
   /// communication inside them; "waiting" is the time a rank waited for the others: in each DEM
   /// step's rebuild test and at the end of the particle phases. Collective; the same on every
   /// rank.
@@ -166,6 +167,7 @@ class CoupledSystem {
   std::int64_t steps_ = 0;
   std::int64_t unconverged_ = 0, fallbacks_before_ = 0;  // counts before this process: from the checkpoint
   double seconds_fluid_ = 0.0, seconds_wait_ = 0.0;
+  double attempt_from_s_ = 0.0;  ///< the simulated time this process started from (a resume's), s
   ForceBudget* budget_ = nullptr;
   std::function<bool()> interrupt_;
   StartOfStep start_of_step_;

@@ -105,6 +105,33 @@ struct CoupledCheckpoint {
   RunSpent spent;
 };
 
+/// Each model's wall time over the attempts that wrote the checkpoint, s. Absent (a build that
+/// recorded none): the models' times count from the resume point, t_s, instead of from the start.
+void read_model_times(const io::CheckpointReader& r, double t_s, RunSpent& spent) {
+  if (!r.has("run.model_names")) {
+    spent.models_from_s = t_s;
+    return;
+  }
+  const auto names = r.strings("run.model_names");
+  const auto seconds = r.doubles("run.model_wall_time_s");
+  spent.models_from_s = r.scalar("run.model_times_from_s");
+  const std::string file = r.path().string();
+  if (seconds.size() != names.size())
+    throw CheckpointError(fmt::format("checkpoint {}: 'run.model_wall_time_s' holds {} values for {} models",
+                                      file, seconds.size(), names.size()));
+  if (!(spent.models_from_s >= 0.0 && spent.models_from_s <= t_s))
+    throw CheckpointError(
+        fmt::format("checkpoint {}: dataset 'run.model_times_from_s' fails the check: {} is not in [0, {}] s",
+                    file, spent.models_from_s, t_s));
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    if (!(seconds[k] >= 0.0 && std::isfinite(seconds[k])))
+      throw CheckpointError(
+          fmt::format("checkpoint {}: dataset 'run.model_wall_time_s' fails the check: {} ({}) is not a time",
+                      file, seconds[k], names[k]));
+    spent.model_wall_s[names[k]] = seconds[k];
+  }
+}
+
 CoupledCheckpoint read_coupled(const io::CheckpointReader& r, const CaseParams& p) {
   CoupledCheckpoint c;
   c.counters.time_s = r.scalar("run.time_s");
@@ -136,6 +163,7 @@ CoupledCheckpoint read_coupled(const io::CheckpointReader& r, const CaseParams& 
     if (!std::isfinite(v))
       throw CheckpointError(
           fmt::format("checkpoint {}: dataset '{}' fails the check: {} is not finite", file, name, v));
+  read_model_times(r, c.counters.time_s, c.spent);
   return c;
 }
 
@@ -226,7 +254,9 @@ std::optional<RunSpent> resume_coupled(coupling::CoupledSystem& run, const std::
   if (candidates.empty()) {
     if (branch_checkpoint.empty()) return std::nullopt;
     start_from_parent(run, branch_checkpoint, quiet);
-    return RunSpent{};
+    RunSpent own;  // a branch pays for its own steps, from the parent's time
+    own.models_from_s = run.time_s();
+    return own;
   }
   const std::string id = case_id(run.params());
   std::vector<std::string> refused;
@@ -275,6 +305,12 @@ void checkpoint_coupled(const coupling::CoupledSystem& run, const std::filesyste
   save_scene(*w);
   w->put("run.wall_time_s", spent.wall_s);
   if (std::isfinite(spent.cpu_core_s)) w->put("run.cpu_time_s", spent.cpu_core_s);
+  std::vector<std::string> names;
+  std::vector<double> seconds;
+  for (const auto& [name, s] : spent.model_wall_s) names.push_back(name), seconds.push_back(s);
+  w->put_strings("run.model_names", names);
+  w->put("run.model_wall_time_s", seconds);
+  w->put("run.model_times_from_s", spent.models_from_s);
   w->commit();
   io::prune_checkpoints(run_dir, static_cast<int>(run.params().output.keep_checkpoints));
 }

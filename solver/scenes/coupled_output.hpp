@@ -26,6 +26,18 @@ io::SnapshotData coupled_snapshot(const coupling::CoupledSystem& run);
 std::vector<std::vector<double>> gather_particles(const coupling::CoupledSystem& run,
                                                   const std::vector<const std::vector<double>*>& arrays);
 
+/// What a coupled run has spent so far, each model's wall time included (its engines' phases as
+/// report_timers adds them at the end): what its checkpoints record.
+inline RunSpent spent_so_far(const RunClock& clock, const ModelTimers& timers,
+                             const coupling::CoupledSystem& run) {
+  ModelTimers now = timers;
+  run.report_timers(now);
+  RunSpent s = clock.spent();
+  s.model_wall_s = now.totals();
+  s.models_from_s = now.counted_from_s();
+  return s;
+}
+
 class CoupledSceneOutput {
  public:
   /// After the run started or resumed. columns: the scene's time-series columns, "time_s" first;
@@ -154,7 +166,7 @@ int run_recorded_steps(coupling::CoupledSystem& run, RunContext& ctx, ModelTimer
   CoupledSceneOutput out(run, ctx, timers, std::move(columns), resumed, record.next_out_s());
   const auto write_checkpoint = [&] {
     ModelTimers::Scope sc(timers, "checkpoints");
-    record.checkpoint(run, ctx.out_dir, clock.spent(), out.next_out_s());
+    record.checkpoint(run, ctx.out_dir, spent_so_far(clock, timers, run), out.next_out_s());
   };
   const int exit_code = run_coupled_steps(run, out, before_step, measure, write_checkpoint, sb);
   out.flush();

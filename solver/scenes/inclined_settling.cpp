@@ -408,7 +408,7 @@ int run_inclined_settling(const CaseParams& p, RunContext& ctx) {
       run, ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) { record.load(r); },
       ctx.branch_checkpoint);
   if (resumed) {
-    clock.carry(*resumed);
+    carry_spent(*resumed, clock, timers);
   } else {
     insert_case_particles(run.dem(), p);
     run.start();

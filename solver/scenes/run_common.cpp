@@ -96,6 +96,7 @@ nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const Mod
   j["mean_settling_velocity_m_s"] = num_or_null(s.mean_settling_velocity_m_s);
   j["settling_velocity_stderr_m_s"] = num_or_null(s.settling_velocity_stderr_m_s);
   j["models"] = timers.to_json();
+  j["model_times_from_s"] = timers.counted_from_s();
   j["program_version"] = fmt::format("{}+{}", kVersion, kGitRevision);
   j["build"] = build_info();
   int ranks = 1, initialized = 0;

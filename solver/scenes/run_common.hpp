@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,6 +35,11 @@ nlohmann::json build_info();
 struct RunSpent {
   double wall_s = 0.0;
   double cpu_core_s = 0.0;  ///< NaN when an earlier attempt's was not recorded (older checkpoints)
+  /// Each model's wall time, s (ModelTimers::totals), over the attempts since models_from_s.
+  std::map<std::string, double> model_wall_s;
+  /// Simulated time (s) from which model_wall_s counts: the run's start, or the point where it
+  /// resumed from a checkpoint of a build that recorded no model times.
+  double models_from_s = 0.0;
 };
 
 /// Common summary keys. Scene-specific keys are added to the returned object by the scene.
@@ -99,8 +105,13 @@ class RunClock {
  public:
   /// Resuming: what the earlier attempts spent, from the checkpoint.
   void carry(const RunSpent& before) { before_ = before; }
+  /// The wall time and CPU core-seconds; the models' wall times are the timers' (a coupled run's
+  /// checkpoint takes all three from spent_so_far, scenes/coupled_output.hpp).
   RunSpent spent() const {
-    return {before_.wall_s + wall_.seconds(), before_.cpu_core_s + process_cpu_core_s() - cpu0_};
+    RunSpent s;
+    s.wall_s = before_.wall_s + wall_.seconds();
+    s.cpu_core_s = before_.cpu_core_s + process_cpu_core_s() - cpu0_;
+    return s;
   }
 
  private:
@@ -108,6 +119,12 @@ class RunClock {
   double cpu0_ = process_cpu_core_s();
   RunSpent before_;
 };
+
+/// Resuming: the run's clock and its models' timers start from what the earlier attempts spent.
+inline void carry_spent(const RunSpent& before, RunClock& clock, ModelTimers& timers) {
+  clock.carry(before);
+  timers.carry(before.model_wall_s, before.models_from_s);
+}
 
 /// When a time-stepping scene writes a checkpoint: on the grid k * every_s of simulated time (so
 /// a resumed run keeps the uninterrupted run's schedule), at the end, and when asked to stop.

@@ -314,7 +314,7 @@ int run_sediment_transport(const CaseParams& p, RunContext& ctx) {
       run, ctx.out_dir, ctx.quiet, [&](const io::CheckpointReader& r) { record.load(r); },
       ctx.branch_checkpoint);
   if (resumed)
-    clock.carry(*resumed);
+    carry_spent(*resumed, clock, timers);
   else
     record.set_pouring_time(pour_bed_and_start_flow(run, p, timers));
   const double h_bed = bed_height_m(p, run.particle_volume_m3());

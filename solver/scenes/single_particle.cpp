@@ -86,7 +86,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
       },
       ctx.branch_checkpoint);
   if (resumed) {
-    clock.carry(*resumed);
+    carry_spent(*resumed, clock, timers);
   } else {
     const auto& box = run.dem().config().box;
     run.dem().add_particle(0, box.lo[0] + 0.5 * box.len[0], box.lo[1] + 0.5 * box.len[1],
@@ -104,7 +104,7 @@ int run_single_particle(const CaseParams& p, RunContext& ctx) {
                          resumed.has_value(), next_out);
   auto write_checkpoint = [&] {
     ModelTimers::Scope sc(timers, "checkpoints");
-    checkpoint_coupled(run, ctx.out_dir, clock.spent(), [&](io::CheckpointWriter& w) {
+    checkpoint_coupled(run, ctx.out_dir, spent_so_far(clock, timers, run), [&](io::CheckpointWriter& w) {
       io::save(w, "stats.wp.", wp_avg);
       w.put("stats.initial_acceleration", acc0);
       w.put("stats.next_out", out.next_out_s());

@@ -70,6 +70,10 @@ c = json.load(open(w / "child" / "summary.json")); p = json.load(open(w / "paren
 assert c["status"] == "completed" and c["parent"]["case_id"] == p["case_id"], c.get("parent")
 assert abs(c["parent"]["time_s"] - 0.05) < 1e-9, c["parent"]  # the checkpoint at or before --at 0.05
 assert c["case_id"] != p["case_id"]
+# A branch's models are timed over its own steps, from its parent's time; an extended run's over
+# all its attempts, from the start.
+assert c["model_times_from_s"] == c["parent"]["time_s"], (c["model_times_from_s"], c["parent"])
+assert a["model_times_from_s"] == 0.0 and b["model_times_from_s"] == 0.0, a["model_times_from_s"]
 print(f"[ report ] extended 0.1 -> 0.16 s: time series and summary identical to a run straight to 0.16 s "
       f"(<<w_p>> {a['mean_settling_velocity_m_s']:.9g}); a study raised from 0.1 to 0.16 s gives the same results "
       f"{[r[1] for r in rows['cont']]}; a branch at viscosity 2e-3 from t = {c['parent']['time_s']} s completed, "

@@ -89,8 +89,9 @@ std::string difference(const fs::path& a, const fs::path& b) {
   auto sa = nlohmann::json::parse(slurp(a / "summary.json"));
   auto sb = nlohmann::json::parse(slurp(b / "summary.json"));
   // What belongs to one attempt (its cost, its list rebuilds), not to the result.
-  for (const char* k : {"wall_time_s", "wall_time_per_simulated_second_s", "attempt_cpu_time_s", "cpu_time_s",
-                        "models", "ranks", "resumed_from_checkpoint", "neighbor_rebuilds_this_attempt"}) {
+  for (const char* k :
+       {"wall_time_s", "wall_time_per_simulated_second_s", "attempt_cpu_time_s", "cpu_time_s", "models",
+        "model_times_from_s", "ranks", "resumed_from_checkpoint", "neighbor_rebuilds_this_attempt"}) {
     sa.erase(k);
     sb.erase(k);
   }
@@ -268,6 +269,75 @@ TEST_F(CheckpointFaults, TheCpuTimeACheckpointCarriesIsAddedToTheResumedAttempts
   const auto s = nlohmann::json::parse(slurp(d / "summary.json"));
   EXPECT_GE(s["cpu_time_s"].get<double>(), carried);
   EXPECT_LE(s["cpu_time_s"].get<double>(), carried + s["attempt_cpu_time_s"].get<double>());
+}
+
+// Each model's wall time a checkpoint carries is the earlier attempts': the resumed run adds its
+// own, so the summary's `models` cover the whole run (model_times_from_s 0), while each rank's
+// phase seconds are this attempt's (ranks.seconds_from_s: the resume point; another attempt may
+// have run on other ranks). Set to 10^6 s each on purpose (the file sealed again), each model's
+// total must lie between that and that plus the resumed attempt's wall time, whatever the machine.
+TEST_F(CheckpointFaults, TheModelTimesACheckpointCarriesAreAddedToTheResumedAttempts) {
+  const auto whole = nlohmann::json::parse(slurp(reference() / "summary.json"));
+  EXPECT_EQ(whole["model_times_from_s"].get<double>(), 0.0);
+  EXPECT_EQ(whole["ranks"]["seconds_from_s"].get<double>(), 0.0);
+  const fs::path d = copy_of_reference("models_carried");
+  fs::remove(ckpt(d, 60));
+  std::vector<std::string> names;
+  double wall_before = 0.0, resumed_at_s = 0.0;
+  {
+    io::CheckpointReader r(ckpt(d, 40));
+    names = r.strings("run.model_names");
+    wall_before = r.scalar("run.wall_time_s");
+    resumed_at_s = r.scalar("run.time_s");
+    EXPECT_EQ(r.scalar("run.model_times_from_s"), 0.0);
+  }
+  ASSERT_NE(std::find(names.begin(), names.end(), "fluid"), names.end());
+  const double carried = 1e6;
+  const std::vector<double> planted(names.size(), carried);
+  const hid_t f = open_for_edit(ckpt(d, 40));
+  ASSERT_GE(f, 0);
+  const hid_t ds = H5Dopen2(f, "run.model_wall_time_s", H5P_DEFAULT);
+  ASSERT_GE(ds, 0);
+  ASSERT_GE(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, planted.data()), 0);
+  H5Dclose(ds);
+  H5Fclose(f);
+  io::seal_file(ckpt(d, 40));
+  const CaseRun r = run_case(d);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(difference(reference(), d), "");
+  const auto s = nlohmann::json::parse(slurp(d / "summary.json"));
+  EXPECT_EQ(s["model_times_from_s"].get<double>(), 0.0);
+  EXPECT_EQ(s["ranks"]["seconds_from_s"].get<double>(), resumed_at_s);
+  const double attempt_wall_s = s["wall_time_s"].get<double>() - wall_before;
+  for (const auto& name : names) {
+    ASSERT_TRUE(s["models"].contains(name)) << name;
+    const double total = s["models"][name]["wall_time_s"].get<double>();
+    EXPECT_GE(total, carried) << name;
+    EXPECT_LE(total, carried + attempt_wall_s) << name;
+  }
+}
+
+// Checkpoints of builds before runs carried their models' wall times: the run resumes bit for
+// bit, and its summary says from when its `models` count (the resume point), instead of
+// presenting the last attempt's times as the whole run's.
+TEST_F(CheckpointFaults, CheckpointWithoutModelTimesCountsThemFromTheResumePoint) {
+  const fs::path d = copy_of_reference("no_model_times");
+  fs::remove(ckpt(d, 60));
+  const double resumed_at_s = io::CheckpointReader(ckpt(d, 40)).scalar("run.time_s");
+  const hid_t f = open_for_edit(ckpt(d, 40));
+  ASSERT_GE(f, 0);
+  ASSERT_GE(H5Adelete(f, "sha256_footer"), 0);
+  for (const char* name : {"run.model_names", "run.model_wall_time_s", "run.model_times_from_s"})
+    ASSERT_GE(H5Ldelete(f, name, H5P_DEFAULT), 0) << name;
+  H5Fclose(f);
+  const CaseRun r = run_case(d);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(difference(reference(), d), "");
+  const auto s = nlohmann::json::parse(slurp(d / "summary.json"));
+  EXPECT_EQ(s["model_times_from_s"].get<double>(), resumed_at_s);
+  EXPECT_GT(resumed_at_s, 0.0);
+  // Its next checkpoint (the end's) says so too, for the attempts after it.
+  EXPECT_EQ(io::CheckpointReader(ckpt(d, 60)).scalar("run.model_times_from_s"), resumed_at_s);
 }
 
 TEST_F(CheckpointFaults, StateFailingValidationIsRefusedNamingTheCheckAndTheOlderOneIsUsed) {

@@ -66,6 +66,8 @@ void expect_resume_is_bitwise(const CaseParams& p, const std::string& tag) {
   ASSERT_TRUE(stopped_at.has_value());
   const double carried = io::CheckpointReader(*stopped_at).scalar("run.cpu_time_s");
   EXPECT_GE(summary(b)["cpu_time_s"].get<double>(), carried);
+  const auto model_names = io::CheckpointReader(*stopped_at).strings("run.model_names");
+  const auto model_carried_s = io::CheckpointReader(*stopped_at).doubles("run.model_wall_time_s");
   ASSERT_EQ(run_in(p, b), kExitOk);
   const auto sa = summary(a), sb = summary(b);
   EXPECT_EQ(sb["resumed_from_checkpoint"], true);
@@ -100,6 +102,13 @@ void expect_resume_is_bitwise(const CaseParams& p, const std::string& tag) {
   EXPECT_GT(carried, 0.0);
   EXPECT_GT(sb["cpu_time_s"].get<double>(), carried);
   EXPECT_GT(sa["cpu_time_s"].get<double>(), 0.0);
+  // Each model's wall time over both attempts too: from the start, at least what the stop's
+  // checkpoint carried.
+  EXPECT_EQ(sb["model_times_from_s"].get<double>(), 0.0);
+  ASSERT_EQ(model_names.size(), model_carried_s.size());
+  for (std::size_t k = 0; k < model_names.size(); ++k)
+    EXPECT_GE(sb["models"][model_names[k]]["wall_time_s"].get<double>(), model_carried_s[k])
+        << model_names[k];
 }
 
 TEST(RestartIdentity, StoppedHalfwayAndResumedEqualsTheUninterruptedRunBitwise) {
