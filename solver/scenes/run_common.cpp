@@ -62,6 +62,14 @@ std::string cpu_model() {
   return "unknown";
 }
 
+/// The run's MPI ranks (1 outside MPI).
+int mpi_ranks() {
+  int ranks = 1, initialized = 0;
+  MPI_Initialized(&initialized);
+  if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  return ranks;
+}
+
 }  // namespace
 
 nlohmann::json build_info() {
@@ -74,9 +82,7 @@ nlohmann::json build_info() {
 }
 
 double process_cpu_core_s() {
-  int ranks = 1, initialized = 0;
-  MPI_Initialized(&initialized);
-  if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  const int ranks = mpi_ranks();
   rusage use{};
   getrusage(RUSAGE_SELF, &use);
   const auto secs = [](const timeval& t) {
@@ -99,10 +105,7 @@ nlohmann::json make_summary(const CaseParams& p, const SummaryBase& s, const Mod
   j["model_times_from_s"] = timers.counted_from_s();
   j["program_version"] = fmt::format("{}+{}", kVersion, kGitRevision);
   j["build"] = build_info();
-  int ranks = 1, initialized = 0;
-  MPI_Initialized(&initialized);
-  if (initialized) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
-  j["mpi_ranks"] = ranks;
+  j["mpi_ranks"] = mpi_ranks();
   // This process's CPU since it started: this attempt's cost (start-up included); cpu_time_s
   // is the run's over all attempts, from its checkpoints.
   j["attempt_cpu_time_s"] = process_cpu_core_s();
