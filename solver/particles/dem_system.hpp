@@ -87,10 +87,10 @@ class DemSystem {
   /// sum of the local particles' v_z (m/s) at the end of step k, added in storage order: the
   /// same bits as summing particles().vz after the k-th of as many step() calls.
   void advance(int count, double* vz_sums = nullptr);
-  /// advance(count) in runs of `check_every` steps (the same bits), asking `stop` after each run
-  /// but the last; returns the steps made: `count`, or fewer when `stop` said yes (the particles
-  /// are then part-way through, for a caller that discards them). `stop` must give every rank
-  /// the same answer.
+  /// advance(count), asking `stop` after every `check_every` steps but the last (the same bits:
+  /// the fused passes run on across the asks); returns the steps made: `count`, or fewer when
+  /// `stop` said yes (the particles are then part-way through, for a caller that discards them).
+  /// `stop` must give every rank the same answer.
   int advance_interruptible(int count, int check_every, const std::function<bool()>& stop);
   /// Rebuilds the neighbour list now (re-sorts and wraps; forces and histories are kept).
   void force_rebuild();
@@ -179,6 +179,9 @@ class DemSystem {
   /// v_z after the closing kick (see advance).
   void kick_kick_drift(double h, double* vz_sum = nullptr);
   void copy_ghost_predictions();
+  /// advance and advance_interruptible: `count` steps, asking `stop` (when given) after every
+  /// `check_every` of them but the last; returns the steps made.
+  int advance_steps(int count, double* vz_sums, int check_every, const std::function<bool()>* stop);
   /// After the drift: the list rebuilt or the ghosts refreshed, then the forces.
   void advance_to_forces();
   bool needs_rebuild() const;

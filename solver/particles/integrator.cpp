@@ -259,6 +259,14 @@ void DemSystem::step() {
 }
 
 void DemSystem::advance(int count, double* vz_sums) {
+  advance_steps(count, vz_sums, 0, nullptr);
+}
+
+int DemSystem::advance_interruptible(int count, int check_every, const std::function<bool()>& stop) {
+  return advance_steps(count, nullptr, std::max(check_every, 1), &stop);
+}
+
+int DemSystem::advance_steps(int count, double* vz_sums, int check_every, const std::function<bool()>* stop) {
   if (!initialized_) initialize();
   for (int k = 0; k < count; ++k) {
     auto t0 = std::chrono::steady_clock::now();
@@ -271,7 +279,11 @@ void DemSystem::advance(int count, double* vz_sums) {
     }
     seconds_integrate += seconds_since(t0);
     advance_to_forces();
-    if (k == count - 1) {
+    // The stop is asked between steps without closing them: the fused passes run on across the
+    // asks, so a step asked every 2 sub-steps (a 405 000-particle case) costs what an unasked one
+    // does (separate closing and opening kicks there took 2.6 % of the run, perf).
+    const bool last = k == count - 1 || (stop && (k + 1) % check_every == 0 && (*stop)());
+    if (last) {
       t0 = std::chrono::steady_clock::now();
       kick(0.5 * cfg_.dt_s, false);
       if (vz_sums) vz_sums[k] = sum_in_order(s_.vz.data(), s_.n_local);
@@ -279,18 +291,9 @@ void DemSystem::advance(int count, double* vz_sums) {
     }
     counters_.time_s += cfg_.dt_s;
     ++counters_.steps;
+    if (last) return k + 1;
   }
-}
-
-int DemSystem::advance_interruptible(int count, int check_every, const std::function<bool()>& stop) {
-  int done = 0;
-  while (done < count) {
-    const int run = std::min(std::max(check_every, 1), count - done);
-    advance(run);
-    done += run;
-    if (done < count && stop()) break;
-  }
-  return done;
+  return count;
 }
 
 void DemSystem::advance_to_forces() {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <random>
 #include <set>
 
@@ -334,6 +335,50 @@ TEST(DemSystem, FusedStepsReportEachStepsVzSumBitwise) {
     EXPECT_EQ(a.particles().vz, b.particles().vz);
     EXPECT_NE(stepped.front(), stepped.back());  // the particles fall: the sums move
   }
+}
+
+TEST(DemSystem, InterruptibleStepsAskTheStopOnScheduleAndMatchPlainStepsBitwise) {
+  // A long coupled step asks for a stop every check_every sub-steps, the fused passes running on
+  // across the asks: it must ask after steps 7, 14, ... but never after the last, end where as
+  // many step() calls end (bit for bit) when no stop comes, and stop after the asked step when
+  // one does, with that step closed (its velocities those of step() calls).
+  auto make = [] {
+    DemConfig c = channel_config();
+    c.track_drag_impulse = true;
+    DemSystem d(c);
+    d.insert_random(300, kR, kRho, {0, 0, 0}, {6e-3, 3.6e-3, 7.8e-3}, 4);
+    for (std::size_t i = 0; i < d.particles().n_local; ++i) d.particles().beta[i] = 1e-5;
+    d.initialize();
+    return d;
+  };
+  auto expect_same = [](const DemSystem& a, const DemSystem& b, const char* what) {
+    EXPECT_EQ(a.particles().x, b.particles().x) << what;
+    EXPECT_EQ(a.particles().vz, b.particles().vz) << what;
+    EXPECT_EQ(a.particles().wx, b.particles().wx) << what;
+    EXPECT_EQ(a.particles().drag_jz, b.particles().drag_jz) << what;
+    EXPECT_EQ(a.time_s(), b.time_s()) << what;
+    EXPECT_EQ(a.steps(), b.steps()) << what;
+  };
+  DemSystem a = make(), b = make();
+  int asks = 0;
+  const std::function<bool()> never = [&] {
+    ++asks;
+    return false;
+  };
+  for (int cycle = 0; cycle < 40; ++cycle) {
+    asks = 0;
+    EXPECT_EQ(a.advance_interruptible(50, 7, never), 50);
+    for (int n = 0; n < 50; ++n) b.step();
+    EXPECT_EQ(asks, 7);  // after steps 7, 14, ..., 49
+  }
+  EXPECT_GT(a.rebuilds(), 1);
+  expect_same(a, b, "no stop");
+
+  asks = 0;
+  const std::function<bool()> third = [&] { return ++asks == 3; };
+  EXPECT_EQ(a.advance_interruptible(50, 7, third), 21);
+  for (int n = 0; n < 21; ++n) b.step();
+  expect_same(a, b, "stopped at the third ask");
 }
 
 TEST(DemSystem, EqualRadiusPathEqualsTheGatheredOneBitwise) {
