@@ -56,15 +56,24 @@ Scheduler::Scheduler(Database& db, const Study& study, const std::vector<CaseSta
       progress_(study.name, opt.jobs, opt.progress_live, opt.progress_every_s) {
   std::map<std::string, const StudyCase*> by_id;
   for (const auto& c : study.cases) by_id[c.id] = &c;
+  // Cases stopped part-way (a signal, --stop-after, or a driver that died with the attempt open)
+  // go first, then the rest, each in study order: a checkpoint's work would otherwise wait behind
+  // cases started afresh, and goes with its run folder should the machine be replaced.
+  std::vector<const StudyCase*> fresh;
   for (const auto& s : states) {
     failures_[s.id] = s.failures;
     if (s.status == CaseStatus::kDone)
       ++done_;
     else if (s.status == CaseStatus::kFailed)
       ++failed_;
-    else if (by_id.count(s.id))
+    else if (!by_id.count(s.id))
+      continue;
+    else if (s.status == CaseStatus::kInterrupted || s.status == CaseStatus::kRunning)
       queue_.push_back(by_id[s.id]);
+    else
+      fresh.push_back(by_id[s.id]);
   }
+  queue_.insert(queue_.end(), fresh.begin(), fresh.end());
 }
 
 bool Scheduler::run() {

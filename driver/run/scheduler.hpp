@@ -43,8 +43,9 @@ struct StudyRunOptions {
 
 class Scheduler {
  public:
-  /// Queues the cases of `study` that `states` (case_states of db) shows neither done nor failed;
-  /// each runs as `solver` in <runs_root>/<case_id>/. study and opt must outlive the scheduler.
+  /// Queues the cases of `study` that `states` (case_states of db) shows neither done nor failed,
+  /// those stopped part-way (interrupted, or an attempt left open) first; each runs as `solver`
+  /// in <runs_root>/<case_id>/. study and opt must outlive the scheduler.
   Scheduler(Database& db, const Study& study, const std::vector<CaseState>& states,
             const StudyRunOptions& opt, std::filesystem::path runs_root, std::vector<std::string> solver);
 

@@ -223,6 +223,53 @@ TEST(StudyRun, SigintStopsCasesAtACheckpointAndRerunResumesThem) {
   EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
 }
 
+TEST(StudyRun, CasesStoppedPartWayResumeBeforeAnyCaseStartsAfresh) {
+  TempDir d;
+  write(d.path / "s.toml", kStudy);
+  const auto db = d.path / "s.db";
+  // One job: the study's first case runs alone and is stopped after its first checkpoint.
+  const pid_t pid = spawn(study_run(d.path / "s.toml", db, 1), d.path, {{"FAKE_STEP_WALL_S", "0.1"}});
+  wait_for_checkpoint(db);
+  ::kill(pid, SIGINT);
+  const auto stopped = wait_run(pid, d.path);
+  ASSERT_EQ(stopped.rc, 75) << stopped.err;
+  ASSERT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 1);
+  ASSERT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 75"), 1);
+  // The same six cases with the stopped one last in study order (groups and angles reversed).
+  write(d.path / "t.toml", R"(
+name = "reversed"
+[base]
+scene = "inclined_settling"
+seed = 1
+[base.particles]
+count = 1000
+[base.time]
+end = 0.8
+average_from = 0.4
+[[group]]
+name = "Ga"
+set = { "fluid.viscosity" = 1.0e-2 }
+[[group]]
+name = "base"
+[matrix]
+"gravity.angle_deg" = [90, 60, 30]
+)");
+  const auto r = run(study_run(d.path / "t.toml", db, 1), d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM results"), 6);
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 7);
+  bd::Database q(db.string(), bd::OpenMode::kExisting);
+  auto text = [&q](const std::string& sql) {
+    auto st = q.prepare(sql);
+    return st.step() ? st.text(0) : std::string();
+  };
+  const std::string stopped_id = text("SELECT case_id FROM attempts WHERE exit_status = 75");
+  EXPECT_EQ(text("SELECT case_id FROM study_cases WHERE study = 'reversed' ORDER BY position DESC LIMIT 1"),
+            stopped_id);
+  EXPECT_EQ(text("SELECT case_id FROM attempts WHERE exit_status IS NOT 75 ORDER BY id LIMIT 1"), stopped_id)
+      << "the rerun's first attempt resumes the stopped case";
+}
+
 TEST(StudyRun, FailedCasesAreRetriedBoundedlyAndTheReasonIsRecorded) {
   TempDir d;
   write(d.path / "s.toml", R"(
