@@ -82,7 +82,11 @@ bool Scheduler::run() {
     bool lock_wait = false;
     const bool out_of_time = opt_.stop_at && Clock::now() >= *opt_.stop_at;
     if ((stop_signal() || out_of_time) && !stopping_) stop_all();
-    if (stopping_) backing_off_.clear();  // they stay pending in the database
+    if (stopping_) {
+      // They stay pending in the database, and in the count; none starts once stopping.
+      for (const auto& b : backing_off_) queue_.push_back(b.second);
+      backing_off_.clear();
+    }
     // Back in the queue once their back-off has passed.
     const auto now = Clock::now();
     for (auto it = backing_off_.begin(); it != backing_off_.end();) {
@@ -183,7 +187,9 @@ void Scheduler::finish(const RunningCase& run, int exit_code) {
     return;
   }
   if (end.kind == AttemptEnd::Kind::kInterrupted) {
-    if (!stopping_ && !stop_signal()) queue_.push_front(c);  // stopped from outside: resume at once
+    // Stopped from outside (not by this driver): resume at once. Stopped by this driver: counted
+    // as pending, and nothing starts once stopping.
+    queue_.push_front(c);
     return;
   }
   const std::string where =
@@ -196,10 +202,13 @@ void Scheduler::finish(const RunningCase& run, int exit_code) {
     if (n >= kStorageFailuresToStop) {
       storage_stop_ = fmt::format("{} storage errors in a row (exit 74), the last: {}", n, end.reason);
       if (!stopping_) stop_all();
-    } else if (!stopping_ && !stop_signal()) {
+    }
+    if (!stopping_ && !stop_signal()) {
       const auto wait = storage_backoff(n);
       std::fprintf(stderr, "%s: runs again in %g s\n", where.c_str(), wait.count());
       backing_off_.emplace_back(Clock::now() + std::chrono::duration_cast<Clock::duration>(wait), c);
+    } else {
+      queue_.push_back(c);  // counted as pending; nothing starts once stopping
     }
     return;
   }
@@ -213,8 +222,8 @@ void Scheduler::finish(const RunningCase& run, int exit_code) {
     fs::rename(run.dir, fs::path(run.dir.string() + fmt::format(".bad-{}", run.attempt)), ec);
   }
   const int failures = ++failures_[c->id];
-  if (end.exit_code != kExitInputError && failures <= opt_.retries && !stopping_)
-    queue_.push_back(c);
+  if (end.exit_code != kExitInputError && failures <= opt_.retries)
+    queue_.push_back(c);  // while stopping, counted as pending: it retries on the next run
   else
     ++failed_;
 }

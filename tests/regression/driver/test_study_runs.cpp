@@ -217,6 +217,15 @@ TEST(StudyRun, SigintStopsCasesAtACheckpointAndRerunResumesThem) {
     EXPECT_LT(ckpt["step"].get<int>(), 8);
   }
   EXPECT_GE(checkpointed, 1);
+  // The last progress line counts every case not done as pending, the stopped ones too.
+  const auto done = count(db, "SELECT COUNT(*) FROM results");
+  const auto last_line = stopped.err.rfind("study small:");
+  ASSERT_NE(last_line, std::string::npos) << stopped.err;
+  EXPECT_NE(stopped.err.find(
+                std::to_string(done) + " done, 0 running, 0 failed, " + std::to_string(6 - done) + " pending",
+                last_line),
+            std::string::npos)
+      << stopped.err.substr(last_line);
 
   const auto r = run(study_run(d.path / "s.toml", db), d.path);
   ASSERT_EQ(r.rc, 0) << r.err;
