@@ -345,7 +345,7 @@ int study_plan(const PlanOptions& opt) {
   if (db) {
     // As `study status` sees them: an open attempt nobody holds (its driver was killed) is
     // interrupted, not running.
-    for (auto& s : case_states_now(*db, opt.db_path, study.name, 2)) states[s.id] = s;
+    for (auto& s : case_states_for(*db, opt.db_path, study, 2)) states[s.id] = s;
     finished = measured(*db);
   }
   const CostModel model(finished);

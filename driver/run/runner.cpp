@@ -172,6 +172,20 @@ std::vector<CaseState> case_states_now(Database& db, const std::string& db_path,
   return states;
 }
 
+std::vector<CaseState> case_states_for(Database& db, const std::string& db_path, const Study& study,
+                                       int retries) {
+  auto states = case_states_now(db, db_path, study.name, retries);
+  // The database holds each case's parameters as of the last `study run`: a time.end raised in the
+  // file since then leaves a result short of it, and `study run` will continue the case.
+  std::map<std::string, const StudyCase*> by_id;
+  for (const auto& c : study.cases) by_id[c.id] = &c;
+  for (auto& s : states)
+    if (s.status == CaseStatus::kDone && by_id.count(s.id) &&
+        !result_reaches_end(db, s.id, to_json(by_id.at(s.id)->params).dump()))
+      s.status = CaseStatus::kPending;
+  return states;
+}
+
 int study_status(const std::string& study_file, const std::string& db_path, int retries,
                  ListingFormat format) {
   Study study = expand_study_file(study_file);
@@ -186,7 +200,7 @@ int study_status(const std::string& study_file, const std::string& db_path, int 
   db.emplace(db_path, OpenMode::kReadOnly);
   add_recorded_refinements(*db, study);
   std::map<std::string, CaseState> known;
-  for (auto& s : case_states_now(*db, db_path, study.name, retries)) known[s.id] = s;
+  for (auto& s : case_states_for(*db, db_path, study, retries)) known[s.id] = s;
   // Cases submitted to Slurm (study submit): their array task and, where squeue answers, its state.
   std::map<std::string, std::string> jobs;
   std::optional<std::vector<SlurmJob>> queue;

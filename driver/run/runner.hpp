@@ -22,6 +22,11 @@ int study_run(const StudyRunOptions& opt);
 /// as interrupted: the one vocabulary of `study status` and `query cases`.
 std::vector<CaseState> case_states_now(Database& db, const std::string& db_path, const std::string& study,
                                        int retries);
+/// case_states_now for the cases as `study` (its file) now sets them: a done case whose result
+/// falls short of a time.end raised in the file since the last `study run` is pending (`study
+/// status`, `study plan`).
+std::vector<CaseState> case_states_for(Database& db, const std::string& db_path, const Study& study,
+                                       int retries);
 /// The study's cases and their states (pending without a database; none is created).
 int study_status(const std::string& study_file, const std::string& db_path, int retries,
                  ListingFormat format = ListingFormat::kTable);

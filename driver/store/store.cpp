@@ -214,6 +214,14 @@ bool summary_reaches_end(Database& db, const std::string& case_id, const std::st
   return !st.step() || st.is_null(0) || st.integer(0) != 0;
 }
 
+bool result_reaches_end(Database& db, const std::string& case_id, const std::string& params_json) {
+  auto st = db.prepare("SELECT 1 FROM results r WHERE r.case_id = ?1 AND " +
+                       reaches_end_sql("r.summary_json", "?2"));
+  st.bind(1, case_id);
+  st.bind(2, params_json);
+  return st.step();
+}
+
 bool has_result(Database& db, const std::string& case_id) {
   auto st = db.prepare("SELECT 1 FROM results r JOIN cases c ON c.id = r.case_id WHERE r.case_id = ?1 AND " +
                        kResultReachesEnd);

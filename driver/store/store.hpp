@@ -35,6 +35,9 @@ bool has_result(Database& db, const std::string& case_id);
 /// Whether a finished run's summary.json (its text) reached the case's time.end as the stored
 /// case now sets it, or met its precision target: a result of it would make the case done.
 bool summary_reaches_end(Database& db, const std::string& case_id, const std::string& summary_json);
+/// Whether a recorded result of the case reaches the time.end (or precision target) that
+/// `params_json` sets: a study file's parameters, which may ask more than those stored.
+bool result_reaches_end(Database& db, const std::string& case_id, const std::string& params_json);
 /// The case's recorded <<w_p>>; unset without a result or a value.
 std::optional<double> result_settling_velocity(Database& db, const std::string& case_id);
 

@@ -275,6 +275,27 @@ TEST(StudyStatus, ARunFinishedAtAnEndSinceRaisedIsNotListedAsUncollected) {
   EXPECT_EQ(r.out.find("not recorded yet"), std::string::npos) << r.out;
 }
 
+// The database holds each case's parameters as of the last `study run`; `study status` and
+// `study plan` read the file as it is now: a time.end raised since shows the finished cases as
+// pending (the plan prices the rest), before any run or collect registers the new end.
+TEST(StudyStatus, AnEndRaisedInTheFileShowsItsFinishedCasesPendingBeforeAnyRun) {
+  TempDir d;
+  const auto db = fake_study_db(d);
+  auto study = std::string(kTwo);
+  study.replace(study.find("end = 0.3"), 9, "end = 0.6");
+  write(d.path / "s.toml", study);
+  const auto r = run({"study", "status", (d.path / "s.toml").string(), "--db", db.string()}, d.path);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_NE(r.out.find("2 cases: 0 done"), std::string::npos) << r.out;
+  const auto p =
+      run({"study", "plan", (d.path / "s.toml").string(), "--db", db.string(), "--format", "csv"}, d.path);
+  ASSERT_EQ(p.rc, 0) << p.err;
+  EXPECT_EQ(p.out.find(",done,"), std::string::npos) << p.out;
+  EXPECT_NE(p.out.find(",pending,"), std::string::npos) << p.out;
+  // Neither command wrote the new end: the stored parameters still end at 0.3 s.
+  EXPECT_EQ(count(db, "SELECT COUNT(*) FROM cases WHERE json_extract(params_json, '$.time.end') = 0.3"), 2);
+}
+
 // `study run --stop-after S`: after S wall seconds every running case checkpoints and stops as on
 // a SIGTERM to the driver (exit 75, the case interrupted, not failed), and the same command
 // resumes it. The fake's 1 000 steps of 0.05 s of wall time each cannot finish in the 1 s given,
