@@ -255,6 +255,15 @@ fs::path fake_study_db(const TempDir& d) {
   return db;
 }
 
+/// fake_study_db, then the study file's time.end raised from 0.3 to 0.6 s (nothing run since).
+fs::path fake_study_db_end_raised(const TempDir& d) {
+  const auto db = fake_study_db(d);
+  auto study = std::string(kTwo);
+  study.replace(study.find("end = 0.3"), 9, "end = 0.6");
+  write(d.path / "s.toml", study);
+  return db;
+}
+
 }  // namespace
 
 // A finished run whose case's time.end has since been raised (time.end is not part of the id) is
@@ -262,10 +271,7 @@ fs::path fake_study_db(const TempDir& d) {
 // to collect it.
 TEST(StudyStatus, ARunFinishedAtAnEndSinceRaisedIsNotListedAsUncollected) {
   TempDir d;
-  const auto db = fake_study_db(d);
-  auto study = std::string(kTwo);
-  study.replace(study.find("end = 0.3"), 9, "end = 0.6");
-  write(d.path / "s.toml", study);
+  const auto db = fake_study_db_end_raised(d);
   // `study collect` registers the raised end and records nothing.
   const auto c = run({"study", "collect", (d.path / "s.toml").string(), "--db", db.string()}, d.path);
   ASSERT_EQ(c.rc, 0) << c.err;
@@ -280,10 +286,7 @@ TEST(StudyStatus, ARunFinishedAtAnEndSinceRaisedIsNotListedAsUncollected) {
 // pending (the plan prices the rest), before any run or collect registers the new end.
 TEST(StudyStatus, AnEndRaisedInTheFileShowsItsFinishedCasesPendingBeforeAnyRun) {
   TempDir d;
-  const auto db = fake_study_db(d);
-  auto study = std::string(kTwo);
-  study.replace(study.find("end = 0.3"), 9, "end = 0.6");
-  write(d.path / "s.toml", study);
+  const auto db = fake_study_db_end_raised(d);
   const auto r = run({"study", "status", (d.path / "s.toml").string(), "--db", db.string()}, d.path);
   ASSERT_EQ(r.rc, 0) << r.err;
   EXPECT_NE(r.out.find("2 cases: 0 done"), std::string::npos) << r.out;

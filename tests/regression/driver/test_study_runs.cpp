@@ -24,9 +24,8 @@ namespace {
 
 using namespace study_process;
 
-// 2 groups x 3 angles; every fake case is 8 steps of FAKE_STEP_WALL_S.
-const char* kStudy = R"(
-name = "small"
+// Every fake case is 8 steps of FAKE_STEP_WALL_S.
+const std::string kSmallBase = R"(
 [base]
 scene = "inclined_settling"
 seed = 1
@@ -35,6 +34,9 @@ count = 1000
 [base.time]
 end = 0.8
 average_from = 0.4
+)";
+// 2 groups x 3 angles.
+const std::string kStudy = "name = \"small\"\n" + kSmallBase + R"(
 [[group]]
 name = "base"
 [[group]]
@@ -245,16 +247,7 @@ TEST(StudyRun, CasesStoppedPartWayResumeBeforeAnyCaseStartsAfresh) {
   ASSERT_EQ(count(db, "SELECT COUNT(*) FROM attempts"), 1);
   ASSERT_EQ(count(db, "SELECT COUNT(*) FROM attempts WHERE exit_status = 75"), 1);
   // The same six cases with the stopped one last in study order (groups and angles reversed).
-  write(d.path / "t.toml", R"(
-name = "reversed"
-[base]
-scene = "inclined_settling"
-seed = 1
-[base.particles]
-count = 1000
-[base.time]
-end = 0.8
-average_from = 0.4
+  write(d.path / "t.toml", "name = \"reversed\"\n" + kSmallBase + R"(
 [[group]]
 name = "Ga"
 set = { "fluid.viscosity" = 1.0e-2 }

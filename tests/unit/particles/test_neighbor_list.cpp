@@ -243,6 +243,19 @@ DemConfig channel_config() {
   return c;
 }
 
+/// 300 spheres falling in that channel, initialised: dry, or wet (a drag coefficient of
+/// 1e-5 kg/s on each and the drag impulse tracked, as in a coupled sub-cycle).
+DemSystem settling_channel(bool dry) {
+  DemConfig c = channel_config();
+  c.dry = dry;
+  c.track_drag_impulse = !dry;
+  DemSystem d(c);
+  d.insert_random(300, kR, kRho, {0, 0, 0}, {6e-3, 3.6e-3, 7.8e-3}, 4);
+  for (std::size_t i = 0; i < d.particles().n_local; ++i) d.particles().beta[i] = 1e-5;
+  d.initialize();
+  return d;
+}
+
 TEST(DemState, ExportImportContinuesBitwise) {
   auto make = [] { return channel_config(); };
   DemSystem a(make());
@@ -305,17 +318,7 @@ TEST(DemSystem, FusedStepsReportEachStepsVzSumBitwise) {
   // those of summing particles().vz (in storage order) after each step(), dry (as that scene
   // runs) and wet (the drag impulse tracked), across chunks and list rebuilds.
   for (const bool dry : {true, false}) {
-    auto make = [dry] {
-      DemConfig c = channel_config();
-      c.dry = dry;
-      c.track_drag_impulse = !dry;
-      DemSystem d(c);
-      d.insert_random(300, kR, kRho, {0, 0, 0}, {6e-3, 3.6e-3, 7.8e-3}, 4);
-      for (std::size_t i = 0; i < d.particles().n_local; ++i) d.particles().beta[i] = 1e-5;
-      d.initialize();
-      return d;
-    };
-    DemSystem a = make(), b = make();
+    DemSystem a = settling_channel(dry), b = settling_channel(dry);
     std::vector<double> fused, stepped;
     for (const int count : {1, 37, 200, 2, 500}) {
       std::vector<double> sums(static_cast<std::size_t>(count), -1.0);
@@ -342,15 +345,6 @@ TEST(DemSystem, InterruptibleStepsAskTheStopOnScheduleAndMatchPlainStepsBitwise)
   // across the asks: it must ask after steps 7, 14, ... but never after the last, end where as
   // many step() calls end (bit for bit) when no stop comes, and stop after the asked step when
   // one does, with that step closed (its velocities those of step() calls).
-  auto make = [] {
-    DemConfig c = channel_config();
-    c.track_drag_impulse = true;
-    DemSystem d(c);
-    d.insert_random(300, kR, kRho, {0, 0, 0}, {6e-3, 3.6e-3, 7.8e-3}, 4);
-    for (std::size_t i = 0; i < d.particles().n_local; ++i) d.particles().beta[i] = 1e-5;
-    d.initialize();
-    return d;
-  };
   auto expect_same = [](const DemSystem& a, const DemSystem& b, const char* what) {
     EXPECT_EQ(a.particles().x, b.particles().x) << what;
     EXPECT_EQ(a.particles().vz, b.particles().vz) << what;
@@ -359,7 +353,7 @@ TEST(DemSystem, InterruptibleStepsAskTheStopOnScheduleAndMatchPlainStepsBitwise)
     EXPECT_EQ(a.time_s(), b.time_s()) << what;
     EXPECT_EQ(a.steps(), b.steps()) << what;
   };
-  DemSystem a = make(), b = make();
+  DemSystem a = settling_channel(false), b = settling_channel(false);
   int asks = 0;
   const std::function<bool()> never = [&] {
     ++asks;
