@@ -112,12 +112,15 @@ PlanEstimate plan_estimate(Database& db, const Study& study, const std::vector<s
   std::map<std::string, const StudyCase*> by_id;
   for (const auto& c : study.cases) by_id[c.id] = &c;
   std::vector<double> costs, packed;
+  std::map<std::string, PlannedCase> planned;
   std::map<std::string, bool> scenes;
   for (const auto& id : to_run_ids)
     if (const auto it = by_id.find(id); it != by_id.end()) {
       const Rest rest = rest_of(runs_root, *it->second);
       costs.push_back(model.core_s(rest.work));
       packed.push_back(model.core_s(rest.upper_work()));
+      planned[id] =
+          PlannedCase{study_wall_s({costs.back()}, 1, ranks), rest.reached_s, it->second->params.time.end_s};
       scenes[it->second->params.scene] = true;
     }
   std::string basis;
@@ -131,9 +134,7 @@ PlanEstimate plan_estimate(Database& db, const Study& study, const std::vector<s
                                                         duration(wall_packed))
                                           : std::string(),
                        count_of(jobs, "job"), count_of(ranks, "rank"), basis.empty() ? "-" : basis);
-  double sum = 0.0;
-  for (double c : costs) sum += study_wall_s({c}, 1, ranks);
-  e.mean_case_wall_s = costs.empty() ? 0.0 : sum / static_cast<double>(costs.size());
+  e.cases = std::move(planned);
   return e;
 }
 

@@ -3,9 +3,11 @@
 // study's wall time on J jobs of N ranks, from the cost model calibrated on the database's
 // finished runs (cost_model.hpp). Runs nothing; reads the database only if it exists.
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
+#include "driver/run/progress.hpp"
 #include "driver/store/database.hpp"
 #include "driver/study/study.hpp"
 
@@ -27,10 +29,10 @@ inline constexpr std::size_t kListEveryCaseMax = 10000;
 int study_plan(const PlanOptions& opt);
 
 /// What `study run` prints before it starts (cases to run and their estimated wall time), and
-/// the estimated wall time of one of them on average (its progress display's first ETA).
+/// each case's estimate (its progress display's ETA).
 struct PlanEstimate {
   std::string line;
-  double mean_case_wall_s = 0.0;
+  std::map<std::string, PlannedCase> cases;  ///< by case id
 };
 /// A case with a run folder under `runs_root` that has reached some time counts only the work
 /// from there to its end.

@@ -96,6 +96,27 @@ double RecentRate::wall_s_per_sim_s(Clock::time_point now, double t_s) const {
   return sim > 0 && wall > 0 ? wall / sim : std::numeric_limits<double>::quiet_NaN();
 }
 
+double PlannedCase::wall_s_per_sim_s() const {
+  return end_s > from_s ? wall_s / (end_s - from_s) : std::numeric_limits<double>::quiet_NaN();
+}
+
+void ProgressDisplay::set_plan(std::map<std::string, PlannedCase> cases) {
+  plan_ = std::move(cases);
+  double sum = 0.0;
+  for (const auto& [id, p] : plan_) sum += p.wall_s;
+  planned_case_wall_s_ =
+      plan_.empty() ? std::numeric_limits<double>::quiet_NaN() : sum / static_cast<double>(plan_.size());
+}
+
+void ProgressDisplay::add_finished_case(const std::string& id, double wall_s, double from_s) {
+  finished_wall_s_.push_back(wall_s);
+  last_t_s_.erase(id);
+  const auto p = plan_.find(id);
+  if (p == plan_.end() || !(p->second.wall_s_per_sim_s() > 0) || !(p->second.end_s > from_s) || !(wall_s > 0))
+    return;
+  speed_ratios_[id] = wall_s / (p->second.end_s - from_s) / p->second.wall_s_per_sim_s();
+}
+
 ProgressDisplay::ProgressDisplay(std::string study, int jobs, bool live, double plain_every_s)
     : study_(std::move(study)),
       jobs_(jobs),
@@ -121,11 +142,13 @@ void ProgressDisplay::draw_at(const ProgressCounts& counts, const std::vector<Ru
     s += "\033[J";
   }
   double remaining_s = 0, estimated_case_s = 0;
-  int estimated = 0, unknown = 0;  // unknown: running cases without a sim_s_per_s yet
+  int estimated = 0;
+  std::vector<const RunningCase*> unknown;  // running cases without a rate yet
   std::string rows;
   std::map<std::string, RecentRate> rates;
   for (const auto& j : running) {
     const double t_s = simulated_time_s(j.dir);
+    last_t_s_[j.c->id] = t_s;
     const double wall_s = std::chrono::duration<double>(now - j.started).count();
     // The recent rate, from the samples of this case's earlier draws (the first at its start).
     RecentRate& rate = rates[j.dir.string()] = std::move(rates_[j.dir.string()]);
@@ -135,24 +158,47 @@ void ProgressDisplay::draw_at(const ProgressCounts& counts, const std::vector<Ru
     const double sim_s_per_s =
         std::isfinite(recent) ? 1.0 / recent : (wall_s > 0 ? (t_s - j.t_start_s) / wall_s : 0);
     const double end_s = j.c->params.time.end_s;
-    remaining_s += sim_s_per_s > 0 ? (end_s - t_s) / sim_s_per_s : 0.0;
-    unknown += sim_s_per_s > 0 ? 0 : 1;
     if (sim_s_per_s > 0) {
+      remaining_s += (end_s - t_s) / sim_s_per_s;
       estimated_case_s += end_s / sim_s_per_s;
       ++estimated;
+      if (const auto p = plan_.find(j.c->id); p != plan_.end() && p->second.wall_s_per_sim_s() > 0)
+        speed_ratios_[j.c->id] = 1.0 / sim_s_per_s / p->second.wall_s_per_sim_s();
+    } else {
+      unknown.push_back(&j);
     }
     rows += fmt::format("  {} {:<12} {:5.1f} deg  t = {:8.3f} / {:g} s  {:8.4f} sim s/s\n", j.c->id,
                         j.c->group, j.c->params.gravity.angle_deg, t_s, end_s, sim_s_per_s);
   }
-  // Mean wall time of the cases finished in this run, else an estimate from the running ones,
-  // else the plan's.
+  // A case the plan does not price: the mean wall time of the cases finished in this run, else an
+  // estimate from the running ones, else the plan's mean.
   double per_case_s = estimated > 0 ? estimated_case_s / estimated : planned_case_wall_s_;
   if (!finished_wall_s_.empty()) {
     per_case_s = 0;
     for (double w : finished_wall_s_) per_case_s += w;
     per_case_s /= static_cast<double>(finished_wall_s_.size());
   }
-  const double eta_s = (remaining_s + static_cast<double>(counts.pending + unknown) * per_case_s) / jobs_;
+  // How fast the cases run against the plan: it prices each case the plan knows.
+  double speed_ratio = 1.0;
+  if (!speed_ratios_.empty()) {
+    speed_ratio = 0;
+    for (const auto& [id, r] : speed_ratios_) speed_ratio += r;
+    speed_ratio /= static_cast<double>(speed_ratios_.size());
+  }
+  const auto planned_rest_s = [&](const std::string& id) {
+    const auto p = plan_.find(id);
+    if (p == plan_.end()) return per_case_s;
+    const auto seen = last_t_s_.find(id);
+    const double from_s =
+        seen == last_t_s_.end() ? p->second.from_s : std::max(p->second.from_s, seen->second);
+    const double per_sim = p->second.wall_s_per_sim_s();
+    const double planned = std::isfinite(per_sim) ? per_sim * (p->second.end_s - from_s) : p->second.wall_s;
+    return speed_ratio * std::max(0.0, planned);
+  };
+  for (const RunningCase* j : unknown) remaining_s += planned_rest_s(j->c->id);
+  for (const auto& id : counts.pending_ids) remaining_s += planned_rest_s(id);
+  const std::size_t unnamed = counts.pending - std::min(counts.pending, counts.pending_ids.size());
+  const double eta_s = (remaining_s + static_cast<double>(unnamed) * per_case_s) / jobs_;
   s += fmt::format("study {}: {} done, {} running, {} failed, {} pending; ETA {}{}\n", study_, counts.done,
                    running.size(), counts.failed, counts.pending, eta_text(eta_s),
                    counts.stopping ? " (stopping)" : "");

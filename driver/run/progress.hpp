@@ -55,6 +55,18 @@ struct ProgressCounts {
   int failed = 0;
   std::size_t pending = 0;
   bool stopping = false;
+  /// The pending cases' ids where known (the ETA prices each by its plan); pending may count more.
+  std::vector<std::string> pending_ids;
+};
+
+/// The plan's estimate of a case's rest (`study run`'s first line): wall_s on the study's ranks
+/// for the simulated time from from_s to end_s.
+struct PlannedCase {
+  double wall_s = 0.0;
+  double from_s = 0.0;
+  double end_s = 0.0;
+  /// Planned wall seconds per simulated second; NaN where the rest spans no simulated time.
+  double wall_s_per_sim_s() const;
 };
 
 class ProgressDisplay {
@@ -63,11 +75,16 @@ class ProgressDisplay {
   /// nothing).
   ProgressDisplay(std::string study, int jobs, bool live, double plain_every_s);
 
-  /// A case finished in this run after `wall_s` seconds: the ETA's time per case from now on.
-  void add_finished_case(double wall_s) { finished_wall_s_.push_back(wall_s); }
-  /// The plan's wall time per case (the line `study run` prints first): the ETA's time per case
-  /// until cases report a rate or finish, so that the first ETA is the plan's.
-  void set_planned_case_wall_s(double wall_s) { planned_case_wall_s_ = wall_s; }
+  /// A case finished in this run after `wall_s` seconds, having run from simulated time from_s:
+  /// the time per case of the pending cases the plan does not price, and, measured against the
+  /// plan, how fast the cases run against it.
+  void add_finished_case(const std::string& id, double wall_s, double from_s);
+  /// The plan's estimate per case id (the line `study run` prints first), so that the first ETA
+  /// is the plan's. The ETA prices each pending case by its own estimate (a study's cases differ
+  /// several-fold: a 405 000-particle case against a 120 000 one) times the mean ratio of the
+  /// measured to the planned wall time per simulated second over the cases running or finished
+  /// in this run; a case stopped part-way only for the simulated time it has left.
+  void set_plan(std::map<std::string, PlannedCase> cases);
 
   /// Replaces the lines drawn last.
   void draw(const ProgressCounts& counts, const std::vector<RunningCase>& running) {
@@ -86,7 +103,12 @@ class ProgressDisplay {
   bool live_;
   double plain_every_s_;
   std::vector<double> finished_wall_s_;
-  double planned_case_wall_s_ = std::numeric_limits<double>::quiet_NaN();
+  std::map<std::string, PlannedCase> plan_;
+  double planned_case_wall_s_ = std::numeric_limits<double>::quiet_NaN();  ///< the plan's mean
+  /// Measured over planned wall time per simulated second, by id, of each case that ran in this
+  /// run: its whole attempt once finished, else its recent rate when last seen running.
+  std::map<std::string, double> speed_ratios_;
+  std::map<std::string, double> last_t_s_;  ///< by id: where each case was when last seen running
   int printed_lines_ = 0;
   std::chrono::steady_clock::time_point last_draw_;
   std::map<std::string, RecentRate> rates_;  ///< by run folder, of the cases running now

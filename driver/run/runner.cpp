@@ -113,7 +113,7 @@ int study_run(const StudyRunOptions& options) {
   const PlanEstimate plan = plan_estimate(db, study, to_run, opt.jobs, opt.ranks, root);
   if (!to_run.empty()) std::fprintf(stderr, "%s\n", plan.line.c_str());
   Scheduler scheduler(db, study, states, opt, root, solver);
-  scheduler.set_planned_case_wall_s(plan.mean_case_wall_s);
+  scheduler.set_plan(plan.cases);
   bool stopped = scheduler.run();
   std::string storage_stop = scheduler.storage_stop();
   // Rounds: replicas where a point's scatter is too large (replicas_target_rel_error), then

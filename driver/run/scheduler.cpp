@@ -183,7 +183,8 @@ void Scheduler::finish(const RunningCase& run, int exit_code) {
   if (end.kind != AttemptEnd::Kind::kStorageFailed) storage_failures_in_a_row_ = 0;
   if (end.kind == AttemptEnd::Kind::kDone) {
     ++done_;
-    progress_.add_finished_case(std::chrono::duration<double>(Clock::now() - run.started).count());
+    progress_.add_finished_case(c->id, std::chrono::duration<double>(Clock::now() - run.started).count(),
+                                run.t_start_s);
     return;
   }
   if (end.kind == AttemptEnd::Kind::kInterrupted) {
@@ -229,7 +230,10 @@ void Scheduler::finish(const RunningCase& run, int exit_code) {
 }
 
 ProgressCounts Scheduler::counts() const {
-  return {done_, failed_, queue_.size() + backing_off_.size(), stopping_};
+  ProgressCounts out{done_, failed_, queue_.size() + backing_off_.size(), stopping_, {}};
+  for (const StudyCase* c : queue_) out.pending_ids.push_back(c->id);
+  for (const auto& b : backing_off_) out.pending_ids.push_back(b.second->id);
+  return out;
 }
 
 }  // namespace boycott::driver

@@ -57,8 +57,8 @@ class Scheduler {
   const std::string& storage_stop() const { return storage_stop_; }
 
   static constexpr int kStorageFailuresToStop = 5;
-  /// The plan's wall time per case, for the progress display's first ETA.
-  void set_planned_case_wall_s(double wall_s) { progress_.set_planned_case_wall_s(wall_s); }
+  /// The plan's estimate per case id, for the progress display's ETA.
+  void set_plan(std::map<std::string, PlannedCase> cases) { progress_.set_plan(std::move(cases)); }
 
  private:
   /// Starts the case, or records it without running it when its result is already there; false

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -75,15 +76,18 @@ TEST(CaseProgress, TheFinishedLiveLineShowsTheWallTimeAndNoEta) {
 TEST(StudyProgress, TheFirstEtaIsThePlansUntilACaseReportsARate) {
   // 4 cases pending on 2 jobs at the plan's 100 s each: 200 s, the plan's study estimate.
   bd::ProgressDisplay display("s", 2, false, 1.0);
-  display.set_planned_case_wall_s(100.0);
+  std::map<std::string, bd::PlannedCase> plan;
+  for (const char* id : {"a", "b", "c", "d"}) plan[id] = {100.0, 0.0, 10.0};
+  display.set_plan(plan);
   bd::ProgressCounts counts;
   counts.pending = 4;
   testing::internal::CaptureStderr();
   display.draw(counts, {});
   std::string line = testing::internal::GetCapturedStderr();
   EXPECT_NE(line.find("4 pending; ETA 3m20s"), std::string::npos) << line;
-  // A finished case's own time replaces the plan's: 3 left at 60 s on 2 jobs.
-  display.add_finished_case(60.0);
+  // A finished case's own time replaces the plan's mean for cases the counts do not name: 3 left
+  // at 60 s on 2 jobs.
+  display.add_finished_case("a", 60.0, 0.0);
   counts.pending = 3;
   counts.done = 1;
   testing::internal::CaptureStderr();
@@ -130,5 +134,54 @@ TEST(StudyProgress, ARunningCasesRateIsItsRecentOneSoAPauseAgesOut) {
   EXPECT_NE(after.find("0.0010 sim s/s"), std::string::npos) << after;
   // 7.4 simulated s left at 0.001: 7 400 s (the attempt's mean rate, 0.00042, would say 4h54m).
   EXPECT_NE(after.find("ETA 2h03m"), std::string::npos) << after;
+  fs::remove_all(dir);
+}
+
+TEST(StudyProgress, EachPendingCaseIsPricedByItsOwnPlanAtTheRateTheCasesRunAgainstIt) {
+  // A study's cases differ several-fold (a 405 000-particle case against a 120 000 one): a mean
+  // case misprices them. The plan: "cheap" 100 s for 0-10 simulated s, "dear" 400 s.
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "boycott_study_progress_per_case_plan";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  bd::StudyCase cheap;
+  cheap.group = std::string("g");
+  cheap.id = std::string("cheap");
+  cheap.params.time.end_s = 10.0;
+  bd::ProgressDisplay display("s", 1, false, 1.0);
+  display.set_plan({{"cheap", {100.0, 0.0, 10.0}}, {"dear", {400.0, 0.0, 10.0}}});
+  bd::ProgressCounts counts;
+  counts.pending = 2;
+  counts.pending_ids = {"cheap", "dear"};
+  const auto line = [&](const std::vector<bd::RunningCase>& running, double wall_s) {
+    testing::internal::CaptureStderr();
+    display.draw_at(
+        counts, running,
+        bd::RecentRate::Clock::time_point{} + std::chrono::duration_cast<bd::RecentRate::Clock::duration>(
+                                                  std::chrono::duration<double>(wall_s)));
+    return testing::internal::GetCapturedStderr();
+  };
+  // Nothing ran yet: the plan's sum, 500 s on 1 job.
+  std::string out = line({}, 0.0);
+  EXPECT_NE(out.find("2 pending; ETA 8m20s"), std::string::npos) << out;
+  // "cheap" runs at 20 wall s per simulated s, twice its plan's 10: at t = 5 s its 5 s left take
+  // 100 s, and "dear" is priced at twice its plan, 800 s: 900 s (a mean case of 20 x 10 = 200 s
+  // would say 300 s).
+  bd::RunningCase run;
+  run.c = &cheap;
+  run.dir = dir;
+  run.started = bd::RecentRate::Clock::time_point{};
+  run.t_start_s = 0.0;
+  counts.pending = 1;
+  counts.pending_ids = {"dear"};
+  std::ofstream(dir / "timeseries.csv") << "t_s,mean_wp_m_s\n" << 5.0 << ",-0.1\n";
+  out = line({run}, 100.0);
+  EXPECT_NE(out.find("1 pending; ETA 15m00s"), std::string::npos) << out;
+  // Stopped at t = 5 s, "cheap" is pending again, for the 5 simulated s it has left: the same.
+  counts.pending = 2;
+  counts.pending_ids = {"cheap", "dear"};
+  counts.stopping = true;
+  out = line({}, 101.0);
+  EXPECT_NE(out.find("2 pending; ETA 15m00s (stopping)"), std::string::npos) << out;
   fs::remove_all(dir);
 }
