@@ -71,6 +71,14 @@ void print_study_results(Database& db, const Study& study, int done) {
   }
 }
 
+/// The cases neither done nor failed.
+std::vector<std::string> ids_to_run(const std::vector<CaseState>& states) {
+  std::vector<std::string> ids;
+  for (const auto& s : states)
+    if (s.status != CaseStatus::kDone && s.status != CaseStatus::kFailed) ids.push_back(s.id);
+  return ids;
+}
+
 }  // namespace
 
 int study_run(const StudyRunOptions& options) {
@@ -107,9 +115,7 @@ int study_run(const StudyRunOptions& options) {
 
   auto states = case_states(db, study.name, opt.retries);
   std::erase_if(states, [&](const CaseState& s) { return collected.in_slurm.count(s.id) > 0; });
-  std::vector<std::string> to_run;
-  for (const auto& s : states)
-    if (s.status != CaseStatus::kDone && s.status != CaseStatus::kFailed) to_run.push_back(s.id);
+  const std::vector<std::string> to_run = ids_to_run(states);
   const PlanEstimate plan = plan_estimate(db, study, to_run, opt.jobs, opt.ranks, root);
   if (!to_run.empty()) std::fprintf(stderr, "%s\n", plan.line.c_str());
   Scheduler scheduler(db, study, states, opt, root, solver);
@@ -129,6 +135,7 @@ int study_run(const StudyRunOptions& options) {
     auto more_states = case_states(db, grown.name, opt.retries);
     std::erase_if(more_states, [&](const CaseState& s) { return collected.in_slurm.count(s.id) > 0; });
     Scheduler more_runs(db, grown, more_states, opt, root, solver);
+    more_runs.set_plan(plan_estimate(db, grown, ids_to_run(more_states), opt.jobs, opt.ranks, root).cases);
     stopped = more_runs.run();
     storage_stop = more_runs.storage_stop();
   }
