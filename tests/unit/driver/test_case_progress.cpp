@@ -96,33 +96,58 @@ TEST(StudyProgress, TheFirstEtaIsThePlansUntilACaseReportsARate) {
   EXPECT_NE(line.find("3 pending; ETA 1m30s"), std::string::npos) << line;
 }
 
+namespace {
+/// A case of a study, running in a run folder of its own whose time series the test writes.
+struct FolderCase {
+  std::filesystem::path dir;
+  bd::StudyCase c;
+  bd::RunningCase run;
+  /// Started at `started_wall_s` after the clock's zero, from simulated time 0.
+  FolderCase(const std::string& id, double end_s, double started_wall_s)
+      : dir(std::filesystem::temp_directory_path() / ("boycott_study_progress_" + id)) {
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    // (from std::string, not a literal: GCC 12 warns a false -Wrestrict on assigning a short one)
+    c.group = std::string("g");
+    c.id = id;
+    c.params.time.end_s = end_s;
+    run.c = &c;
+    run.dir = dir;
+    run.started = at(started_wall_s);
+    run.t_start_s = 0.0;
+  }
+  FolderCase(const FolderCase&) = delete;
+  FolderCase& operator=(const FolderCase&) = delete;
+  ~FolderCase() { std::filesystem::remove_all(dir); }
+  /// The solver's last row: simulated time t_s.
+  void reached(double t_s) const {
+    std::ofstream(dir / "timeseries.csv") << "t_s,mean_wp_m_s\n" << t_s << ",-0.1\n";
+  }
+  static bd::RecentRate::Clock::time_point at(double wall_s) {
+    return bd::RecentRate::Clock::time_point{} +
+           std::chrono::duration_cast<bd::RecentRate::Clock::duration>(std::chrono::duration<double>(wall_s));
+  }
+};
+
+/// The progress block drawn at `wall_s` after the clock's zero.
+std::string drawn(bd::ProgressDisplay& display, const bd::ProgressCounts& counts,
+                  const std::vector<bd::RunningCase>& running, double wall_s) {
+  testing::internal::CaptureStderr();
+  display.draw_at(counts, running, FolderCase::at(wall_s));
+  return testing::internal::GetCapturedStderr();
+}
+}  // namespace
+
 TEST(StudyProgress, ARunningCasesRateIsItsRecentOneSoAPauseAgesOut) {
   // A case at 0.001 simulated s per wall s, paused for an hour (a campaign stopped for a
   // benchmark), then running again: once the pause is older than a quarter of the attempt, the
   // rate shown is the running one again, not the attempt's mean.
-  namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / "boycott_study_progress_recent_rate";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  bd::StudyCase c;
-  // (from std::string, not a literal: GCC 12 warns a false -Wrestrict on assigning a short one)
-  c.group = std::string("g");
-  c.id = std::string("0123456789abcdef");
-  c.params.time.end_s = 10.0;
-  bd::RunningCase run;
-  run.c = &c;
-  run.dir = dir;
-  run.started = bd::RecentRate::Clock::time_point{} + std::chrono::hours(1);
-  run.t_start_s = 0.0;
+  const FolderCase f("0123456789abcdef", 10.0, 3600.0);
   bd::ProgressDisplay display("s", 1, false, 1.0);
-  bd::ProgressCounts counts;
+  const bd::ProgressCounts counts;
   auto draw = [&](double wall_s, double t_s) {
-    std::ofstream(dir / "timeseries.csv") << "t_s,mean_wp_m_s\n" << t_s << ",-0.1\n";
-    testing::internal::CaptureStderr();
-    display.draw_at(counts, {run},
-                    run.started + std::chrono::duration_cast<bd::RecentRate::Clock::duration>(
-                                      std::chrono::duration<double>(wall_s)));
-    return testing::internal::GetCapturedStderr();
+    f.reached(t_s);
+    return drawn(display, counts, {f.run}, 3600.0 + wall_s);
   };
   EXPECT_NE(draw(1000, 1.0).find("0.0010 sim s/s"), std::string::npos);
   draw(4600, 1.0);                             // an hour without progress
@@ -134,54 +159,32 @@ TEST(StudyProgress, ARunningCasesRateIsItsRecentOneSoAPauseAgesOut) {
   EXPECT_NE(after.find("0.0010 sim s/s"), std::string::npos) << after;
   // 7.4 simulated s left at 0.001: 7 400 s (the attempt's mean rate, 0.00042, would say 4h54m).
   EXPECT_NE(after.find("ETA 2h03m"), std::string::npos) << after;
-  fs::remove_all(dir);
 }
 
 TEST(StudyProgress, EachPendingCaseIsPricedByItsOwnPlanAtTheRateTheCasesRunAgainstIt) {
   // A study's cases differ several-fold (a 405 000-particle case against a 120 000 one): a mean
   // case misprices them. The plan: "cheap" 100 s for 0-10 simulated s, "dear" 400 s.
-  namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / "boycott_study_progress_per_case_plan";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  bd::StudyCase cheap;
-  cheap.group = std::string("g");
-  cheap.id = std::string("cheap");
-  cheap.params.time.end_s = 10.0;
+  const FolderCase cheap("cheap", 10.0, 0.0);
   bd::ProgressDisplay display("s", 1, false, 1.0);
   display.set_plan({{"cheap", {100.0, 0.0, 10.0}}, {"dear", {400.0, 0.0, 10.0}}});
   bd::ProgressCounts counts;
   counts.pending = 2;
   counts.pending_ids = {"cheap", "dear"};
-  const auto line = [&](const std::vector<bd::RunningCase>& running, double wall_s) {
-    testing::internal::CaptureStderr();
-    display.draw_at(
-        counts, running,
-        bd::RecentRate::Clock::time_point{} + std::chrono::duration_cast<bd::RecentRate::Clock::duration>(
-                                                  std::chrono::duration<double>(wall_s)));
-    return testing::internal::GetCapturedStderr();
-  };
   // Nothing ran yet: the plan's sum, 500 s on 1 job.
-  std::string out = line({}, 0.0);
+  std::string out = drawn(display, counts, {}, 0.0);
   EXPECT_NE(out.find("2 pending; ETA 8m20s"), std::string::npos) << out;
   // "cheap" runs at 20 wall s per simulated s, twice its plan's 10: at t = 5 s its 5 s left take
   // 100 s, and "dear" is priced at twice its plan, 800 s: 900 s (a mean case of 20 x 10 = 200 s
   // would say 300 s).
-  bd::RunningCase run;
-  run.c = &cheap;
-  run.dir = dir;
-  run.started = bd::RecentRate::Clock::time_point{};
-  run.t_start_s = 0.0;
   counts.pending = 1;
   counts.pending_ids = {"dear"};
-  std::ofstream(dir / "timeseries.csv") << "t_s,mean_wp_m_s\n" << 5.0 << ",-0.1\n";
-  out = line({run}, 100.0);
+  cheap.reached(5.0);
+  out = drawn(display, counts, {cheap.run}, 100.0);
   EXPECT_NE(out.find("1 pending; ETA 15m00s"), std::string::npos) << out;
   // Stopped at t = 5 s, "cheap" is pending again, for the 5 simulated s it has left: the same.
   counts.pending = 2;
   counts.pending_ids = {"cheap", "dear"};
   counts.stopping = true;
-  out = line({}, 101.0);
+  out = drawn(display, counts, {}, 101.0);
   EXPECT_NE(out.find("2 pending; ETA 15m00s (stopping)"), std::string::npos) << out;
-  fs::remove_all(dir);
 }
