@@ -100,8 +100,8 @@ double PlannedCase::wall_s_per_sim_s() const {
   return end_s > from_s ? wall_s / (end_s - from_s) : std::numeric_limits<double>::quiet_NaN();
 }
 
-void ProgressDisplay::set_plan(std::map<std::string, PlannedCase> cases) {
-  plan_ = std::move(cases);
+void ProgressDisplay::set_plan(const std::map<std::string, PlannedCase>& cases) {
+  plan_ = {cases.begin(), cases.end()};
   double sum = 0.0;
   for (const auto& [id, p] : plan_) sum += p.wall_s;
   planned_case_wall_s_ =
@@ -124,11 +124,12 @@ ProgressDisplay::ProgressDisplay(std::string study, int jobs, bool live, double 
       plain_every_s_(plain_every_s),
       last_draw_(Clock::now()) {}
 
-void ProgressDisplay::redraw_if_due(const ProgressCounts& counts, const std::vector<RunningCase>& running) {
+void ProgressDisplay::redraw_if_due(const std::function<ProgressCounts()>& counts,
+                                    const std::vector<RunningCase>& running) {
   const auto every =
       live_ ? std::chrono::duration<double>(0.5) : std::chrono::duration<double>(plain_every_s_);
   if ((live_ || plain_every_s_ > 0) && Clock::now() - last_draw_ >= every) {
-    draw(counts, running);
+    draw(counts(), running);
     last_draw_ = Clock::now();
   }
 }

@@ -6,9 +6,11 @@
 #include <cstddef>
 #include <deque>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <map>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -84,7 +86,7 @@ class ProgressDisplay {
   /// several-fold: a 405 000-particle case against a 120 000 one) times the mean ratio of the
   /// measured to the planned wall time per simulated second over the cases running or finished
   /// in this run; a case stopped part-way only for the simulated time it has left.
-  void set_plan(std::map<std::string, PlannedCase> cases);
+  void set_plan(const std::map<std::string, PlannedCase>& cases);
 
   /// Replaces the lines drawn last.
   void draw(const ProgressCounts& counts, const std::vector<RunningCase>& running) {
@@ -94,8 +96,9 @@ class ProgressDisplay {
   /// case's rate is its recent one (RecentRate, sampled at each draw from its start).
   void draw_at(const ProgressCounts& counts, const std::vector<RunningCase>& running,
                std::chrono::steady_clock::time_point now);
-  /// draw(), at most twice a second live, else every plain_every_s.
-  void redraw_if_due(const ProgressCounts& counts, const std::vector<RunningCase>& running);
+  /// draw() with counts(), at most twice a second live, else every plain_every_s (counts() is
+  /// asked only then: it lists every pending case, and the scheduler polls every 20 ms).
+  void redraw_if_due(const std::function<ProgressCounts()>& counts, const std::vector<RunningCase>& running);
 
  private:
   std::string study_;
@@ -103,7 +106,7 @@ class ProgressDisplay {
   bool live_;
   double plain_every_s_;
   std::vector<double> finished_wall_s_;
-  std::map<std::string, PlannedCase> plan_;
+  std::unordered_map<std::string, PlannedCase> plan_;  ///< looked up for every pending case at each draw
   double planned_case_wall_s_ = std::numeric_limits<double>::quiet_NaN();  ///< the plan's mean
   /// Measured over planned wall time per simulated second, by id, of each case that ran in this
   /// run: its whole attempt once finished, else its recent rate when last seen running.

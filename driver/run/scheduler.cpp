@@ -115,7 +115,7 @@ bool Scheduler::run() {
       reap(*exited);
       continue;
     }
-    progress_.redraw_if_due(counts(), running_);
+    progress_.redraw_if_due([this] { return counts(); }, running_);
     // A locked folder frees only when another process exits: no need to ask as often.
     std::this_thread::sleep_for(std::chrono::milliseconds(lock_wait ? 100 : 20));
   }

@@ -58,7 +58,7 @@ class Scheduler {
 
   static constexpr int kStorageFailuresToStop = 5;
   /// The plan's estimate per case id, for the progress display's ETA.
-  void set_plan(std::map<std::string, PlannedCase> cases) { progress_.set_plan(std::move(cases)); }
+  void set_plan(const std::map<std::string, PlannedCase>& cases) { progress_.set_plan(cases); }
 
  private:
   /// Starts the case, or records it without running it when its result is already there; false
